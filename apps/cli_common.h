@@ -1,0 +1,42 @@
+// Shared pieces of the `mapless` subcommands: the run configuration file, pose parsing, and the
+// mapping of YAML onto the library's options structs. main() lives in main.cc.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <stdexcept>
+#include <string>
+
+#include "mapless/core/pose.h"
+#include "mapless/sim/simulation.h"
+
+namespace mapless::app {
+
+// Exit codes: 0 success, 1 a run that did not succeed (e.g. a collision), 2 bad input or usage.
+inline constexpr int kExitRunFailed = 1;
+inline constexpr int kExitBadInput = 2;
+
+// Thrown by a subcommand whose run ended without success (the message says why): exit code 1.
+class RunFailed : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Parses "X,Y,THETA_DEG"; throws InputError naming the option.
+Pose2 ParsePoseDeg(const std::string& text, const std::string& option);
+
+// Options of a simulated run, read from --config FILE (see config/default.yaml).
+sim::DriveOptions LoadDriveOptions(const std::string& config_path);
+
+// Drives the scenario's taught path and writes DIR/frames/NNNNNN.png, DIR/frames.csv,
+// DIR/groundtruth.tum, DIR/odometry.tum, DIR/topdown.png and DIR/summary.json (each file written
+// atomically; frames as they are rendered, so an interrupted run keeps every complete frame).
+sim::DriveSummary DriveToDirectory(const sim::Scenario& scenario, const sim::DriveOptions& options,
+                                   const std::string& out_dir);
+
+// Registers the subcommands on the app.
+void AddSimCommands(CLI::App* app);
+void AddDemoCommand(CLI::App* app);
+void AddBenchCommand(CLI::App* app);
+
+}  // namespace mapless::app

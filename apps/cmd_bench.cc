@@ -1,0 +1,124 @@
+// `mapless bench`: per-stage medians in milliseconds on one thread, on 320x240 frames, next to a
+// stock OpenCV primitive measured in the same run so that the ratio is meaningful on any machine.
+// Later issues add their stages here.
+#include <algorithm>
+#include <chrono>
+#include <functional>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include <opencv2/core.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include "cli_common.h"
+#include "mapless/sim/driver.h"
+
+namespace mapless::app {
+namespace {
+
+// Median over `repeats` calls of `fn(i)`, in milliseconds (after `warmup` untimed calls).
+double MedianMs(int repeats, int warmup, const std::function<void(int)>& fn) {
+  for (int i = 0; i < warmup; ++i) fn(i);
+  std::vector<double> ms;
+  ms.reserve(static_cast<std::size_t>(repeats));
+  for (int i = 0; i < repeats; ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    fn(i);
+    const auto t1 = std::chrono::steady_clock::now();
+    ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+  }
+  std::nth_element(ms.begin(), ms.begin() + static_cast<long>(ms.size() / 2), ms.end());
+  return ms[ms.size() / 2];
+}
+
+// Poses along a scenario's taught path (ground truth of a clean drive), for typical views.
+std::vector<Pose2> PosesAlong(const sim::Scenario& scenario, int count) {
+  std::vector<Pose2> poses;
+  sim::Simulation s(scenario.world, scenario.camera, {}, 1);
+  s.AddRobot(scenario.teach_start, scenario.robot);
+  sim::ScriptedDriver driver(scenario.teach_start, scenario.teach_path, scenario.teach_speed_mps);
+  while (!driver.done() && poses.size() < 5000) {
+    poses.push_back(s.robot(0).pose());
+    s.SetCommand(0, driver.Update(s.robot(0).pose()));
+    s.Advance(0.1);
+  }
+  std::vector<Pose2> picked;
+  for (int i = 0; i < count; ++i) {
+    picked.push_back(poses[static_cast<std::size_t>(i) * poses.size() / static_cast<std::size_t>(count)]);
+  }
+  return picked;
+}
+
+}  // namespace
+
+void AddBenchCommand(CLI::App* app) {
+  struct Args {
+    bool json = false;
+    int repeats = 100;
+    std::string scenario = "narrow_room_sharp_turn";
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* bench = app->add_subcommand(
+      "bench", "Per-stage medians (ms, one thread, 320x240) with OpenCV references from the same run");
+  bench->add_flag("--json", args->json, "Print one JSON object instead of a table");
+  bench->add_option("--repeats", args->repeats, "Timed calls per stage")
+      ->capture_default_str()
+      ->check(CLI::Range(3, 100000));
+  bench->add_option("--scenario", args->scenario, "Scenario whose views are rendered")
+      ->capture_default_str();
+  bench->callback([args] {
+    cv::setNumThreads(1);
+    sim::Scenario scenario = sim::LoadScenario(args->scenario);
+    scenario.camera.model = sim::CameraModel::FromFov(320, 240, DegToRad(60.0));
+    const std::vector<Pose2> poses = PosesAlong(scenario, 32);
+    sim::Simulation s(scenario.world, scenario.camera, {}, 1);
+    s.AddRobot(poses.front(), scenario.robot);
+    const sim::Renderer& renderer = s.renderer();
+    const auto& cam = scenario.camera;
+
+    std::vector<cv::Mat> frames;
+    for (const Pose2& p : poses) frames.push_back(renderer.Render(cam.model, sim::WorldFromCamera(p, cam.mount)));
+
+    nlohmann::json j;
+    j["threads"] = cv::getNumThreads();
+    j["frame"] = "320x240";
+    j["repeats"] = args->repeats;
+    cv::Mat sink;
+    j["sim_render_320x240_ms"] = MedianMs(args->repeats, 3, [&](int i) {
+      const Pose2& p = poses[static_cast<std::size_t>(i) % poses.size()];
+      sink = renderer.Render(cam.model, sim::WorldFromCamera(p, cam.mount));
+    });
+    // Reference: DIS optical flow (PRESET_FAST) on consecutive views of the same drive.
+    std::vector<cv::Mat> pair_a;
+    std::vector<cv::Mat> pair_b;
+    {
+      sim::Simulation drive(scenario.world, scenario.camera, {}, 1);
+      drive.AddRobot(poses[poses.size() / 3], scenario.robot);
+      for (int k = 0; k < 8; ++k) {
+        pair_a.push_back(drive.RenderClean(0));
+        drive.SetCommand(0, Twist2{0.3, 0.1});
+        drive.Advance(0.1);
+        pair_b.push_back(drive.RenderClean(0));
+      }
+    }
+    auto dis = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_FAST);
+    cv::Mat flow;
+    j["opencv_dis_fast_320x240_ms"] = MedianMs(args->repeats, 3, [&](int i) {
+      const auto k = static_cast<std::size_t>(i) % pair_a.size();
+      dis->calc(pair_a[k], pair_b[k], flow);
+    });
+    j["sim_render_over_dis_fast"] =
+        j["sim_render_320x240_ms"].get<double>() / j["opencv_dis_fast_320x240_ms"].get<double>();
+    if (args->json) {
+      std::cout << j.dump() << "\n";
+      return;
+    }
+    std::printf("%-34s %10s\n", "stage", "median ms");
+    for (const char* key : {"sim_render_320x240_ms", "opencv_dis_fast_320x240_ms"}) {
+      std::printf("%-34s %10.3f\n", key, j[key].get<double>());
+    }
+    std::printf("%-34s %10.2f  (issue 2: <= 2.0)\n", "sim_render / dis_fast", j["sim_render_over_dis_fast"].get<double>());
+  });
+}
+
+}  // namespace mapless::app

@@ -1,0 +1,47 @@
+// The `mapless` command line. Subcommands live in cmd_*.cc; this file only dispatches and turns
+// exceptions into one clear error line and an exit code (0 ok, 1 run failed, 2 bad input/usage).
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+#include <opencv2/core.hpp>
+
+#include "cli_common.h"
+#include "mapless/core/check.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"mapless: appearance-based robot navigation from one uncalibrated camera, no map"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "mapless 0.1.0");
+  spdlog::set_pattern("%^[%l]%$ %v");
+  cv::setNumThreads(1);
+  mapless::app::AddDemoCommand(&app);
+  mapless::app::AddSimCommands(&app);
+  mapless::app::AddBenchCommand(&app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "mapless: error: " << e.what() << " (see --help)\n";
+    return mapless::app::kExitBadInput;
+  } catch (const mapless::InputError& e) {
+    std::cerr << "mapless: error: " << e.what() << "\n";
+    return mapless::app::kExitBadInput;
+  } catch (const mapless::app::RunFailed& e) {
+    std::cerr << "mapless: " << e.what() << "\n";
+    return mapless::app::kExitRunFailed;
+  } catch (const cv::Exception& e) {
+    std::cerr << "mapless: error: OpenCV: " << e.err << " in " << e.func << "\n";
+    return mapless::app::kExitRunFailed;
+  } catch (const std::exception& e) {
+    std::cerr << "mapless: error: " << e.what() << "\n";
+    return mapless::app::kExitRunFailed;
+  }
+  return 0;
+}

@@ -1,0 +1,52 @@
+// Google Benchmark micro benchmarks. The per-stage medians users quote come from `mapless bench`;
+// these are for profiling single primitives while optimising.
+#include <benchmark/benchmark.h>
+
+#include <opencv2/core.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include "mapless/sim/simulation.h"
+
+namespace {
+
+using mapless::Pose2;
+using mapless::Twist2;
+using mapless::sim::LoadScenario;
+using mapless::sim::Simulation;
+
+void BM_SimRender320x240(benchmark::State& state) {
+  cv::setNumThreads(1);
+  const auto scenario = LoadScenario("narrow_room_sharp_turn");
+  Simulation sim(scenario.world, scenario.camera, {}, 1);
+  sim.AddRobot(Pose2{1.0, 0.0, 0.0}, scenario.robot);
+  for (auto _ : state) benchmark::DoNotOptimize(sim.RenderClean(0).data);
+}
+BENCHMARK(BM_SimRender320x240)->Unit(benchmark::kMillisecond);
+
+void BM_SimRenderOutdoor320x240(benchmark::State& state) {
+  cv::setNumThreads(1);
+  const auto scenario = LoadScenario("outdoor_70m");
+  Simulation sim(scenario.world, scenario.camera, {}, 1);
+  sim.AddRobot(Pose2{10.0, 0.0, 0.0}, scenario.robot);
+  for (auto _ : state) benchmark::DoNotOptimize(sim.RenderClean(0).data);
+}
+BENCHMARK(BM_SimRenderOutdoor320x240)->Unit(benchmark::kMillisecond);
+
+void BM_OpenCvDisFast320x240(benchmark::State& state) {
+  cv::setNumThreads(1);
+  const auto scenario = LoadScenario("narrow_room_sharp_turn");
+  Simulation sim(scenario.world, scenario.camera, {}, 1);
+  sim.AddRobot(Pose2{1.0, 0.0, 0.0}, scenario.robot);
+  const cv::Mat a = sim.RenderClean(0);
+  sim.SetCommand(0, Twist2{0.3, 0.1});
+  sim.Advance(0.1);
+  const cv::Mat b = sim.RenderClean(0);
+  auto dis = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_FAST);
+  cv::Mat flow;
+  for (auto _ : state) dis->calc(a, b, flow);
+}
+BENCHMARK(BM_OpenCvDisFast320x240)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

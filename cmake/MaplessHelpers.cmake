@@ -1,0 +1,39 @@
+# Helpers shared by every target of the project.
+
+# Warnings as errors on the project's own targets only (never in global flags).
+function(mapless_target_warnings target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor
+                                           -Wold-style-cast -Wcast-align -Wunused -Woverloaded-virtual
+                                           -Wnull-dereference -Wformat=2 -Werror)
+  if(MAPLESS_SANITIZE)
+    target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer
+                                             -fno-sanitize-recover=undefined)
+    target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+  endif()
+endfunction()
+
+# mapless_library(NAME name SRCS ... PUBLIC_DEPS ... PRIVATE_DEPS ...)
+# One static library per module folder: mapless_<name>, alias mapless::<name>.
+function(mapless_library)
+  cmake_parse_arguments(ARG "" "NAME" "SRCS;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
+  set(target mapless_${ARG_NAME})
+  add_library(${target} STATIC ${ARG_SRCS})
+  add_library(mapless::${ARG_NAME} ALIAS ${target})
+  target_include_directories(${target} PUBLIC ${PROJECT_SOURCE_DIR}/src)
+  target_link_libraries(${target} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+  mapless_target_warnings(${target})
+endfunction()
+
+# mapless_test(NAME name SRCS ... DEPS ...): one GoogleTest binary, tests discovered by ctest.
+function(mapless_test)
+  if(NOT MAPLESS_BUILD_TESTS)
+    return()
+  endif()
+  cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS" ${ARGN})
+  add_executable(${ARG_NAME} ${ARG_SRCS})
+  target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
+  target_compile_definitions(${ARG_NAME} PRIVATE
+    MAPLESS_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  mapless_target_warnings(${ARG_NAME})
+  gtest_discover_tests(${ARG_NAME} WORKING_DIRECTORY ${PROJECT_BINARY_DIR} DISCOVERY_TIMEOUT 60)
+endfunction()

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Installs every Debian package mapless needs to build, test and benchmark.
+# Idempotent: packages already installed are skipped; nothing is done when all are present.
+# Usage: scripts/setup.sh            (as root, or with sudo available)
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake ninja-build pkg-config git
+  libopencv-dev          # images, features, optical flow (Debian's build: no SURF)
+  libeigen3-dev          # linear algebra (PCA, least squares)
+  libyaml-cpp-dev        # scenario, world and configuration files
+  libcli11-dev           # the `mapless` command line
+  libspdlog-dev libfmt-dev   # logging in apps (library code does not log)
+  nlohmann-json3-dev     # JSON output (bench, eval, localize)
+  libgtest-dev libgmock-dev  # unit and integration tests
+  libbenchmark-dev       # micro benchmarks
+  libzmq3-dev cppzmq-dev # fleet messaging (leader/follower)
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null 2>&1 || { echo "setup: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+  SUDO="sudo"
+fi
+
+echo "setup: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -q
+$SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"

@@ -1,0 +1,49 @@
+#include "mapless/io/atomic_file.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "mapless/core/check.h"
+#include "mapless/io/tum.h"
+
+namespace mapless::io {
+namespace {
+
+TEST(AtomicFile, WritesThenReadsBackAndLeavesNoTemporary) {
+  const auto dir = std::filesystem::temp_directory_path() / "mapless_atomic_test";
+  std::filesystem::remove_all(dir);
+  MakeDirectories(dir.string());
+  const std::string path = (dir / "a.txt").string();
+  WriteFileAtomic(path, "first");
+  WriteFileAtomic(path, "second");
+  EXPECT_EQ(ReadFile(path), "second");
+  int files = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++files;
+  EXPECT_EQ(files, 1);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(AtomicFile, UnwritablePathThrowsNamingIt) {
+  try {
+    WriteFileAtomic("/nonexistent_dir/x.txt", "x");
+    FAIL() << "expected an error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent_dir/x.txt"), std::string::npos);
+  }
+}
+
+TEST(Tum, RoundTripsPlanarPoses) {
+  std::vector<StampedPose> poses = {{0, Pose2{1, 2, 0.5}}, {100'000'000, Pose2{-1, 0.25, -2.5}}};
+  const auto back = ParseTum(FormatTum(poses), "t");
+  ASSERT_EQ(back.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(back[i].t_ns, poses[i].t_ns);
+    EXPECT_NEAR(back[i].pose.x_m, poses[i].pose.x_m, 1e-6);
+    EXPECT_NEAR(back[i].pose.y_m, poses[i].pose.y_m, 1e-6);
+    EXPECT_NEAR(back[i].pose.theta_rad, poses[i].pose.theta_rad, 1e-6);
+  }
+}
+
+}  // namespace
+}  // namespace mapless::io

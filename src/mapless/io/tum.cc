@@ -1,0 +1,47 @@
+#include "mapless/io/tum.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "mapless/core/check.h"
+#include "mapless/io/atomic_file.h"
+
+namespace mapless::io {
+
+std::string FormatTum(const std::vector<StampedPose>& poses) {
+  std::string out = "# timestamp tx ty tz qx qy qz qw\n";
+  char line[256];
+  for (const auto& p : poses) {
+    const double half = 0.5 * p.pose.theta_rad;
+    std::snprintf(line, sizeof(line), "%.6f %.6f %.6f 0 0 0 %.9f %.9f\n", ToSeconds(p.t_ns),
+                  p.pose.x_m, p.pose.y_m, std::sin(half), std::cos(half));
+    out += line;
+  }
+  return out;
+}
+
+std::vector<StampedPose> ParseTum(const std::string& text, const std::string& name) {
+  std::vector<StampedPose> out;
+  std::istringstream in(text);
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    double t = 0, x = 0, y = 0, z = 0, qx = 0, qy = 0, qz = 0, qw = 0;
+    if (!(fields >> t >> x >> y >> z >> qx >> qy >> qz >> qw)) {
+      throw InputError(name + ":" + std::to_string(line_no) + ": expected 8 numbers per line");
+    }
+    out.push_back({FromSeconds(t), Pose2{x, y, 2.0 * std::atan2(qz, qw)}});
+    out.back().pose.theta_rad = WrapAngle(out.back().pose.theta_rad);
+  }
+  return out;
+}
+
+void WriteTumAtomic(const std::string& path, const std::vector<StampedPose>& poses) {
+  WriteFileAtomic(path, FormatTum(poses));
+}
+
+}  // namespace mapless::io

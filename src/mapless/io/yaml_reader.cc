@@ -1,0 +1,186 @@
+#include "mapless/io/yaml_reader.h"
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+
+#include "mapless/core/check.h"
+
+namespace mapless::io {
+namespace {
+
+std::string ShortValue(const YAML::Node& node) {
+  if (node.IsScalar()) return "'" + node.Scalar() + "'";
+  if (node.IsSequence()) return "a list";
+  if (node.IsMap()) return "a mapping";
+  return "nothing";
+}
+
+}  // namespace
+
+YamlMap YamlMap::LoadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return LoadString(buffer.str(), path);
+}
+
+YamlMap YamlMap::LoadString(const std::string& text, const std::string& name) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    std::ostringstream out;
+    out << name << ":" << e.mark.line + 1 << ":" << e.mark.column + 1 << ": malformed YAML: " << e.msg;
+    throw InputError(out.str());
+  }
+  if (!root.IsMap()) throw InputError(name + ":1:1: expected a YAML mapping at the top level");
+  return YamlMap(root, name, "");
+}
+
+YamlMap::YamlMap(YAML::Node node, std::string file, std::string path)
+    : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)) {}
+
+std::string YamlMap::ChildPath(const std::string& key) const {
+  if (path_.empty()) return key;
+  if (!key.empty() && key[0] == '[') return path_ + key;
+  return path_ + "." + key;
+}
+
+std::string YamlMap::Where(const YAML::Node& at) const {
+  std::ostringstream out;
+  out << file_;
+  const YAML::Mark mark = at.Mark();
+  if (mark.line >= 0) out << ":" << mark.line + 1 << ":" << mark.column + 1;
+  return out.str();
+}
+
+void YamlMap::Fail(const std::string& key, const std::string& message) const {
+  YAML::Node at = node_;
+  if (!key.empty() && node_.IsMap() && node_[key]) at = node_[key];
+  const std::string field = key.empty() ? path_ : ChildPath(key);
+  throw InputError(Where(at) + ": " + (field.empty() ? "" : field + ": ") + message);
+}
+
+bool YamlMap::Has(const std::string& key) const {
+  return node_.IsMap() && node_[key] && !node_[key].IsNull();
+}
+
+YAML::Node YamlMap::Child(const std::string& key) const {
+  if (!node_.IsMap()) Fail("", "expected a mapping, got " + ShortValue(node_));
+  if (!Has(key)) Fail("", "missing required field '" + ChildPath(key) + "'");
+  return node_[key];
+}
+
+double YamlMap::GetDouble(const std::string& key) const {
+  const YAML::Node n = Child(key);
+  double value = 0.0;
+  if (!n.IsScalar() || !YAML::convert<double>::decode(n, value) || !std::isfinite(value)) {
+    Fail(key, "expected a number, got " + ShortValue(n));
+  }
+  return value;
+}
+
+int YamlMap::GetInt(const std::string& key) const {
+  const YAML::Node n = Child(key);
+  int value = 0;
+  if (!n.IsScalar() || !YAML::convert<int>::decode(n, value)) {
+    Fail(key, "expected an integer, got " + ShortValue(n));
+  }
+  return value;
+}
+
+std::string YamlMap::GetString(const std::string& key) const {
+  const YAML::Node n = Child(key);
+  if (!n.IsScalar()) Fail(key, "expected a string, got " + ShortValue(n));
+  return n.Scalar();
+}
+
+double YamlMap::GetDouble(const std::string& key, double fallback) const {
+  return Has(key) ? GetDouble(key) : fallback;
+}
+int YamlMap::GetInt(const std::string& key, int fallback) const {
+  return Has(key) ? GetInt(key) : fallback;
+}
+bool YamlMap::GetBool(const std::string& key, bool fallback) const {
+  if (!Has(key)) return fallback;
+  const YAML::Node n = node_[key];
+  bool value = false;
+  if (!n.IsScalar() || !YAML::convert<bool>::decode(n, value)) {
+    Fail(key, "expected true or false, got " + ShortValue(n));
+  }
+  return value;
+}
+std::string YamlMap::GetString(const std::string& key, const std::string& fallback) const {
+  return Has(key) ? GetString(key) : fallback;
+}
+
+std::vector<double> YamlMap::GetDoubles(const std::string& key, int n) const {
+  const YAML::Node list = Child(key);
+  const std::string expected =
+      n < 0 ? "a list of numbers" : "a list of " + std::to_string(n) + " numbers";
+  if (!list.IsSequence() || (n >= 0 && static_cast<int>(list.size()) != n)) {
+    Fail(key, "expected " + expected + ", got " + ShortValue(list));
+  }
+  std::vector<double> out;
+  for (const auto& item : list) {
+    double value = 0.0;
+    if (!item.IsScalar() || !YAML::convert<double>::decode(item, value) || !std::isfinite(value)) {
+      Fail(key, "expected " + expected + ", got element " + ShortValue(item));
+    }
+    out.push_back(value);
+  }
+  return out;
+}
+
+std::vector<std::string> YamlMap::GetStrings(const std::string& key) const {
+  const YAML::Node list = Child(key);
+  if (!list.IsSequence()) Fail(key, "expected a list of strings, got " + ShortValue(list));
+  std::vector<std::string> out;
+  for (const auto& item : list) {
+    if (!item.IsScalar()) Fail(key, "expected a list of strings, got element " + ShortValue(item));
+    out.push_back(item.Scalar());
+  }
+  return out;
+}
+
+YamlMap YamlMap::GetMap(const std::string& key) const {
+  const YAML::Node n = Child(key);
+  if (!n.IsMap()) Fail(key, "expected a mapping, got " + ShortValue(n));
+  return YamlMap(n, file_, ChildPath(key));
+}
+
+std::vector<YamlMap> YamlMap::GetList(const std::string& key) const {
+  const YAML::Node list = Child(key);
+  if (!list.IsSequence()) Fail(key, "expected a list, got " + ShortValue(list));
+  std::vector<YamlMap> out;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    out.emplace_back(list[i], file_, ChildPath(key) + "[" + std::to_string(i) + "]");
+  }
+  return out;
+}
+
+std::vector<YamlMap> YamlMap::GetMapList(const std::string& key) const {
+  std::vector<YamlMap> out = GetList(key);
+  for (const auto& item : out) {
+    if (!item.node().IsMap()) item.Fail("", "expected a mapping, got " + ShortValue(item.node()));
+  }
+  return out;
+}
+
+void YamlMap::CheckKnownKeys(std::initializer_list<const char*> known) const {
+  if (!node_.IsMap()) Fail("", "expected a mapping, got " + ShortValue(node_));
+  for (const auto& kv : node_) {
+    const std::string key = kv.first.as<std::string>();
+    const bool ok = std::any_of(known.begin(), known.end(),
+                                [&](const char* k) { return key == k; });
+    if (!ok) {
+      std::string list;
+      for (const char* k : known) list += (list.empty() ? "" : ", ") + std::string(k);
+      Fail(key, "unknown field (known: " + list + ")");
+    }
+  }
+}
+
+}  // namespace mapless::io

@@ -1,0 +1,63 @@
+#include "mapless/io/yaml_reader.h"
+
+#include <gtest/gtest.h>
+
+#include "mapless/core/check.h"
+
+namespace mapless::io {
+namespace {
+
+std::string ErrorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(YamlMap, ReadsTypedFieldsAndDefaults) {
+  const YamlMap m = YamlMap::LoadString("a: 1.5\nb: 3\nc: hello\nd: [1, 2, 3]\ne: true\n", "t.yaml");
+  EXPECT_DOUBLE_EQ(m.GetDouble("a"), 1.5);
+  EXPECT_EQ(m.GetInt("b"), 3);
+  EXPECT_EQ(m.GetString("c"), "hello");
+  EXPECT_EQ(m.GetDoubles("d", 3).size(), 3u);
+  EXPECT_TRUE(m.GetBool("e", false));
+  EXPECT_DOUBLE_EQ(m.GetDouble("missing", 7.0), 7.0);
+}
+
+TEST(YamlMap, MalformedYamlNamesFileAndLine) {
+  const std::string err = ErrorOf([] { YamlMap::LoadString("a: 1\nb: [1, 2\n", "bad.yaml"); });
+  EXPECT_NE(err.find("bad.yaml:"), std::string::npos) << err;
+  EXPECT_NE(err.find("malformed YAML"), std::string::npos) << err;
+}
+
+TEST(YamlMap, WrongTypeNamesFieldPathAndLine) {
+  const YamlMap m = YamlMap::LoadString("world:\n  objects:\n    - size: [1, x]\n", "w.yaml");
+  const std::string err = ErrorOf([&] {
+    m.GetMap("world").GetMapList("objects")[0].GetDoubles("size", 2);
+  });
+  EXPECT_NE(err.find("w.yaml:3:"), std::string::npos) << err;
+  EXPECT_NE(err.find("world.objects[0].size"), std::string::npos) << err;
+}
+
+TEST(YamlMap, UnknownKeyIsAnError) {
+  const YamlMap m = YamlMap::LoadString("speed: 1\nsped: 2\n", "k.yaml");
+  const std::string err = ErrorOf([&] { m.CheckKnownKeys({"speed"}); });
+  EXPECT_NE(err.find("k.yaml:2:"), std::string::npos) << err;
+  EXPECT_NE(err.find("sped: unknown field"), std::string::npos) << err;
+}
+
+TEST(YamlMap, MissingRequiredFieldIsNamed) {
+  const YamlMap m = YamlMap::LoadString("a: 1\n", "m.yaml");
+  const std::string err = ErrorOf([&] { m.GetDouble("b"); });
+  EXPECT_NE(err.find("missing required field 'b'"), std::string::npos) << err;
+}
+
+TEST(YamlMap, MissingFileIsNamed) {
+  const std::string err = ErrorOf([] { YamlMap::LoadFile("/nonexistent/x.yaml"); });
+  EXPECT_NE(err.find("/nonexistent/x.yaml: cannot open file"), std::string::npos) << err;
+}
+
+}  // namespace
+}  // namespace mapless::io

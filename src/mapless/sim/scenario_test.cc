@@ -1,0 +1,125 @@
+#include "mapless/sim/scenario.h"
+
+#include <gtest/gtest.h>
+
+#include <functional>
+
+#include "mapless/core/check.h"
+
+namespace mapless::sim {
+namespace {
+
+std::string ErrorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+const char* kMinimal = R"(
+name: tiny
+world:
+  objects:
+    - {type: box, tag: car, center: [3, 1], size_m: [1, 1, 1]}
+teach:
+  start: [0, 0, 0]
+  path: [[2, 0]]
+)";
+
+TEST(Scenario, EveryBuiltinScenarioLoadsAndValidates) {
+  const auto names = BuiltinScenarioNames();
+  EXPECT_GE(names.size(), 15u);
+  for (const auto& name : names) {
+    Scenario s;
+    ASSERT_NO_THROW(s = LoadScenario(name)) << name;
+    EXPECT_EQ(s.name, name);
+    EXPECT_FALSE(s.description.empty()) << name;
+    EXPECT_GT(s.PathLength(), 0.0) << name;
+    EXPECT_NO_THROW(ApplyVariant(s.world, s.repeat_variant)) << name;
+  }
+}
+
+TEST(Scenario, PaperScenariosHaveThePapersPathLengths) {
+  struct Expect {
+    const char* name;
+    double length_m;
+  };
+  // Kassir et al. Section VII: 9 m, 6 m, 25 m, 10 m, 10 m, 30 m, 70 m.
+  for (const Expect& e : {Expect{"narrow_room_sharp_turn", 9}, Expect{"wide_left_turn_offset_start", 6},
+                          Expect{"corridor_25m", 25}, Expect{"table1_sharp_turn_low_texture", 10},
+                          Expect{"table1_almost_straight", 10}, Expect{"indoor_30m", 30},
+                          Expect{"outdoor_70m", 70}}) {
+    const Scenario s = LoadScenario(e.name);
+    EXPECT_NEAR(s.PathLength(), e.length_m, 0.1 * e.length_m) << e.name;
+  }
+}
+
+TEST(Scenario, OffsetStartRepeatBeginsTwoMetresAheadOfTheTaughtStart) {
+  const Scenario s = LoadScenario("wide_left_turn_offset_start");
+  EXPECT_NEAR(s.teach_start.DistanceTo(s.repeat_start), 2.0, 0.05);
+}
+
+TEST(Scenario, LoopWithRemovedCarsLosesTwoCarsInTheRepeat) {
+  const Scenario s = LoadScenario("outdoor_loop_cars_removed");
+  EXPECT_EQ(s.repeat_variant.remove.size(), 2u);
+  EXPECT_LT(ApplyVariant(s.world, s.repeat_variant).objects.size(), s.world.objects.size());
+}
+
+TEST(Scenario, RotationInPlaceScenarioRotatesNinetyDegrees) {
+  const Scenario s = LoadScenario("rotation_in_place");
+  double rotation = 0;
+  for (const auto& step : s.teach_path) {
+    if (step.kind == PathStep::Kind::kRotate) rotation += step.rotate_rad;
+  }
+  EXPECT_NEAR(std::abs(rotation), kPi / 2, 1e-9);
+}
+
+TEST(Scenario, MinimalScenarioUsesDefaults) {
+  const Scenario s = ParseScenario(kMinimal, "tiny.yaml", "");
+  EXPECT_EQ(s.camera.model.width, 320);
+  EXPECT_EQ(s.camera.model.height, 240);
+  EXPECT_NEAR(s.camera.model.fx, 160.0 / std::tan(DegToRad(30)), 1e-9);
+  EXPECT_DOUBLE_EQ(s.camera.rate_hz, 10.0);
+  EXPECT_EQ(s.world.objects.size(), 1u);
+}
+
+TEST(Scenario, MalformedFieldIsReportedWithFileLineAndField) {
+  std::string text = kMinimal;
+  text.replace(text.find("size_m: [1, 1, 1]"), 17, "size_m: [1, one, 1]");
+  const std::string err = ErrorOf([&] { ParseScenario(text, "bad.yaml", ""); });
+  EXPECT_NE(err.find("bad.yaml:5:"), std::string::npos) << err;
+  EXPECT_NE(err.find("world.objects[0].size_m"), std::string::npos) << err;
+}
+
+TEST(Scenario, UnknownFieldAndUnknownTagAreErrors) {
+  std::string text = std::string(kMinimal) + "repeat:\n  variant: {remove: [truck]}\n";
+  EXPECT_NE(ErrorOf([&] { ParseScenario(text, "t.yaml", ""); }).find("no object has tag 'truck'"),
+            std::string::npos);
+  std::string typo = std::string(kMinimal) + "camra: {width: 10}\n";
+  EXPECT_NE(ErrorOf([&] { ParseScenario(typo, "t.yaml", ""); }).find("camra: unknown field"),
+            std::string::npos);
+}
+
+TEST(Scenario, UnknownBuiltinNameSaysSo) {
+  EXPECT_NE(ErrorOf([] { LoadScenario("no_such_scenario"); }).find("unknown scenario 'no_such_scenario'"),
+            std::string::npos);
+}
+
+TEST(Scenario, RepeatCopiesObjectsAlongAStep) {
+  const char* rep = R"(
+world:
+  objects:
+    - {type: poster, center: [1, 2, 1.5], size_m: [0.5, 0.7], repeat: {count: 4, step: [2.5, 0]}}
+teach: {start: [0, 0, 0], path: [[1, 0]]}
+)";
+  const Scenario s = ParseScenario(rep, "rep.yaml", "");
+  ASSERT_EQ(s.world.objects.size(), 4u);
+  EXPECT_DOUBLE_EQ(s.world.objects[3].center.x(), 8.5);
+  // Identical copies share one texture seed (visual aliasing).
+  EXPECT_EQ(s.world.objects[0].texture.seed, s.world.objects[3].texture.seed);
+}
+
+}  // namespace
+}  // namespace mapless::sim

@@ -1,0 +1,176 @@
+#include "mapless/sim/simulation.h"
+
+#include <cmath>
+
+#include "mapless/core/check.h"
+#include "mapless/sim/driver.h"
+
+namespace mapless::sim {
+
+void SimulationOptions::Validate() const {
+  MAPLESS_CHECK(physics_dt_s > 0.0 && physics_dt_s <= 0.1,
+                "SimulationOptions.physics_dt_s = " << physics_dt_s << "; must be in (0, 0.1]");
+  MAPLESS_CHECK(robot_body_height_m > 0.0,
+                "SimulationOptions.robot_body_height_m = " << robot_body_height_m << "; must be > 0");
+  render.Validate();
+}
+
+void DriveOptions::Validate() const {
+  MAPLESS_CHECK(timeout_factor >= 1.0,
+                "DriveOptions.timeout_factor = " << timeout_factor << "; must be >= 1");
+  sim.Validate();
+}
+
+Simulation::Simulation(const World& world, CameraSpec camera, SimulationOptions options,
+                       std::uint64_t seed)
+    : world_(world),
+      camera_(std::move(camera)),
+      options_(options),
+      seed_(seed),
+      renderer_(world_, options.render) {
+  options_.Validate();
+  camera_.Validate();
+}
+
+int Simulation::AddRobot(const Pose2& start, const RobotOptions& options) {
+  const int index = robot_count();
+  robots_.emplace_back(start, options, Rng::Derive(seed_, 1000 + static_cast<std::uint64_t>(index)).NextU64());
+  frames_.push_back(0);
+  stopped_.push_back(false);
+  TextureSpec body;
+  body.type = TextureType::kBlobs;
+  body.seed = 7000 + static_cast<std::uint64_t>(index);
+  body.texel_m = 0.004;
+  body_textures_.push_back(GenerateTexture(body));
+  return index;
+}
+
+void Simulation::SetCommand(int robot, const Twist2& command) {
+  const auto i = static_cast<std::size_t>(robot);
+  if (stopped_.at(i)) return;
+  robots_.at(i).SetCommand(command);
+}
+
+bool Simulation::collided(int robot) const {
+  for (const Collision& c : collisions_) {
+    if (c.robot == robot) return true;
+  }
+  return false;
+}
+
+void Simulation::Advance(double dt_s) {
+  const int steps = std::max(1, static_cast<int>(std::lround(dt_s / options_.physics_dt_s)));
+  for (int k = 0; k < steps; ++k) {
+    for (std::size_t i = 0; i < robots_.size(); ++i) {
+      if (!stopped_[i]) robots_[i].Step(options_.physics_dt_s);
+    }
+    t_ns_ += FromSeconds(options_.physics_dt_s);
+    CheckCollisions();
+  }
+}
+
+void Simulation::CheckCollisions() {
+  for (std::size_t i = 0; i < robots_.size(); ++i) {
+    if (stopped_[i]) continue;
+    const Pose2& p = robots_[i].pose();
+    const double r = robots_[i].options().radius_m;
+    std::string with;
+    if (ClearanceTo(world_, p.x_m, p.y_m) < r) with = "obstacle";
+    for (std::size_t j = 0; j < robots_.size() && with.empty(); ++j) {
+      if (j == i) continue;
+      if (p.DistanceTo(robots_[j].pose()) < r + robots_[j].options().radius_m) {
+        with = "robot " + std::to_string(j);
+      }
+    }
+    if (!with.empty()) {
+      collisions_.push_back(Collision{static_cast<int>(i), t_ns_, p, with});
+      stopped_[i] = true;
+      robots_[i].Reset(p);
+    }
+  }
+}
+
+std::vector<Surface> Simulation::OtherRobots(int robot) const {
+  std::vector<Surface> out;
+  for (std::size_t j = 0; j < robots_.size(); ++j) {
+    if (static_cast<int>(j) == robot) continue;
+    WorldObject body;
+    body.kind = ObjectKind::kCylinder;
+    body.center = Eigen::Vector2d(robots_[j].pose().x_m, robots_[j].pose().y_m);
+    body.radius_m = robots_[j].options().radius_m;
+    body.height_m = options_.robot_body_height_m;
+    AppendObjectSurfaces(body, body_textures_[j], &out);
+  }
+  return out;
+}
+
+cv::Mat Simulation::RenderClean(int robot) const {
+  const auto& r = robots_.at(static_cast<std::size_t>(robot));
+  return renderer_.Render(camera_.model, WorldFromCamera(r.pose(), camera_.mount), OtherRobots(robot));
+}
+
+cv::Mat Simulation::Render(int robot) {
+  cv::Mat image = RenderClean(robot);
+  const auto i = static_cast<std::size_t>(robot);
+  const std::uint64_t frame = frames_[i]++;
+  if (!camera_.effects.Any()) return image;
+  Rng rng = Rng::Derive(seed_, (frame << 8) + i + 1);
+  return ApplyEffects(image, camera_.effects, &rng);
+}
+
+DriveSummary DriveTaughtPath(const Scenario& scenario, const DriveOptions& options,
+                             const std::function<void(const DriveFrame&)>& on_frame) {
+  options.Validate();
+  scenario.Validate();
+  Simulation sim(scenario.world, scenario.camera, options.sim, options.seed);
+  const int robot = sim.AddRobot(scenario.teach_start, scenario.robot);
+  ScriptedDriver driver(scenario.teach_start, scenario.teach_path, scenario.teach_speed_mps);
+  const double period = 1.0 / scenario.camera.rate_hz;
+  double rotation = 0.0;
+  for (const PathStep& s : scenario.teach_path) {
+    if (s.kind == PathStep::Kind::kRotate) rotation += std::abs(s.rotate_rad);
+  }
+  const double nominal = scenario.PathLength() / scenario.teach_speed_mps + rotation / 0.5 + 5.0;
+  const double timeout = options.timeout_factor * nominal;
+  DriveSummary summary;
+  Pose2 last = scenario.teach_start;
+  while (true) {
+    DriveFrame frame;
+    frame.index = summary.frames;
+    frame.t_ns = sim.now_ns();
+    frame.truth = sim.robot(robot).pose();
+    frame.odometry = sim.robot(robot).odometry();
+    if (options.render_frames) frame.image = sim.Render(robot);
+    if (on_frame) on_frame(frame);
+    ++summary.frames;
+    summary.distance_m += frame.truth.DistanceTo(last);
+    last = frame.truth;
+    if (driver.done()) {
+      summary.completed = true;
+      summary.status = "completed";
+      break;
+    }
+    if (sim.collided(robot) && options.stop_on_collision) {
+      const Collision& c = sim.collisions().front();
+      summary.collided = true;
+      char buf[128];
+      std::snprintf(buf, sizeof(buf), "collision with %s at (%.2f, %.2f) after %.1f s",
+                    c.with.c_str(), c.pose.x_m, c.pose.y_m, ToSeconds(c.t_ns));
+      summary.status = buf;
+      break;
+    }
+    if (ToSeconds(sim.now_ns()) > timeout) {
+      char buf[96];
+      std::snprintf(buf, sizeof(buf), "timeout after %.1f s (3x the nominal duration)", ToSeconds(sim.now_ns()));
+      summary.status = buf;
+      break;
+    }
+    sim.SetCommand(robot, driver.Update(sim.robot(robot).pose()));
+    sim.Advance(period);
+  }
+  summary.collided = summary.collided || sim.collided(robot);
+  summary.duration_s = ToSeconds(sim.now_ns());
+  return summary;
+}
+
+}  // namespace mapless::sim

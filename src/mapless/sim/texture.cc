@@ -1,0 +1,268 @@
+#include "mapless/sim/texture.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "mapless/core/check.h"
+#include "mapless/core/rng.h"
+
+namespace mapless::sim {
+namespace {
+
+struct TypeName {
+  TextureType type;
+  const char* name;
+};
+constexpr TypeName kTypeNames[] = {
+    {TextureType::kNoise, "noise"},   {TextureType::kBricks, "bricks"},
+    {TextureType::kTiles, "tiles"},   {TextureType::kBlobs, "blobs"},
+    {TextureType::kPoster, "poster"}, {TextureType::kPlain, "plain"},
+    {TextureType::kChecker, "checker"}, {TextureType::kImage, "image"}};
+
+// Tileable value noise: a random lattice of `cells` x `cells` values, bicubic-smoothed by upsampling
+// with wrap-around, so that the result tiles.
+cv::Mat TileableNoise(int size, int cells, Rng* rng) {
+  cv::Mat lattice(cells, cells, CV_32F);
+  for (int y = 0; y < cells; ++y) {
+    for (int x = 0; x < cells; ++x) lattice.at<float>(y, x) = static_cast<float>(rng->Uniform());
+  }
+  // Pad by wrapping, upsample, crop: keeps continuity across the tile border.
+  const int pad = 2;
+  cv::Mat padded;
+  cv::copyMakeBorder(lattice, padded, pad, pad, pad, pad, cv::BORDER_WRAP);
+  const double scale = static_cast<double>(size) / cells;
+  cv::Mat up;
+  cv::resize(padded, up, cv::Size(), scale, scale, cv::INTER_CUBIC);
+  const int off = static_cast<int>(std::lround(pad * scale));
+  return up(cv::Rect(off, off, size, size)).clone();
+}
+
+// Fractal (multi-octave) noise in [-1, 1] roughly, tileable.
+cv::Mat FractalNoise(int size, int base_cells, int octaves, Rng* rng) {
+  cv::Mat sum = cv::Mat::zeros(size, size, CV_32F);
+  double amplitude = 1.0;
+  double total = 0.0;
+  int cells = base_cells;
+  for (int o = 0; o < octaves && cells <= size; ++o) {
+    sum += amplitude * (TileableNoise(size, cells, rng) - 0.5);
+    total += amplitude;
+    amplitude *= 0.6;
+    cells *= 2;
+  }
+  return sum * (2.0 / total);
+}
+
+// Draws a filled rectangle that wraps around the tile border.
+void WrappedRect(cv::Mat* img, int x, int y, int w, int h, float value) {
+  const int size = img->cols;
+  for (int dy = -size; dy <= 0; dy += size) {
+    for (int dx = -size; dx <= 0; dx += size) {
+      cv::rectangle(*img, cv::Rect(x + dx, y + dy, w, h), cv::Scalar(value), cv::FILLED);
+      cv::rectangle(*img, cv::Rect(x + dx + size, y + dy + size, w, h), cv::Scalar(value),
+                    cv::FILLED);
+      cv::rectangle(*img, cv::Rect(x + dx + size, y + dy, w, h), cv::Scalar(value), cv::FILLED);
+      cv::rectangle(*img, cv::Rect(x + dx, y + dy + size, w, h), cv::Scalar(value), cv::FILLED);
+    }
+  }
+}
+
+void WrappedEllipse(cv::Mat* img, int x, int y, int ax, int ay, double angle, float value) {
+  const int size = img->cols;
+  for (int oy = -size; oy <= size; oy += size) {
+    for (int ox = -size; ox <= size; ox += size) {
+      cv::ellipse(*img, cv::Point(x + ox, y + oy), cv::Size(ax, ay), angle, 0, 360,
+                  cv::Scalar(value), cv::FILLED, cv::LINE_AA);
+    }
+  }
+}
+
+// Signed content in roughly [-1, 1]; scaled to mean/contrast at the end.
+cv::Mat Noise(int size, Rng* rng) { return FractalNoise(size, 4, 6, rng) * 1.6; }
+
+cv::Mat Bricks(int size, Rng* rng) {
+  cv::Mat img = FractalNoise(size, 16, 4, rng) * 0.25;
+  const int rows = 8;
+  const int cols = 4;
+  const int bh = size / rows;
+  const int bw = size / cols;
+  const int mortar = std::max(2, size / 96);
+  for (int r = 0; r < rows; ++r) {
+    const int shift = (r % 2) * bw / 2;
+    for (int c = 0; c < cols; ++c) {
+      const float tone = static_cast<float>(rng->Uniform(-0.6, 0.6));
+      cv::Mat brick = img(cv::Rect(0, r * bh, size, bh));
+      const int x0 = (c * bw + shift) % size;
+      cv::Mat region(bh, bw, CV_32F, cv::Scalar(tone));
+      for (int y = 0; y < bh; ++y) {
+        for (int x = 0; x < bw; ++x) {
+          float& v = brick.at<float>(y, (x0 + x) % size);
+          const bool is_mortar = y < mortar || x < mortar;
+          v = is_mortar ? -1.0f : v + region.at<float>(y, x);
+        }
+      }
+    }
+  }
+  return img;
+}
+
+cv::Mat Tiles(int size, Rng* rng) {
+  cv::Mat img = FractalNoise(size, 8, 5, rng) * 0.3;
+  const int n = 8;
+  const int step = size / n;
+  const int grout = std::max(2, size / 128);
+  for (int ty = 0; ty < n; ++ty) {
+    for (int tx = 0; tx < n; ++tx) {
+      const float tone = static_cast<float>(rng->Uniform(-0.5, 0.5));
+      img(cv::Rect(tx * step, ty * step, step, step)) += tone;
+      // A few specks per tile give corners for feature detectors.
+      for (int k = 0; k < 2; ++k) {
+        const int sx = tx * step + grout + static_cast<int>(rng->UniformInt(step - 3 * grout));
+        const int sy = ty * step + grout + static_cast<int>(rng->UniformInt(step - 3 * grout));
+        const int w = 2 + static_cast<int>(rng->UniformInt(std::max(1, step / 6)));
+        cv::rectangle(img, cv::Rect(sx, sy, w, w), cv::Scalar(rng->Uniform(-1, 1)), cv::FILLED);
+      }
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    img(cv::Rect(0, i * step, size, grout)).setTo(-1.0);
+    img(cv::Rect(i * step, 0, grout, size)).setTo(-1.0);
+  }
+  return img;
+}
+
+cv::Mat Blobs(int size, Rng* rng) {
+  cv::Mat img = FractalNoise(size, 4, 6, rng) * 0.5;
+  const int count = 60 + static_cast<int>(rng->UniformInt(40));
+  for (int i = 0; i < count; ++i) {
+    const int x = static_cast<int>(rng->UniformInt(size));
+    const int y = static_cast<int>(rng->UniformInt(size));
+    const float value = static_cast<float>(rng->Uniform(-1.0, 1.0));
+    const int extent = 3 + static_cast<int>(rng->UniformInt(std::max(1, size / 14)));
+    if (rng->Uniform() < 0.5) {
+      WrappedRect(&img, x, y, extent, 3 + static_cast<int>(rng->UniformInt(extent + 1)), value);
+    } else {
+      WrappedEllipse(&img, x, y, extent, 2 + static_cast<int>(rng->UniformInt(extent + 1)),
+                     rng->Uniform(0, 180), value);
+    }
+  }
+  return img;
+}
+
+cv::Mat Poster(int size, Rng* rng) {
+  // High-contrast picture: a background, big shapes, and lines of "text" bars. Not tileable.
+  cv::Mat img(size, size, CV_32F, cv::Scalar(rng->Uniform(-0.8, 0.8)));
+  img += FractalNoise(size, 4, 4, rng) * 0.2;
+  const int shapes = 6 + static_cast<int>(rng->UniformInt(6));
+  for (int i = 0; i < shapes; ++i) {
+    const cv::Point c(static_cast<int>(rng->UniformInt(size)), static_cast<int>(rng->UniformInt(size)));
+    const int r = size / 16 + static_cast<int>(rng->UniformInt(size / 5));
+    const double value = rng->Uniform(-1.0, 1.0);
+    if (i % 2 == 0) {
+      cv::circle(img, c, r, cv::Scalar(value), cv::FILLED, cv::LINE_AA);
+    } else {
+      cv::rectangle(img, cv::Rect(c.x - r, c.y - r / 2, 2 * r, r), cv::Scalar(value), cv::FILLED);
+    }
+  }
+  const int lines = 4 + static_cast<int>(rng->UniformInt(5));
+  for (int l = 0; l < lines; ++l) {
+    const int y = size / 10 + l * (size * 8 / 10) / lines;
+    int x = size / 12;
+    while (x < size * 11 / 12) {
+      const int w = size / 40 + static_cast<int>(rng->UniformInt(size / 12));
+      cv::rectangle(img, cv::Rect(x, y, w, std::max(2, size / 40)), cv::Scalar(-1.0), cv::FILLED);
+      x += w + size / 60;
+    }
+  }
+  const int border = std::max(2, size / 50);
+  cv::rectangle(img, cv::Rect(0, 0, size, size), cv::Scalar(1.0), border);
+  return img;
+}
+
+cv::Mat Plain(int size, Rng* rng) { return FractalNoise(size, 2, 3, rng) * 0.3; }
+
+cv::Mat Checker(int size) {
+  cv::Mat img(size, size, CV_32F);
+  const int step = size / 8;
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x) {
+      img.at<float>(y, x) = ((x / step + y / step) % 2 == 0) ? 1.0f : -1.0f;
+    }
+  }
+  return img;
+}
+
+bool IsPowerOfTwo(int v) { return v > 0 && (v & (v - 1)) == 0; }
+
+}  // namespace
+
+TextureType ParseTextureType(const std::string& name) {
+  for (const auto& t : kTypeNames) {
+    if (name == t.name) return t.type;
+  }
+  throw InputError("unknown texture type '" + name +
+                   "' (known: noise, bricks, tiles, blobs, poster, plain, checker, image)");
+}
+
+const char* TextureTypeName(TextureType type) {
+  for (const auto& t : kTypeNames) {
+    if (type == t.type) return t.name;
+  }
+  return "?";
+}
+
+void TextureSpec::Validate() const {
+  MAPLESS_CHECK(texel_m > 0.0, "TextureSpec.texel_m = " << texel_m << "; must be > 0");
+  MAPLESS_CHECK(mean >= 0.0 && mean <= 255.0, "TextureSpec.mean = " << mean << "; must be in [0, 255]");
+  MAPLESS_CHECK(contrast >= 0.0 && contrast <= 4.0,
+                "TextureSpec.contrast = " << contrast << "; must be in [0, 4]");
+  MAPLESS_CHECK(IsPowerOfTwo(size_px) && size_px >= 64 && size_px <= 2048,
+                "TextureSpec.size_px = " << size_px << "; must be a power of two in [64, 2048]");
+  MAPLESS_CHECK(type != TextureType::kImage || !file.empty(),
+                "TextureSpec.file is empty; an image texture needs a file");
+}
+
+cv::Mat GenerateTextureImage(const TextureSpec& spec) {
+  spec.Validate();
+  Rng rng(spec.seed * 0x9E3779B97F4A7C15ULL + static_cast<std::uint64_t>(spec.type));
+  const int size = spec.size_px;
+  if (spec.type == TextureType::kImage) {
+    cv::Mat img = cv::imread(spec.file, cv::IMREAD_GRAYSCALE);
+    if (img.empty()) throw InputError(spec.file + ": cannot read texture image");
+    cv::Mat out;
+    cv::resize(img, out, cv::Size(size, size), 0, 0, cv::INTER_AREA);
+    return out;
+  }
+  cv::Mat signal;
+  switch (spec.type) {
+    case TextureType::kNoise: signal = Noise(size, &rng); break;
+    case TextureType::kBricks: signal = Bricks(size, &rng); break;
+    case TextureType::kTiles: signal = Tiles(size, &rng); break;
+    case TextureType::kBlobs: signal = Blobs(size, &rng); break;
+    case TextureType::kPoster: signal = Poster(size, &rng); break;
+    case TextureType::kPlain: signal = Plain(size, &rng); break;
+    case TextureType::kChecker: signal = Checker(size); break;
+    case TextureType::kImage: break;
+  }
+  cv::Mat out;
+  signal.convertTo(out, CV_8U, 80.0 * spec.contrast, spec.mean);
+  return out;
+}
+
+std::shared_ptr<const Texture> GenerateTexture(const TextureSpec& spec) {
+  auto texture = std::make_shared<Texture>();
+  texture->texel_m = spec.texel_m;
+  texture->fit = spec.fit;
+  texture->levels.push_back(GenerateTextureImage(spec));
+  // Box-filtered mip levels down to 1x1 (exact 2x2 averages keep the texture tileable).
+  while (texture->levels.back().cols > 1) {
+    cv::Mat next;
+    cv::resize(texture->levels.back(), next, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+    texture->levels.push_back(next);
+  }
+  return texture;
+}
+
+}  // namespace mapless::sim

@@ -1,0 +1,48 @@
+// Procedural textures for the simulated world, generated from a seed: multi-scale noise, bricks,
+// tiles, random blobs and rectangles, posters, a low-texture plain variant, or an image file.
+// Each texture is a power-of-two grayscale image that tiles, with a mip pyramid so that the
+// renderer samples it without aliasing at any distance.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace mapless::sim {
+
+enum class TextureType { kNoise, kBricks, kTiles, kBlobs, kPoster, kPlain, kChecker, kImage };
+
+// Parses "noise", "bricks", ... ; throws InputError on an unknown name.
+TextureType ParseTextureType(const std::string& name);
+const char* TextureTypeName(TextureType type);
+
+struct TextureSpec {
+  TextureType type = TextureType::kNoise;
+  std::uint64_t seed = 1;
+  double texel_m = 0.01;   // world size of one texel, metres (ignored when `fit` is set)
+  bool fit = false;        // stretch one copy over the whole surface (posters, pictures)
+  double mean = 128.0;     // mean intensity, 0..255
+  double contrast = 1.0;   // 1 = the type's normal contrast; 0.15 gives a low-texture surface
+  int size_px = 256;       // side of the texture image, a power of two (64..2048)
+  std::string file;        // image file for kImage (grayscale; resized to size_px)
+
+  void Validate() const;   // throws InputError naming the field and value
+};
+
+// A tileable texture with its mip pyramid: levels[0] is size_px x size_px, each next level half.
+struct Texture {
+  std::vector<cv::Mat> levels;  // CV_8UC1, power-of-two sides
+  double texel_m = 0.01;
+  bool fit = false;
+};
+
+// Generates the texture for `spec` (deterministic for a given spec).
+std::shared_ptr<const Texture> GenerateTexture(const TextureSpec& spec);
+
+// Only the base image, without mip levels (for tests and previews).
+cv::Mat GenerateTextureImage(const TextureSpec& spec);
+
+}  // namespace mapless::sim

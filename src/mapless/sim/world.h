@@ -1,0 +1,66 @@
+// The simulated world: a textured ground plane, an optional ceiling, a sky, and objects standing on
+// the ground: walls (vertical rectangles), boxes (cars, chairs, cupboards), cylinders (pillars,
+// bins) and flat posters. Objects carry tags so that a variant of the same world can remove or move
+// them (the papers' "two parked cars left during the repeat").
+#pragma once
+
+#include <Eigen/Core>
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mapless/sim/texture.h"
+
+namespace mapless::sim {
+
+enum class ObjectKind { kWall, kBox, kCylinder, kPoster };
+
+struct WorldObject {
+  ObjectKind kind = ObjectKind::kBox;
+  std::string tag;          // optional; used by variants
+  TextureSpec texture;
+  // kWall: a vertical rectangle from `a` to `b` on the ground, `height_m` tall.
+  Eigen::Vector2d a = Eigen::Vector2d::Zero();
+  Eigen::Vector2d b = Eigen::Vector2d::Zero();
+  // kBox: centre, footprint `size_m` (length along yaw, width), `height_m`, heading `yaw_rad`.
+  // kCylinder: centre, `radius_m`, `height_m`.
+  // kPoster: centre (x, y) at height `z_m` (poster centre), `size_m` = (width, height), facing
+  //          direction `yaw_rad` (the side it is seen from).
+  Eigen::Vector2d center = Eigen::Vector2d::Zero();
+  Eigen::Vector2d size_m = Eigen::Vector2d::Zero();
+  double height_m = 1.0;
+  double radius_m = 0.2;
+  double yaw_rad = 0.0;
+  double z_m = 1.0;
+};
+
+struct World {
+  TextureSpec ground;
+  std::optional<TextureSpec> ceiling;  // indoor worlds
+  double ceiling_height_m = 2.6;
+  double sky_top = 205.0;              // sky intensity at the top of the image
+  double sky_horizon = 175.0;          // sky intensity at the bottom of the image
+  std::vector<WorldObject> objects;
+
+  void Validate() const;  // throws InputError naming the object and field
+};
+
+// A variant of a world: objects removed or moved by tag.
+struct WorldVariant {
+  std::vector<std::string> remove;                    // tags to remove
+  std::map<std::string, Eigen::Vector2d> move_m;      // tag -> displacement (dx, dy)
+};
+
+// Returns the world with the variant applied; throws InputError for a tag no object has.
+World ApplyVariant(const World& world, const WorldVariant& variant);
+
+// Distance from point (x, y) to the nearest obstacle footprint (walls, boxes, cylinders; posters
+// hang on walls and do not count). Negative inside a box or cylinder.
+double ClearanceTo(const World& world, double x_m, double y_m);
+
+// Axis-aligned bounds of all object footprints: (min_x, min_y, max_x, max_y).
+Eigen::Vector4d FootprintBounds(const World& world);
+
+}  // namespace mapless::sim

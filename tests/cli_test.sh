@@ -1,0 +1,90 @@
+#!/usr/bin/env bash
+# Integration test of the `mapless` command line: every subcommand answers --help, bad input gives
+# one error line and exit code 2, outputs are deterministic and complete.
+# Usage: cli_test.sh PATH/TO/mapless SOURCE_TESTS_DIR
+set -u
+MAPLESS="$1"
+HERE="$2"
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+passed=0
+failed=0
+
+check() {  # check NAME CONDITION-EXIT-CODE
+  if [ "$2" -eq 0 ]; then passed=$((passed + 1)); echo "ok   $1"; else failed=$((failed + 1)); echo "FAIL $1"; fi
+}
+
+# expect_exit NAME CODE CMD...: runs CMD, checks its exit code, keeps stderr in $TMP/err.
+expect_exit() {
+  local name="$1" code="$2"
+  shift 2
+  "$@" >"$TMP/out" 2>"$TMP/err"
+  local got=$?
+  [ "$got" -eq "$code" ]
+  local ok=$?
+  [ $ok -ne 0 ] && { echo "     expected exit $code, got $got; stderr:"; sed 's/^/     | /' "$TMP/err"; }
+  check "$name" $ok
+}
+
+# Every subcommand answers --help with exit 0 and a usage text.
+for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench"; do
+  # shellcheck disable=SC2086
+  expect_exit "help: mapless $sub --help" 0 "$MAPLESS" $sub --help
+  grep -qi "usage" "$TMP/out"; check "help text: mapless $sub" $?
+done
+
+# sim list: one name per line, the paper scenarios among them.
+expect_exit "sim list" 0 "$MAPLESS" sim list
+[ "$(wc -l <"$TMP/out")" -ge 15 ]; check "sim list has >= 15 scenarios" $?
+for s in narrow_room_sharp_turn table1_sharp_turn_low_texture corridor_s_shaped office_aliasing; do
+  grep -qx "$s" "$TMP/out"; check "sim list names $s" $?
+done
+
+# Unknown option, unknown subcommand: usage errors, exit 2, one line.
+expect_exit "unknown option exits 2" 2 "$MAPLESS" sim list --bogus
+[ "$(wc -l <"$TMP/err")" -eq 1 ]; check "unknown option: one error line" $?
+expect_exit "unknown subcommand exits 2" 2 "$MAPLESS" fly
+
+# Malformed scenario: one line naming the file and the field, exit 2.
+expect_exit "malformed scenario exits 2" 2 "$MAPLESS" sim render --scenario "$HERE/data/bad_scenario_field.yaml" --pose 0,0,0 --out "$TMP/x.png"
+[ "$(wc -l <"$TMP/err")" -eq 1 ]; check "malformed scenario: one error line" $?
+grep -q "bad_scenario_field.yaml:[0-9]*:[0-9]*: world.objects\[1\].radius_m" "$TMP/err"; check "malformed scenario: names file, line and field" $?
+expect_exit "broken YAML exits 2" 2 "$MAPLESS" sim render --scenario "$HERE/data/bad_scenario_syntax.yaml" --pose 0,0,0 --out "$TMP/x.png"
+grep -q "bad_scenario_syntax.yaml:[0-9]*:[0-9]*: malformed YAML" "$TMP/err"; check "broken YAML: names file and line" $?
+expect_exit "missing scenario file exits 2" 2 "$MAPLESS" sim drive --scenario "$TMP/none.yaml" --out "$TMP/d"
+grep -q "none.yaml: cannot open file" "$TMP/err"; check "missing file is named" $?
+expect_exit "unknown built-in exits 2" 2 "$MAPLESS" sim render --scenario nowhere --pose 0,0,0 --out "$TMP/x.png"
+expect_exit "bad pose exits 2" 2 "$MAPLESS" sim render --scenario narrow_room_sharp_turn --pose 1,2 --out "$TMP/x.png"
+grep -q -- "--pose '1,2'" "$TMP/err"; check "bad pose is named" $?
+printf 'render: {edge_supersample: 0}\n' >"$TMP/bad_config.yaml"
+expect_exit "bad config value exits 2" 2 "$MAPLESS" sim drive --scenario rotation_in_place --out "$TMP/d" --config "$TMP/bad_config.yaml"
+grep -q "bad_config.yaml:1:[0-9]*: render: RenderOptions.edge_supersample = 0" "$TMP/err"; check "bad config names file, line and field" $?
+
+# Render: deterministic bytes for the same scenario, pose and seed.
+expect_exit "render a" 0 "$MAPLESS" sim render --scenario narrow_room_sharp_turn --pose 1.0,0.2,10 --out "$TMP/a.png" --seed 3
+expect_exit "render b" 0 "$MAPLESS" sim render --scenario narrow_room_sharp_turn --pose 1.0,0.2,10 --out "$TMP/b.png" --seed 3
+cmp -s "$TMP/a.png" "$TMP/b.png"; check "render is byte-identical for the same inputs" $?
+expect_exit "render repeat variant" 0 "$MAPLESS" sim render --scenario outdoor_loop_cars_removed --pose 0,0,0 --out "$TMP/v.png" --repeat-variant
+expect_exit "render teach world" 0 "$MAPLESS" sim render --scenario outdoor_loop_cars_removed --pose 0,0,0 --out "$TMP/t.png"
+! cmp -s "$TMP/v.png" "$TMP/t.png"; check "repeat variant differs from the teach world" $?
+
+# Drive: frames, TUM poses, top-down picture; identical poses for the same seed.
+expect_exit "drive 1" 0 "$MAPLESS" sim drive --scenario rotation_in_place --out "$TMP/d1" --seed 5
+expect_exit "drive 2" 0 "$MAPLESS" sim drive --scenario rotation_in_place --out "$TMP/d2" --seed 5
+for f in groundtruth.tum odometry.tum topdown.png summary.json frames.csv frames/000000.png; do
+  [ -s "$TMP/d1/$f" ]; check "drive writes $f" $?
+done
+n_frames=$(ls "$TMP/d1/frames" | wc -l)
+n_poses=$(grep -vc '^#' "$TMP/d1/groundtruth.tum")
+[ "$n_frames" -eq "$n_poses" ] && [ "$n_frames" -gt 50 ]; check "one pose per frame ($n_frames frames)" $?
+cmp -s "$TMP/d1/groundtruth.tum" "$TMP/d2/groundtruth.tum"; check "drive poses identical for the same seed" $?
+cmp -s "$TMP/d1/frames/000040.png" "$TMP/d2/frames/000040.png"; check "drive frames identical for the same seed" $?
+ls "$TMP/d1" "$TMP/d1/frames" | grep -q '\.tmp\.' && r=1 || r=0; check "no temporary files left" $r
+
+# Bench: one JSON object with the render stage and its reference.
+expect_exit "bench --json" 0 "$MAPLESS" bench --json --repeats 5
+grep -q '"sim_render_320x240_ms":[0-9.]*' "$TMP/out" && grep -q '"opencv_dis_fast_320x240_ms"' "$TMP/out"; check "bench JSON has the render stage and DIS reference" $?
+[ "$(wc -l <"$TMP/out")" -eq 1 ]; check "bench JSON is one line" $?
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
