@@ -1,6 +1,7 @@
 #include "mapless/sim/renderer.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -41,10 +42,12 @@ struct Prepared {
   float a1x, a1y, a1z, c1;
   float a2x, a2y, a2z, c2;
   float s_scale, t_scale;  // texels per unit of alpha, beta (level 0)
-  float lod_scale;         // log2 factor: area_texels = t^2 * lod_scale / |n . d|
+  float lod_base;          // mip level = lod_base - lod_slope * log2|n . d| (see ShadeHit)
   float shade;
-  const Texture* texture;
+  const Texture::LevelView* levels;  // mip pyramid, levels[0] finest
+  int max_level;
   int x0, x1, y0, y1;      // inclusive screen bounds
+  int group;               // edge group (see Surface::edge_group), made unique per render
 };
 
 struct Hit {
@@ -54,65 +57,44 @@ struct Hit {
   float nd;
 };
 
-// Ray d = (xd, yd, 1): intersection with the prepared surface, or false.
-inline bool Intersect(const Prepared& p, float xd, float yd, float near_m, float far_m, Hit* hit) {
-  const float nd = p.nx * xd + p.ny * yd + p.nz;
-  if (nd == 0.0f) return false;
-  const float t = p.k / nd;
-  if (!(t > near_m && t < far_m)) return false;
-  const float alpha = t * (p.a1x * xd + p.a1y * yd + p.a1z) - p.c1;
-  const float beta = t * (p.a2x * xd + p.a2y * yd + p.a2z) - p.c2;
-  switch (p.shape) {
-    case Surface::Shape::kParallelogram:
-      if (alpha < 0.0f || alpha > 1.0f || beta < 0.0f || beta > 1.0f) return false;
-      break;
-    case Surface::Shape::kDisk:
-      if (alpha * alpha + beta * beta > 1.0f) return false;
-      break;
-    case Surface::Shape::kPlane: break;
-  }
-  *hit = Hit{t, alpha, beta, nd};
-  return true;
-}
-
-inline float Bilinear(const cv::Mat& level, float s, float t) {
-  const int size = level.cols;  // square, power of two
-  const int mask = size - 1;
-  const float fs = s - 0.5f;
-  const float ft = t - 0.5f;
-  const float s0f = std::floor(fs);
-  const float t0f = std::floor(ft);
-  const float ws = fs - s0f;
-  const float wt = ft - t0f;
-  // Wrap in 64-bit first: far ground points can have texel coordinates beyond 2^31.
-  const int s0 = static_cast<int>(static_cast<std::int64_t>(s0f) & mask);
-  const int t0 = static_cast<int>(static_cast<std::int64_t>(t0f) & mask);
+// Bilinear sample of one mip level in fixed point. (s_fx, t_fx) are level-0 texel coordinates
+// times 256; level l is reached by an arithmetic shift (a floor, also for negative coordinates).
+// Returns the grey level times 65536.
+inline int BilinearFixed(const Texture::LevelView& level, int level_index, std::int64_t s_fx,
+                         std::int64_t t_fx) {
+  const int mask = (1 << level.log2_size) - 1;
+  const std::int64_t sf = (s_fx >> level_index) - 128;  // texel centres at +0.5
+  const std::int64_t tf = (t_fx >> level_index) - 128;
+  const int ws = static_cast<int>(sf & 255);
+  const int wt = static_cast<int>(tf & 255);
+  const int s0 = static_cast<int>((sf >> 8) & mask);
+  const int t0 = static_cast<int>((tf >> 8) & mask);
   const int s1 = (s0 + 1) & mask;
   const int t1 = (t0 + 1) & mask;
-  const std::uint8_t* r0 = level.ptr<std::uint8_t>(t0);
-  const std::uint8_t* r1 = level.ptr<std::uint8_t>(t1);
-  const float top = r0[s0] + ws * (r0[s1] - r0[s0]);
-  const float bottom = r1[s0] + ws * (r1[s1] - r1[s0]);
-  return top + wt * (bottom - top);
+  const std::uint8_t* r0 = level.data + (t0 << level.log2_size);
+  const std::uint8_t* r1 = level.data + (t1 << level.log2_size);
+  const int top = (r0[s0] << 8) + ws * (r0[s1] - r0[s0]);
+  const int bottom = (r1[s0] << 8) + ws * (r1[s1] - r1[s0]);
+  return (top << 8) + wt * (bottom - top);
 }
 
-inline float ShadeHit(const Prepared& p, const Hit& h, float anisotropy) {
-  const Texture& tex = *p.texture;
-  const float s = h.alpha * p.s_scale;
-  const float t = h.beta * p.t_scale;
-  const float abs_nd = std::max(std::abs(h.nd), 1e-6f);
-  // Footprint of the pixel on the surface, in texels^2: t^2 / (f^2 texel^2 |n.d|); the
-  // anisotropy term moves the choice towards the long side of the footprint.
-  float lod = 0.5f * (FastLog2(h.t * h.t * p.lod_scale) - (1.0f + anisotropy) * FastLog2(abs_nd));
-  const int max_level = static_cast<int>(tex.levels.size()) - 1;
-  if (lod <= 0.0f) return p.shade * Bilinear(tex.levels[0], s, t);
-  if (lod >= static_cast<float>(max_level)) return p.shade * tex.levels[max_level].at<std::uint8_t>(0, 0);
+// `lod_slope` is 0.5 (3 + anisotropy), fixed per render.
+inline float ShadeHit(const Prepared& p, const Hit& h, float lod_slope) {
+  // Level-0 texel coordinates in 24.8 fixed point (hits are nearer than far_m, so they fit).
+  const auto s_fx = static_cast<std::int64_t>(h.alpha * p.s_scale * 256.0f);
+  const auto t_fx = static_cast<std::int64_t>(h.beta * p.t_scale * 256.0f);
+  // Footprint of the pixel on the surface in texels^2 is t^2 / (f^2 texel^2 |n.d|), and the
+  // anisotropy a moves the choice towards its long side: level = 0.5 log2(t^2 L / |n.d|^(1+a)).
+  // With t = k / (n.d) this is 0.5 log2(k^2 L) - 0.5 (3 + a) log2|n.d|: one log per pixel.
+  const float lod = p.lod_base - lod_slope * FastLog2(std::max(std::abs(h.nd), 1e-6f));
+  constexpr float kInv16 = 1.0f / 65536.0f;
+  if (lod <= 0.0f) return p.shade * kInv16 * static_cast<float>(BilinearFixed(p.levels[0], 0, s_fx, t_fx));
+  if (lod >= static_cast<float>(p.max_level)) return p.shade * p.levels[p.max_level].data[0];
   const int l0 = static_cast<int>(lod);
   const float w = lod - static_cast<float>(l0);
-  const float scale0 = 1.0f / static_cast<float>(1 << l0);
-  const float v0 = Bilinear(tex.levels[l0], s * scale0, t * scale0);
-  const float v1 = Bilinear(tex.levels[l0 + 1], s * scale0 * 0.5f, t * scale0 * 0.5f);
-  return p.shade * (v0 + w * (v1 - v0));
+  const auto v0 = static_cast<float>(BilinearFixed(p.levels[l0], l0, s_fx, t_fx));
+  const auto v1 = static_cast<float>(BilinearFixed(p.levels[l0 + 1], l0 + 1, s_fx, t_fx));
+  return p.shade * kInv16 * (v0 + w * (v1 - v0));
 }
 
 // Clips a polygon (camera frame) to z >= near and returns its projected bounds, or false.
@@ -211,11 +193,137 @@ bool Prepare(const Surface& s, const CameraModel& cam, const Rigid3& camera_from
     p.s_scale = static_cast<float>(e1.norm() / texel_m);
     p.t_scale = static_cast<float>(e2.norm() / texel_m);
   }
-  p.lod_scale = static_cast<float>(1.0 / (cam.fx * cam.fy * texel_m * texel_m));
+  p.lod_base = static_cast<float>(0.5 * std::log2(k * k / (cam.fx * cam.fy * texel_m * texel_m)));
   p.shade = s.shade;
-  p.texture = &tex;
+  p.levels = tex.views.data();
+  p.max_level = static_cast<int>(tex.views.size()) - 1;
   *out = p;
   return true;
+}
+
+// Branchless selects written with bit masks: GCC turns `a[i] = c ? x : a[i]` into a conditional
+// store, which blocks vectorisation; these keep the loops below straight-line.
+inline float Select(bool c, float a, float b) {
+  std::uint32_t ua = 0;
+  std::uint32_t ub = 0;
+  std::memcpy(&ua, &a, sizeof(ua));
+  std::memcpy(&ub, &b, sizeof(ub));
+  const std::uint32_t m = 0u - static_cast<std::uint32_t>(c);
+  const std::uint32_t r = (ua & m) | (ub & ~m);
+  float out = 0.0f;
+  std::memcpy(&out, &r, sizeof(out));
+  return out;
+}
+
+inline std::int32_t Select(bool c, std::int32_t a, std::int32_t b) {
+  const std::int32_t m = -static_cast<std::int32_t>(c);
+  return (a & m) | (b & ~m);
+}
+
+// Per-pixel results of pass 1, as structure of arrays.
+struct Buffers {
+  std::vector<float> depth;
+  std::vector<std::int32_t> id;
+  std::vector<float> alpha;
+  std::vector<float> beta;
+  std::vector<float> nd;
+};
+
+// One row of pass 1 for one surface. Restrict-qualified parameters tell the compiler that the
+// buffers do not overlap, so that the loop vectorises.
+template <Surface::Shape kShape>
+void RasterRow(const Prepared& p, std::int32_t index, float nd_row, float a1_row, float a2_row,
+               float near_m, float far_m, const float* __restrict xs, float* __restrict depth,
+               std::int32_t* __restrict id, float* __restrict alpha_out,
+               float* __restrict beta_out, float* __restrict nd_out) {
+  const float nx = p.nx, k = p.k, a1x = p.a1x, c1 = p.c1, a2x = p.a2x, c2 = p.c2;
+  const int x_begin = p.x0;
+  const int x_end = p.x1 + 1;  // half-open, so that the trip count is computable
+  for (int x = x_begin; x < x_end; ++x) {
+    const float xv = xs[x];
+    const float nd = nx * xv + nd_row;
+    const float t = k / nd;  // nd = 0 gives inf or nan: every comparison below is false
+    const float alpha = t * (a1x * xv + a1_row) - c1;
+    const float beta = t * (a2x * xv + a2_row) - c2;
+    bool inside = true;
+    if (kShape == Surface::Shape::kParallelogram) {
+      inside = (alpha >= 0.0f) & (alpha <= 1.0f) & (beta >= 0.0f) & (beta <= 1.0f);
+    } else if (kShape == Surface::Shape::kDisk) {
+      inside = alpha * alpha + beta * beta <= 1.0f;
+    }
+    const float d = depth[x];
+    const bool hit = inside & (t > near_m) & (t < far_m) & (t < d);
+    depth[x] = Select(hit, t, d);
+    id[x] = Select(hit, index, id[x]);
+    alpha_out[x] = Select(hit, alpha, alpha_out[x]);
+    beta_out[x] = Select(hit, beta, beta_out[x]);
+    nd_out[x] = Select(hit, nd, nd_out[x]);
+  }
+}
+
+template <Surface::Shape kShape>
+void RasterSurface(const Prepared& p, std::int32_t index, const std::vector<float>& xd,
+                   const std::vector<float>& yd, int w, float near_m, float far_m, Buffers* buf) {
+  float* depth = buf->depth.data();
+  std::int32_t* id = buf->id.data();
+  float* alpha_out = buf->alpha.data();
+  float* beta_out = buf->beta.data();
+  float* nd_out = buf->nd.data();
+  const float* xs = xd.data();
+  for (int y = p.y0; y <= p.y1; ++y) {
+    const float yv = yd[static_cast<std::size_t>(y)];
+    const float nd_row = p.ny * yv + p.nz;
+    if (kShape == Surface::Shape::kPlane) {
+      // Skip rows wholly beyond the horizon (t < 0 at both ends; n . d is linear along the row).
+      const float nd0 = p.nx * xs[p.x0] + nd_row;
+      const float nd1 = p.nx * xs[p.x1] + nd_row;
+      if (p.k * nd0 <= 0.0f && p.k * nd1 <= 0.0f) continue;
+    }
+    const float a1_row = p.a1y * yv + p.a1z;
+    const float a2_row = p.a2y * yv + p.a2z;
+    const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(y) * w;
+    RasterRow<kShape>(p, index, nd_row, a1_row, a2_row, near_m, far_m, xs, depth + row, id + row,
+                      alpha_out + row, beta_out + row, nd_out + row);
+  }
+}
+
+// The sub-rays of one silhouette pixel and, per sub-ray, the nearest hit so far.
+constexpr int kMaxSubRays = 64;  // edge_supersample <= 8
+struct SubRayBuffers {
+  float xv[kMaxSubRays];
+  float yv[kMaxSubRays];
+  float t[kMaxSubRays];
+  float alpha[kMaxSubRays];
+  float beta[kMaxSubRays];
+  float nd[kMaxSubRays];
+  std::int32_t winner[kMaxSubRays];
+};
+
+// Tests every sub-ray against one candidate surface (branchless, so that it vectorises).
+template <Surface::Shape kShape>
+void SubRays(const Prepared& p, std::int32_t candidate, int n, float near_m, float far_m,
+             SubRayBuffers* b) {
+  for (int k = 0; k < n; ++k) {
+    const float xv = b->xv[k];
+    const float yv = b->yv[k];
+    const float nd = p.nx * xv + p.ny * yv + p.nz;
+    const float t = p.k / nd;
+    const float alpha = t * (p.a1x * xv + p.a1y * yv + p.a1z) - p.c1;
+    const float beta = t * (p.a2x * xv + p.a2y * yv + p.a2z) - p.c2;
+    bool inside = true;
+    if (kShape == Surface::Shape::kParallelogram) {
+      inside = (alpha >= 0.0f) & (alpha <= 1.0f) & (beta >= 0.0f) & (beta <= 1.0f);
+    } else if (kShape == Surface::Shape::kDisk) {
+      inside = alpha * alpha + beta * beta <= 1.0f;
+    }
+    const float best = b->t[k];
+    const bool hit = inside & (t > near_m) & (t < far_m) & (t < best);
+    b->t[k] = Select(hit, t, best);
+    b->alpha[k] = Select(hit, alpha, b->alpha[k]);
+    b->beta[k] = Select(hit, beta, b->beta[k]);
+    b->nd[k] = Select(hit, nd, b->nd[k]);
+    b->winner[k] = Select(hit, candidate, b->winner[k]);
+  }
 }
 
 }  // namespace
@@ -269,6 +377,7 @@ void AppendObjectSurfaces(const WorldObject& o, std::shared_ptr<const Texture> t
     }
     case ObjectKind::kCylinder: {
       const int facets = 20;
+      const int group = static_cast<int>(out->size());  // unique among this list's surfaces
       const double step = 2.0 * kPi / facets;
       const Eigen::Vector3d h = up * o.height_m;
       for (int i = 0; i < facets; ++i) {
@@ -279,6 +388,7 @@ void AppendObjectSurfaces(const WorldObject& o, std::shared_ptr<const Texture> t
         const Eigen::Vector3d p1(o.center.x() + o.radius_m * std::cos(a1),
                                  o.center.y() + o.radius_m * std::sin(a1), 0.0);
         add(Surface::Shape::kParallelogram, p0, p1 - p0, h, true);
+        out->back().edge_group = group;
       }
       add(Surface::Shape::kDisk, Eigen::Vector3d(o.center.x(), o.center.y(), o.height_m),
           Eigen::Vector3d(o.radius_m, 0, 0), Eigen::Vector3d(0, o.radius_m, 0), true);
@@ -338,15 +448,22 @@ cv::Mat Renderer::Render(const CameraModel& cam, const Rigid3& world_from_camera
   const int h = cam.height;
   const float near_m = static_cast<float>(options_.near_m);
   const float far_m = static_cast<float>(options_.far_m);
-  const float aniso = static_cast<float>(options_.anisotropy);
+  const float lod_slope = static_cast<float>(0.5 * (3.0 + options_.anisotropy));
 
   std::vector<Prepared> prepared;
   prepared.reserve(surfaces_.size() + extra.size());
+  int list_offset = 0;
+  const int group_base = 1 << 20;  // grouped surfaces: group_base + list offset + edge_group
   for (const auto* list : {&surfaces_, &extra}) {
-    for (const Surface& s : *list) {
+    for (std::size_t k = 0; k < list->size(); ++k) {
+      const Surface& s = (*list)[k];
       Prepared p;
-      if (Prepare(s, cam, camera_from_world, options_, &p)) prepared.push_back(p);
+      if (!Prepare(s, cam, camera_from_world, options_, &p)) continue;
+      p.group = s.edge_group >= 0 ? group_base + list_offset + s.edge_group
+                                  : static_cast<int>(prepared.size());
+      prepared.push_back(p);
     }
+    list_offset += static_cast<int>(list->size());
   }
 
   std::vector<float> xd(static_cast<std::size_t>(w));
@@ -355,27 +472,31 @@ cv::Mat Renderer::Render(const CameraModel& cam, const Rigid3& world_from_camera
   for (int y = 0; y < h; ++y) yd[static_cast<std::size_t>(y)] = static_cast<float>((y - cam.cy) / cam.fy);
 
   const std::size_t npix = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-  std::vector<float> depth(npix, std::numeric_limits<float>::infinity());
-  std::vector<std::int32_t> id(npix, -1);
-  std::vector<Hit> hits(npix);
+  Buffers buf;
+  buf.depth.assign(npix, std::numeric_limits<float>::infinity());
+  buf.id.assign(npix, -1);
+  buf.alpha.resize(npix);
+  buf.beta.resize(npix);
+  buf.nd.resize(npix);
 
-  // Pass 1: nearest surface per pixel centre.
+  // Pass 1: nearest surface per pixel centre. Branchless over structure-of-arrays buffers so that
+  // the compiler vectorises the ray-surface tests.
   for (std::size_t si = 0; si < prepared.size(); ++si) {
     const Prepared& p = prepared[si];
-    for (int y = p.y0; y <= p.y1; ++y) {
-      const float yv = yd[static_cast<std::size_t>(y)];
-      const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
-      for (int x = p.x0; x <= p.x1; ++x) {
-        Hit hit;
-        if (!Intersect(p, xd[static_cast<std::size_t>(x)], yv, near_m, far_m, &hit)) continue;
-        const std::size_t i = row + static_cast<std::size_t>(x);
-        if (hit.t >= depth[i]) continue;
-        depth[i] = hit.t;
-        id[i] = static_cast<std::int32_t>(si);
-        hits[i] = hit;
-      }
+    switch (p.shape) {
+      case Surface::Shape::kParallelogram:
+        RasterSurface<Surface::Shape::kParallelogram>(p, static_cast<std::int32_t>(si), xd, yd, w, near_m, far_m, &buf);
+        break;
+      case Surface::Shape::kDisk:
+        RasterSurface<Surface::Shape::kDisk>(p, static_cast<std::int32_t>(si), xd, yd, w, near_m, far_m, &buf);
+        break;
+      case Surface::Shape::kPlane:
+        RasterSurface<Surface::Shape::kPlane>(p, static_cast<std::int32_t>(si), xd, yd, w, near_m, far_m, &buf);
+        break;
     }
   }
+  const std::vector<float>& depth = buf.depth;
+  const std::vector<std::int32_t>& id = buf.id;
 
   auto sky = [&](float yv) {
     // yv is the ray's vertical slope; map the image rows' range linearly.
@@ -387,10 +508,12 @@ cv::Mat Renderer::Render(const CameraModel& cam, const Rigid3& world_from_camera
   for (int y = 0; y < h; ++y) {
     std::uint8_t* out = image.ptr<std::uint8_t>(y);
     const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
+    const float sky_row = sky(yd[static_cast<std::size_t>(y)]);
     for (int x = 0; x < w; ++x) {
       const std::size_t i = row + static_cast<std::size_t>(x);
-      const float v = id[i] < 0 ? sky(yd[static_cast<std::size_t>(y)])
-                                : ShadeHit(prepared[static_cast<std::size_t>(id[i])], hits[i], aniso);
+      const float v = id[i] < 0 ? sky_row
+                                : ShadeHit(prepared[static_cast<std::size_t>(id[i])],
+                                           Hit{depth[i], buf.alpha[i], buf.beta[i], buf.nd[i]}, lod_slope);
       out[x] = cv::saturate_cast<std::uint8_t>(v);
     }
   }
@@ -402,18 +525,38 @@ cv::Mat Renderer::Render(const CameraModel& cam, const Rigid3& world_from_camera
   const float sub_y = static_cast<float>(1.0 / cam.fy);
   // Mark both pixels of every horizontally or vertically adjacent pair that sees different
   // surfaces (or a surface and the sky).
+  std::vector<std::int32_t> group(npix);
+  for (std::size_t i = 0; i < npix; ++i) {
+    group[i] = id[i] < 0 ? -1 : prepared[static_cast<std::size_t>(id[i])].group;
+  }
   std::vector<std::uint8_t> edge(npix, 0);
   for (int y = 0; y < h; ++y) {
     const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
     for (int x = 0; x < w; ++x) {
       const std::size_t i = row + static_cast<std::size_t>(x);
-      if (x + 1 < w && id[i] != id[i + 1]) edge[i] = edge[i + 1] = 1;
-      if (y + 1 < h && id[i] != id[i + static_cast<std::size_t>(w)]) {
+      if (x + 1 < w && group[i] != group[i + 1]) edge[i] = edge[i + 1] = 1;
+      if (y + 1 < h && group[i] != group[i + static_cast<std::size_t>(w)]) {
         edge[i] = edge[i + static_cast<std::size_t>(w)] = 1;
       }
     }
   }
+  struct Accum {
+    float t = 0.0f, alpha = 0.0f, beta = 0.0f, nd = 0.0f;
+    int n = 0;
+  };
   std::vector<std::int32_t> candidates;
+  candidates.reserve(9);
+  std::array<Accum, 9> accum{};
+  const int nsub = ss * ss;
+  std::vector<float> sub_dx(static_cast<std::size_t>(nsub));
+  std::vector<float> sub_dy(static_cast<std::size_t>(nsub));
+  for (int sy = 0; sy < ss; ++sy) {
+    for (int sx = 0; sx < ss; ++sx) {
+      sub_dx[static_cast<std::size_t>(sy * ss + sx)] = ((sx + 0.5f) / ss - 0.5f) * sub_x;
+      sub_dy[static_cast<std::size_t>(sy * ss + sx)] = ((sy + 0.5f) / ss - 0.5f) * sub_y;
+    }
+  }
+  SubRayBuffers sub;
   for (int y = 0; y < h; ++y) {
     std::uint8_t* out = image.ptr<std::uint8_t>(y);
     for (int x = 0; x < w; ++x) {
@@ -435,26 +578,54 @@ cv::Mat Renderer::Render(const CameraModel& cam, const Rigid3& world_from_camera
           }
         }
       }
-      float sum = 0.0f;
-      for (int sy = 0; sy < ss; ++sy) {
-        const float yv = yd[static_cast<std::size_t>(y)] + ((sy + 0.5f) / ss - 0.5f) * sub_y;
-        for (int sx = 0; sx < ss; ++sx) {
-          const float xv = xd[static_cast<std::size_t>(x)] + ((sx + 0.5f) / ss - 0.5f) * sub_x;
-          float best_t = std::numeric_limits<float>::infinity();
-          const Prepared* best = nullptr;
-          Hit best_hit{};
-          for (const std::int32_t c : candidates) {
-            if (c < 0) continue;
-            Hit hit;
-            const Prepared& p = prepared[static_cast<std::size_t>(c)];
-            if (Intersect(p, xv, yv, near_m, far_m, &hit) && hit.t < best_t) {
-              best_t = hit.t;
-              best = &p;
-              best_hit = hit;
-            }
-          }
-          sum += best ? ShadeHit(*best, best_hit, aniso) : sky(yv);
+      // Coverage by S x S sub-rays; each surface that wins sub-rays is shaded once, at the
+      // centroid of its winning hits (multisample anti-aliasing), the sky per sub-ray.
+      const float xc = xd[static_cast<std::size_t>(x)];
+      const float yc = yd[static_cast<std::size_t>(y)];
+      for (int k = 0; k < nsub; ++k) {
+        sub.xv[k] = xc + sub_dx[static_cast<std::size_t>(k)];
+        sub.yv[k] = yc + sub_dy[static_cast<std::size_t>(k)];
+        sub.t[k] = std::numeric_limits<float>::infinity();
+        sub.winner[k] = -1;
+      }
+      for (std::size_t c = 0; c < candidates.size(); ++c) {
+        if (candidates[c] < 0) continue;
+        const Prepared& p = prepared[static_cast<std::size_t>(candidates[c])];
+        const auto ci = static_cast<std::int32_t>(c);
+        switch (p.shape) {
+          case Surface::Shape::kParallelogram:
+            SubRays<Surface::Shape::kParallelogram>(p, ci, nsub, near_m, far_m, &sub);
+            break;
+          case Surface::Shape::kDisk:
+            SubRays<Surface::Shape::kDisk>(p, ci, nsub, near_m, far_m, &sub);
+            break;
+          case Surface::Shape::kPlane:
+            SubRays<Surface::Shape::kPlane>(p, ci, nsub, near_m, far_m, &sub);
+            break;
         }
+      }
+      for (Accum& a : accum) a = Accum{};
+      float sky_sum = 0.0f;
+      for (int k = 0; k < nsub; ++k) {
+        if (sub.winner[k] < 0) {
+          sky_sum += sky(sub.yv[k]);
+          continue;
+        }
+        Accum& a = accum[static_cast<std::size_t>(sub.winner[k])];
+        a.t += sub.t[k];
+        a.alpha += sub.alpha[k];
+        a.beta += sub.beta[k];
+        a.nd += sub.nd[k];
+        ++a.n;
+      }
+      float sum = sky_sum;
+      for (std::size_t c = 0; c < candidates.size(); ++c) {
+        const Accum& a = accum[c];
+        if (a.n == 0) continue;
+        const float inv = 1.0f / static_cast<float>(a.n);
+        const Hit mean{a.t * inv, a.alpha * inv, a.beta * inv, a.nd * inv};
+        sum += static_cast<float>(a.n) *
+               ShadeHit(prepared[static_cast<std::size_t>(candidates[c])], mean, lod_slope);
       }
       out[x] = cv::saturate_cast<std::uint8_t>(sum / static_cast<float>(ss * ss));
     }

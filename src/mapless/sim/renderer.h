@@ -5,8 +5,9 @@
 // against the surfaces whose screen bounding box covers it (a z-buffered ray caster), samples each
 // texture from its mip pyramid with trilinear filtering (no texture aliasing at any distance), and
 // then supersamples the pixels on silhouettes (where the visible surface changes between
-// neighbours) with an S x S grid of rays, so that edges move smoothly under sub-pixel motion and
-// optical flow is meaningful. Deterministic: the same world, camera and pose give identical bytes.
+// neighbours): an S x S grid of sub-rays measures how much of the pixel each surface covers, and
+// each covering surface is shaded once at the centroid of its sub-rays (multisample
+// anti-aliasing). Edges thus move smoothly under sub-pixel motion and optical flow is meaningful. Deterministic: the same world, camera and pose give identical bytes.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -20,7 +21,7 @@
 namespace mapless::sim {
 
 struct RenderOptions {
-  int edge_supersample = 3;       // S: S x S rays per silhouette pixel (1 disables anti-aliasing)
+  int edge_supersample = 4;       // S: S x S coverage rays per silhouette pixel (1: no anti-aliasing)
   double near_m = 0.02;           // nearest visible distance along the optical axis, metres
   double far_m = 150.0;           // farthest visible distance, metres
   double anisotropy = 0.5;        // mip choice: 0 = geometric mean of the footprint (sharper),
@@ -37,6 +38,9 @@ struct Surface {
   Eigen::Vector3d e2 = Eigen::Vector3d::UnitY();     // second edge / radius vector / plane axis
   bool one_sided = false;                            // visible only from the side of e1 x e2
   float shade = 1.0f;                                // brightness factor (fixed light)
+  // Surfaces with the same non-negative group form one smooth object (a cylinder's facets): the
+  // boundaries between them are not silhouettes and are not supersampled.
+  int edge_group = -1;
   std::shared_ptr<const Texture> texture;
 };
 

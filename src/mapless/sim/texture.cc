@@ -262,6 +262,12 @@ std::shared_ptr<const Texture> GenerateTexture(const TextureSpec& spec) {
     cv::resize(texture->levels.back(), next, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
     texture->levels.push_back(next);
   }
+  for (const cv::Mat& level : texture->levels) {
+    CV_Assert(level.isContinuous());
+    int log2 = 0;
+    while ((1 << log2) < level.cols) ++log2;
+    texture->views.push_back(Texture::LevelView{level.ptr<std::uint8_t>(0), log2});
+  }
   return texture;
 }
 

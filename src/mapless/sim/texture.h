@@ -34,7 +34,13 @@ struct TextureSpec {
 
 // A tileable texture with its mip pyramid: levels[0] is size_px x size_px, each next level half.
 struct Texture {
-  std::vector<cv::Mat> levels;  // CV_8UC1, power-of-two sides
+  // Raw view of one level for the renderer's inner loop: a continuous square of side 2^log2_size.
+  struct LevelView {
+    const std::uint8_t* data = nullptr;
+    int log2_size = 0;
+  };
+  std::vector<cv::Mat> levels;     // CV_8UC1, power-of-two sides
+  std::vector<LevelView> views;    // one per level, pointing into `levels`
   double texel_m = 0.01;
   bool fit = false;
 };
