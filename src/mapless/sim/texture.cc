@@ -40,8 +40,9 @@ cv::Mat TileableNoise(int size, int cells, Rng* rng) {
   return up(cv::Rect(off, off, size, size)).clone();
 }
 
-// Fractal (multi-octave) noise in [-1, 1] roughly, tileable.
-cv::Mat FractalNoise(int size, int base_cells, int octaves, Rng* rng) {
+// Fractal (multi-octave) noise in [-1, 1] roughly, tileable. `persistence` is the amplitude ratio
+// between an octave and the next finer one: higher values keep more fine detail (corners).
+cv::Mat FractalNoise(int size, int base_cells, int octaves, Rng* rng, double persistence = 0.6) {
   cv::Mat sum = cv::Mat::zeros(size, size, CV_32F);
   double amplitude = 1.0;
   double total = 0.0;
@@ -49,7 +50,7 @@ cv::Mat FractalNoise(int size, int base_cells, int octaves, Rng* rng) {
   for (int o = 0; o < octaves && cells <= size; ++o) {
     sum += amplitude * (TileableNoise(size, cells, rng) - 0.5);
     total += amplitude;
-    amplitude *= 0.6;
+    amplitude *= persistence;
     cells *= 2;
   }
   return sum * (2.0 / total);
@@ -79,11 +80,27 @@ void WrappedEllipse(cv::Mat* img, int x, int y, int ax, int ay, double angle, fl
   }
 }
 
+// Small dark and bright specks (pebbles, pores, dirt): strong corners for feature detectors.
+void Specks(cv::Mat* img, int count, int max_size, Rng* rng) {
+  const int size = img->cols;
+  for (int i = 0; i < count; ++i) {
+    const int x = static_cast<int>(rng->UniformInt(static_cast<std::uint64_t>(size)));
+    const int y = static_cast<int>(rng->UniformInt(static_cast<std::uint64_t>(size)));
+    const int w = 1 + static_cast<int>(rng->UniformInt(static_cast<std::uint64_t>(max_size)));
+    const int h = 1 + static_cast<int>(rng->UniformInt(static_cast<std::uint64_t>(max_size)));
+    WrappedRect(img, x, y, w, h, static_cast<float>(rng->Uniform() < 0.5 ? -1.0 : 1.0));
+  }
+}
+
 // Signed content in roughly [-1, 1]; scaled to mean/contrast at the end.
-cv::Mat Noise(int size, Rng* rng) { return FractalNoise(size, 4, 6, rng) * 1.6; }
+cv::Mat Noise(int size, Rng* rng) {
+  cv::Mat img = FractalNoise(size, 4, 7, rng, 0.75) * 1.5;
+  Specks(&img, size * size / 400, std::max(1, size / 128), rng);
+  return img;
+}
 
 cv::Mat Bricks(int size, Rng* rng) {
-  cv::Mat img = FractalNoise(size, 16, 4, rng) * 0.25;
+  cv::Mat img = FractalNoise(size, 16, 4, rng, 0.8) * 0.35;
   const int rows = 8;
   const int cols = 4;
   const int bh = size / rows;
@@ -93,23 +110,23 @@ cv::Mat Bricks(int size, Rng* rng) {
     const int shift = (r % 2) * bw / 2;
     for (int c = 0; c < cols; ++c) {
       const float tone = static_cast<float>(rng->Uniform(-0.6, 0.6));
-      cv::Mat brick = img(cv::Rect(0, r * bh, size, bh));
-      const int x0 = (c * bw + shift) % size;
-      cv::Mat region(bh, bw, CV_32F, cv::Scalar(tone));
-      for (int y = 0; y < bh; ++y) {
+      const int x0 = c * bw + shift;
+      for (int y = r * bh; y < (r + 1) * bh; ++y) {
+        float* row = img.ptr<float>(y);
         for (int x = 0; x < bw; ++x) {
-          float& v = brick.at<float>(y, (x0 + x) % size);
-          const bool is_mortar = y < mortar || x < mortar;
-          v = is_mortar ? -1.0f : v + region.at<float>(y, x);
+          float& v = row[(x0 + x) % size];
+          const bool is_mortar = y - r * bh < mortar || x < mortar;
+          v = is_mortar ? -1.0f : v + tone;
         }
       }
     }
   }
+  Specks(&img, size * size / 300, std::max(1, size / 100), rng);
   return img;
 }
 
 cv::Mat Tiles(int size, Rng* rng) {
-  cv::Mat img = FractalNoise(size, 8, 5, rng) * 0.3;
+  cv::Mat img = FractalNoise(size, 8, 5, rng, 0.75) * 0.35;
   const int n = 8;
   const int step = size / n;
   const int grout = std::max(2, size / 128);
@@ -118,7 +135,7 @@ cv::Mat Tiles(int size, Rng* rng) {
       const float tone = static_cast<float>(rng->Uniform(-0.5, 0.5));
       img(cv::Rect(tx * step, ty * step, step, step)) += tone;
       // A few specks per tile give corners for feature detectors.
-      for (int k = 0; k < 2; ++k) {
+      for (int k = 0; k < 5; ++k) {
         const int sx = tx * step + grout + static_cast<int>(rng->UniformInt(step - 3 * grout));
         const int sy = ty * step + grout + static_cast<int>(rng->UniformInt(step - 3 * grout));
         const int w = 2 + static_cast<int>(rng->UniformInt(std::max(1, step / 6)));
@@ -134,13 +151,13 @@ cv::Mat Tiles(int size, Rng* rng) {
 }
 
 cv::Mat Blobs(int size, Rng* rng) {
-  cv::Mat img = FractalNoise(size, 4, 6, rng) * 0.5;
-  const int count = 60 + static_cast<int>(rng->UniformInt(40));
+  cv::Mat img = FractalNoise(size, 4, 7, rng, 0.7) * 0.5;
+  const int count = 180 + static_cast<int>(rng->UniformInt(60));
   for (int i = 0; i < count; ++i) {
     const int x = static_cast<int>(rng->UniformInt(size));
     const int y = static_cast<int>(rng->UniformInt(size));
     const float value = static_cast<float>(rng->Uniform(-1.0, 1.0));
-    const int extent = 3 + static_cast<int>(rng->UniformInt(std::max(1, size / 14)));
+    const int extent = 2 + static_cast<int>(rng->UniformInt(std::max(1, size / 20)));
     if (rng->Uniform() < 0.5) {
       WrappedRect(&img, x, y, extent, 3 + static_cast<int>(rng->UniformInt(extent + 1)), value);
     } else {
