@@ -5,6 +5,7 @@
 #include <chrono>
 #include <functional>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 #include <opencv2/core.hpp>
@@ -55,7 +56,7 @@ void AddBenchCommand(CLI::App* app) {
   struct Args {
     bool json = false;
     int repeats = 100;
-    std::string scenario = "narrow_room_sharp_turn";
+    std::string scenario;  // empty: the default mix of indoor, outdoor and aliasing scenes
   };
   auto args = std::make_shared<Args>();
   CLI::App* bench = app->add_subcommand(
@@ -64,36 +65,47 @@ void AddBenchCommand(CLI::App* app) {
   bench->add_option("--repeats", args->repeats, "Timed calls per stage")
       ->capture_default_str()
       ->check(CLI::Range(3, 100000));
-  bench->add_option("--scenario", args->scenario, "Scenario whose views are rendered")
-      ->capture_default_str();
+  bench->add_option("--scenario", args->scenario,
+                    "Render views of this scenario only (default: narrow_room_sharp_turn, "
+                    "outdoor_70m and office_aliasing, 12 views along each taught path)");
   bench->callback([args] {
     cv::setNumThreads(1);
-    sim::Scenario scenario = sim::LoadScenario(args->scenario);
-    scenario.camera.model = sim::CameraModel::FromFov(320, 240, DegToRad(60.0));
-    const std::vector<Pose2> poses = PosesAlong(scenario, 32);
-    sim::Simulation s(scenario.world, scenario.camera, {}, 1);
-    s.AddRobot(poses.front(), scenario.robot);
-    const sim::Renderer& renderer = s.renderer();
-    const auto& cam = scenario.camera;
-
-    std::vector<cv::Mat> frames;
-    for (const Pose2& p : poses) frames.push_back(renderer.Render(cam.model, sim::WorldFromCamera(p, cam.mount)));
+    const std::vector<std::string> names =
+        args->scenario.empty()
+            ? std::vector<std::string>{"narrow_room_sharp_turn", "outdoor_70m", "office_aliasing"}
+            : std::vector<std::string>{args->scenario};
+    // Typical views: poses along each scenario's taught path, at 320x240 and 60 degrees.
+    struct View {
+      const sim::Renderer* renderer;
+      sim::CameraSpec camera;
+      Pose2 pose;
+    };
+    std::vector<std::unique_ptr<sim::Renderer>> renderers;
+    std::vector<View> views;
+    for (const std::string& name : names) {
+      sim::Scenario scenario = sim::LoadScenario(name);
+      scenario.camera.model = sim::CameraModel::FromFov(320, 240, DegToRad(60.0));
+      renderers.push_back(std::make_unique<sim::Renderer>(scenario.world, sim::RenderOptions{}));
+      for (const Pose2& p : PosesAlong(scenario, 12)) views.push_back({renderers.back().get(), scenario.camera, p});
+    }
+    const sim::Scenario scenario = sim::LoadScenario(names.front());
 
     nlohmann::json j;
+    j["scenarios"] = names;
     j["threads"] = cv::getNumThreads();
     j["frame"] = "320x240";
     j["repeats"] = args->repeats;
     cv::Mat sink;
     j["sim_render_320x240_ms"] = MedianMs(args->repeats, 3, [&](int i) {
-      const Pose2& p = poses[static_cast<std::size_t>(i) % poses.size()];
-      sink = renderer.Render(cam.model, sim::WorldFromCamera(p, cam.mount));
+      const View& v = views[static_cast<std::size_t>(i) % views.size()];
+      sink = v.renderer->Render(v.camera.model, sim::WorldFromCamera(v.pose, v.camera.mount));
     });
     // Reference: DIS optical flow (PRESET_FAST) on consecutive views of the same drive.
     std::vector<cv::Mat> pair_a;
     std::vector<cv::Mat> pair_b;
     {
       sim::Simulation drive(scenario.world, scenario.camera, {}, 1);
-      drive.AddRobot(poses[poses.size() / 3], scenario.robot);
+      drive.AddRobot(views[views.size() / 7].pose, scenario.robot);
       for (int k = 0; k < 8; ++k) {
         pair_a.push_back(drive.RenderClean(0));
         drive.SetCommand(0, Twist2{0.3, 0.1});

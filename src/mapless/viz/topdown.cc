@@ -82,7 +82,9 @@ cv::Mat DrawTopDown(const sim::World& world, const std::vector<TopDownPath>& pat
     cv::drawMarker(img, px(m.x(), m.y()), cv::Scalar(0, 140, 0), cv::MARKER_STAR, 14, 2);
   }
   int legend_x = 10;
-  for (const auto& path : paths) {
+  // Draw in reverse so that the first path (usually the reference) ends up on top.
+  for (auto it = paths.rbegin(); it != paths.rend(); ++it) {
+    const TopDownPath& path = *it;
     std::vector<cv::Point> pts;
     for (const Pose2& p : path.poses) pts.push_back(px(p.x_m, p.y_m));
     if (pts.size() >= 2) cv::polylines(img, pts, false, path.color, 2, cv::LINE_AA);
