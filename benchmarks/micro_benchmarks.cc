@@ -14,21 +14,21 @@ using mapless::Twist2;
 using mapless::sim::LoadScenario;
 using mapless::sim::Simulation;
 
-void BM_SimRender320x240(benchmark::State& state) {
+void RenderLoop(benchmark::State& state, const char* scenario_name, const Pose2& pose) {
   cv::setNumThreads(1);
-  const auto scenario = LoadScenario("narrow_room_sharp_turn");
+  const auto scenario = LoadScenario(scenario_name);
   Simulation sim(scenario.world, scenario.camera, {}, 1);
-  sim.AddRobot(Pose2{1.0, 0.0, 0.0}, scenario.robot);
+  sim.AddRobot(pose, scenario.robot);
   for (auto _ : state) benchmark::DoNotOptimize(sim.RenderClean(0).data);
+}
+
+void BM_SimRender320x240(benchmark::State& state) {
+  RenderLoop(state, "narrow_room_sharp_turn", Pose2{1.0, 0.0, 0.0});
 }
 BENCHMARK(BM_SimRender320x240)->Unit(benchmark::kMillisecond);
 
 void BM_SimRenderOutdoor320x240(benchmark::State& state) {
-  cv::setNumThreads(1);
-  const auto scenario = LoadScenario("outdoor_70m");
-  Simulation sim(scenario.world, scenario.camera, {}, 1);
-  sim.AddRobot(Pose2{10.0, 0.0, 0.0}, scenario.robot);
-  for (auto _ : state) benchmark::DoNotOptimize(sim.RenderClean(0).data);
+  RenderLoop(state, "outdoor_70m", Pose2{10.0, 0.0, 0.0});
 }
 BENCHMARK(BM_SimRenderOutdoor320x240)->Unit(benchmark::kMillisecond);
 

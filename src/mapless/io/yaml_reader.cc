@@ -1,6 +1,7 @@
 #include "mapless/io/yaml_reader.h"
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <sstream>
 

@@ -2,19 +2,12 @@
 
 #include <gtest/gtest.h>
 
+
 #include "mapless/core/check.h"
+#include "mapless/core/testing.h"
 
 namespace mapless::io {
 namespace {
-
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 TEST(YamlMap, ReadsTypedFieldsAndDefaults) {
   const YamlMap m = YamlMap::LoadString("a: 1.5\nb: 3\nc: hello\nd: [1, 2, 3]\ne: true\n", "t.yaml");
@@ -27,14 +20,14 @@ TEST(YamlMap, ReadsTypedFieldsAndDefaults) {
 }
 
 TEST(YamlMap, MalformedYamlNamesFileAndLine) {
-  const std::string err = ErrorOf([] { YamlMap::LoadString("a: 1\nb: [1, 2\n", "bad.yaml"); });
+  const std::string err = testing::InputErrorOf([] { YamlMap::LoadString("a: 1\nb: [1, 2\n", "bad.yaml"); });
   EXPECT_NE(err.find("bad.yaml:"), std::string::npos) << err;
   EXPECT_NE(err.find("malformed YAML"), std::string::npos) << err;
 }
 
 TEST(YamlMap, WrongTypeNamesFieldPathAndLine) {
   const YamlMap m = YamlMap::LoadString("world:\n  objects:\n    - size: [1, x]\n", "w.yaml");
-  const std::string err = ErrorOf([&] {
+  const std::string err = testing::InputErrorOf([&] {
     m.GetMap("world").GetMapList("objects")[0].GetDoubles("size", 2);
   });
   EXPECT_NE(err.find("w.yaml:3:"), std::string::npos) << err;
@@ -43,19 +36,19 @@ TEST(YamlMap, WrongTypeNamesFieldPathAndLine) {
 
 TEST(YamlMap, UnknownKeyIsAnError) {
   const YamlMap m = YamlMap::LoadString("speed: 1\nsped: 2\n", "k.yaml");
-  const std::string err = ErrorOf([&] { m.CheckKnownKeys({"speed"}); });
+  const std::string err = testing::InputErrorOf([&] { m.CheckKnownKeys({"speed"}); });
   EXPECT_NE(err.find("k.yaml:2:"), std::string::npos) << err;
   EXPECT_NE(err.find("sped: unknown field"), std::string::npos) << err;
 }
 
 TEST(YamlMap, MissingRequiredFieldIsNamed) {
   const YamlMap m = YamlMap::LoadString("a: 1\n", "m.yaml");
-  const std::string err = ErrorOf([&] { m.GetDouble("b"); });
+  const std::string err = testing::InputErrorOf([&] { m.GetDouble("b"); });
   EXPECT_NE(err.find("missing required field 'b'"), std::string::npos) << err;
 }
 
 TEST(YamlMap, MissingFileIsNamed) {
-  const std::string err = ErrorOf([] { YamlMap::LoadFile("/nonexistent/x.yaml"); });
+  const std::string err = testing::InputErrorOf([] { YamlMap::LoadFile("/nonexistent/x.yaml"); });
   EXPECT_NE(err.find("/nonexistent/x.yaml: cannot open file"), std::string::npos) << err;
 }
 

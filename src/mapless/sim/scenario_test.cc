@@ -2,21 +2,12 @@
 
 #include <gtest/gtest.h>
 
-#include <functional>
 
 #include "mapless/core/check.h"
+#include "mapless/core/testing.h"
 
 namespace mapless::sim {
 namespace {
-
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 const char* kMinimal = R"(
 name: tiny
@@ -88,22 +79,22 @@ TEST(Scenario, MinimalScenarioUsesDefaults) {
 TEST(Scenario, MalformedFieldIsReportedWithFileLineAndField) {
   std::string text = kMinimal;
   text.replace(text.find("size_m: [1, 1, 1]"), 17, "size_m: [1, one, 1]");
-  const std::string err = ErrorOf([&] { ParseScenario(text, "bad.yaml", ""); });
+  const std::string err = testing::InputErrorOf([&] { ParseScenario(text, "bad.yaml", ""); });
   EXPECT_NE(err.find("bad.yaml:5:"), std::string::npos) << err;
   EXPECT_NE(err.find("world.objects[0].size_m"), std::string::npos) << err;
 }
 
 TEST(Scenario, UnknownFieldAndUnknownTagAreErrors) {
   std::string text = std::string(kMinimal) + "repeat:\n  variant: {remove: [truck]}\n";
-  EXPECT_NE(ErrorOf([&] { ParseScenario(text, "t.yaml", ""); }).find("no object has tag 'truck'"),
+  EXPECT_NE(testing::InputErrorOf([&] { ParseScenario(text, "t.yaml", ""); }).find("no object has tag 'truck'"),
             std::string::npos);
   std::string typo = std::string(kMinimal) + "camra: {width: 10}\n";
-  EXPECT_NE(ErrorOf([&] { ParseScenario(typo, "t.yaml", ""); }).find("camra: unknown field"),
+  EXPECT_NE(testing::InputErrorOf([&] { ParseScenario(typo, "t.yaml", ""); }).find("camra: unknown field"),
             std::string::npos);
 }
 
 TEST(Scenario, UnknownBuiltinNameSaysSo) {
-  EXPECT_NE(ErrorOf([] { LoadScenario("no_such_scenario"); }).find("unknown scenario 'no_such_scenario'"),
+  EXPECT_NE(testing::InputErrorOf([] { LoadScenario("no_such_scenario"); }).find("unknown scenario 'no_such_scenario'"),
             std::string::npos);
 }
 

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "mapless/core/check.h"
 
@@ -42,6 +44,29 @@ TEST(Texture, LowContrastVariantIsMuchFlatterThanNormal) {
   cv::meanStdDev(GenerateTextureImage(normal), m1, s1);
   cv::meanStdDev(GenerateTextureImage(low), m2, s2);
   EXPECT_LT(s2[0], 0.25 * s1[0]);
+}
+
+TEST(Texture, ImageFileTextureIsLoadedAsGreyAndResized) {
+  const std::string path = ::testing::TempDir() + "mapless_texture.png";
+  cv::Mat colour(40, 60, CV_8UC3, cv::Scalar(0, 0, 0));
+  cv::rectangle(colour, cv::Rect(0, 0, 30, 40), cv::Scalar(255, 255, 255), cv::FILLED);
+  ASSERT_TRUE(cv::imwrite(path, colour));
+  TextureSpec spec;
+  spec.type = TextureType::kImage;
+  spec.file = path;
+  spec.size_px = 64;
+  const cv::Mat img = GenerateTextureImage(spec);
+  ASSERT_EQ(img.type(), CV_8UC1);
+  ASSERT_EQ(img.size(), cv::Size(64, 64));
+  EXPECT_GT(img.at<std::uint8_t>(32, 5), 200);   // left half white
+  EXPECT_LT(img.at<std::uint8_t>(32, 58), 50);   // right half black
+  spec.file = "/nonexistent/texture.png";
+  try {
+    GenerateTextureImage(spec);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/texture.png"), std::string::npos);
+  }
 }
 
 TEST(Texture, InvalidSpecNamesTheField) {
