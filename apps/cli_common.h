@@ -38,5 +38,6 @@ sim::DriveSummary DriveToDirectory(const sim::Scenario& scenario, const sim::Dri
 void AddSimCommands(CLI::App* app);
 void AddDemoCommand(CLI::App* app);
 void AddBenchCommand(CLI::App* app);
+void AddShiftCommand(CLI::App* app);
 
 }  // namespace mapless::app

@@ -27,7 +27,7 @@ expect_exit() {
 }
 
 # Every subcommand answers --help with exit 0 and a usage text.
-for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench"; do
+for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench" "shift"; do
   # shellcheck disable=SC2086
   expect_exit "help: mapless $sub --help" 0 "$MAPLESS" $sub --help
   grep -qi "usage" "$TMP/out"; check "help text: mapless $sub" $?
@@ -80,6 +80,15 @@ n_poses=$(grep -vc '^#' "$TMP/d1/groundtruth.tum")
 cmp -s "$TMP/d1/groundtruth.tum" "$TMP/d2/groundtruth.tum"; check "drive poses identical for the same seed" $?
 cmp -s "$TMP/d1/frames/000040.png" "$TMP/d2/frames/000040.png"; check "drive frames identical for the same seed" $?
 ls "$TMP/d1" "$TMP/d1/frames" | grep -q '\.tmp\.' && r=1 || r=0; check "no temporary files left" $r
+
+# Shift: JSON with the documented fields; the sign follows dx = x_current - x_reference.
+S="$HERE/data/stromovka"
+expect_exit "shift --json" 0 "$MAPLESS" shift "$S/0101.png" "$S/1201.png" --json
+grep -q '"dx_px":' "$TMP/out" && grep -q '"matches":' "$TMP/out" && grep -q '"ok":true' "$TMP/out"; check "shift JSON has dx_px, matches, ok" $?
+dx=$(sed 's/.*"dx_px":\([-0-9.e]*\).*/\1/' "$TMP/out")
+awk -v d="$dx" 'BEGIN { exit !(d > 40.5 - 17.5 && d < 40.5 + 17.5) }'; check "shift of Stromovka place 1, session 12 vs 01 is 40.5 +- 17.5 px (got $dx)" $?
+expect_exit "shift of a missing image exits 2" 2 "$MAPLESS" shift "$S/0101.png" "$TMP/none.png"
+grep -q "none.png: cannot read image" "$TMP/err"; check "shift names the missing image" $?
 
 # Bench: one JSON object with the render stage and its reference.
 expect_exit "bench --json" 0 "$MAPLESS" bench --json --repeats 5

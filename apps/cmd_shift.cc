@@ -1,0 +1,66 @@
+// `mapless shift REFERENCE CURRENT`: horizontal image displacement of CURRENT relative to
+// REFERENCE, dx = x_in_current - x_in_reference for the same scene point.
+#include <cstdio>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "cli_common.h"
+#include "mapless/core/check.h"
+#include "mapless/features/shift.h"
+
+namespace mapless::app {
+namespace {
+
+cv::Mat ReadGrey(const std::string& path) {
+  cv::Mat img;
+  try {
+    img = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  } catch (const cv::Exception&) {
+    img.release();
+  }
+  if (img.empty()) throw InputError(path + ": cannot read image (missing, or not an image file)");
+  return img;
+}
+
+}  // namespace
+
+void AddShiftCommand(CLI::App* app) {
+  struct Args {
+    std::string reference;
+    std::string current;
+    bool json = false;
+    std::string detector = "akaze_upright";
+    double ratio = 0.85;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app->add_subcommand(
+      "shift", "Horizontal shift of CURRENT relative to REFERENCE: dx = x_current - x_reference (px)");
+  cmd->add_option("REFERENCE", args->reference, "Reference image")->required();
+  cmd->add_option("CURRENT", args->current, "Current image")->required();
+  cmd->add_flag("--json", args->json, "Print {\"dx_px\", \"matches\", \"inliers\", \"ok\"} as JSON");
+  cmd->add_option("--detector", args->detector, "orb, akaze, akaze_upright or sift")->capture_default_str();
+  cmd->add_option("--ratio", args->ratio, "Ratio-test threshold")->capture_default_str();
+  cmd->callback([args] {
+    features::ShiftOptions options;
+    options.features.type = features::ParseDetectorType(args->detector);
+    options.matching.ratio = args->ratio;
+    options.Validate();
+    const features::ShiftEstimate e =
+        features::EstimateShift(ReadGrey(args->reference), ReadGrey(args->current), options);
+    if (args->json) {
+      nlohmann::json j;
+      j["dx_px"] = e.dx_px;
+      j["matches"] = e.matches;
+      j["inliers"] = e.inliers;
+      j["ok"] = e.ok;
+      std::cout << j.dump() << "\n";
+    } else {
+      std::printf("dx_px %.2f  matches %d  inliers %d  %s\n", e.dx_px, e.matches, e.inliers,
+                  e.ok ? "ok" : "NOT OK (too few consistent matches)");
+    }
+  });
+}
+
+}  // namespace mapless::app

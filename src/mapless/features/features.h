@@ -1,0 +1,59 @@
+// Feature detection, description and matching: the front end of the funnel-lane methods.
+// Detectors: ORB (default), AKAZE, upright AKAZE (no rotation invariance: a ground robot's camera
+// does not roll, and dropping invariance makes descriptors more distinctive across seasons) and
+// SIFT. Debian's OpenCV has no SURF, which the funnel-lane paper used.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <opencv2/features2d.hpp>
+
+#include <string>
+#include <vector>
+
+namespace mapless::features {
+
+enum class DetectorType { kOrb, kAkaze, kAkazeUpright, kSift };
+
+// "orb", "akaze", "akaze_upright", "sift"; throws InputError on an unknown name.
+DetectorType ParseDetectorType(const std::string& name);
+const char* DetectorTypeName(DetectorType type);
+
+struct FeatureOptions {
+  DetectorType type = DetectorType::kOrb;
+  int max_features = 500;            // ORB and SIFT: keep at most this many (strongest first)
+  int orb_fast_threshold = 20;       // ORB: FAST corner threshold, grey levels
+  double akaze_threshold = 0.0005;   // AKAZE: detector response threshold
+  void Validate() const;             // throws InputError naming the field
+};
+
+struct Features {
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;  // one row per keypoint
+  bool binary = true;   // Hamming (ORB, AKAZE) or L2 (SIFT) distance
+};
+
+// Holds the OpenCV detector (not thread-safe: one per thread).
+class FeatureExtractor {
+ public:
+  explicit FeatureExtractor(FeatureOptions options);
+  // Detects and describes features of a grey (or colour, converted) image.
+  Features Extract(const cv::Mat& image) const;
+  const FeatureOptions& options() const { return options_; }
+
+ private:
+  FeatureOptions options_;
+  cv::Ptr<cv::Feature2D> detector_;
+};
+
+struct MatchOptions {
+  double ratio = 0.85;          // Lowe's ratio test: best distance < ratio * second best
+  double max_dy_px = 1e9;       // reject matches whose vertical offset exceeds this
+  bool mutual = false;          // keep only matches that are also best in the other direction
+  void Validate() const;
+};
+
+// Matches of query features to train features (queryIdx into `query`, trainIdx into `train`).
+std::vector<cv::DMatch> MatchFeatures(const Features& query, const Features& train,
+                                      const MatchOptions& options);
+
+}  // namespace mapless::features

@@ -1,0 +1,90 @@
+#include "mapless/features/features.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "mapless/core/check.h"
+#include "mapless/features/klt.h"
+#include "mapless/sim/simulation.h"
+
+namespace mapless::features {
+namespace {
+
+cv::Mat SimFrame(const char* scenario, const Pose2& pose) {
+  const sim::Scenario s = sim::LoadScenario(scenario);
+  sim::Simulation sim(s.world, s.camera, {}, 1);
+  sim.AddRobot(pose, s.robot);
+  return sim.RenderClean(0);
+}
+
+TEST(FeatureExtractor, EveryDetectorFindsFeaturesOnASimulatorFrame) {
+  const cv::Mat frame = SimFrame("table1_almost_straight", Pose2{1.0, 0.0, 0.0});
+  for (const char* name : {"orb", "akaze", "akaze_upright", "sift"}) {
+    FeatureOptions o;
+    o.type = ParseDetectorType(name);
+    const Features f = FeatureExtractor(o).Extract(frame);
+    EXPECT_GE(f.keypoints.size(), 100u) << name;
+    EXPECT_EQ(static_cast<std::size_t>(f.descriptors.rows), f.keypoints.size()) << name;
+    EXPECT_EQ(f.binary, o.type != DetectorType::kSift) << name;
+  }
+  EXPECT_THROW(ParseDetectorType("surf"), InputError);
+}
+
+TEST(MatchFeatures, AFrameMatchedWithItselfGivesIdentityMatches) {
+  const cv::Mat frame = SimFrame("table1_almost_straight", Pose2{1.0, 0.0, 0.0});
+  const FeatureExtractor extractor(FeatureOptions{});
+  const Features f = extractor.Extract(frame);
+  MatchOptions m;
+  m.mutual = true;
+  const auto matches = MatchFeatures(f, f, m);
+  ASSERT_GT(matches.size(), 50u);
+  int identity = 0;
+  for (const auto& match : matches) identity += match.queryIdx == match.trainIdx ? 1 : 0;
+  EXPECT_GT(identity, static_cast<int>(0.95 * static_cast<double>(matches.size())));
+}
+
+TEST(MatchFeatures, VerticalOffsetBoundRejectsMatches) {
+  const cv::Mat frame = SimFrame("table1_almost_straight", Pose2{1.0, 0.0, 0.0});
+  cv::Mat moved;
+  const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, 0, 0, 1, 20);
+  cv::warpAffine(frame, moved, shift, frame.size());
+  const FeatureExtractor extractor(FeatureOptions{});
+  MatchOptions loose;
+  MatchOptions tight;
+  tight.max_dy_px = 5.0;
+  const Features a = extractor.Extract(frame);
+  const Features b = extractor.Extract(moved);
+  EXPECT_GT(MatchFeatures(a, b, loose).size(), 50u);
+  EXPECT_LT(MatchFeatures(a, b, tight).size(), MatchFeatures(a, b, loose).size() / 5);
+}
+
+TEST(TrackKlt, RecoversASubPixelTranslation) {
+  const cv::Mat frame = SimFrame("table1_almost_straight", Pose2{1.0, 0.0, 0.0});
+  cv::Mat moved;
+  const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, 2.3, 0, 1, -1.1);
+  cv::warpAffine(frame, moved, shift, frame.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+  std::vector<cv::Point2f> corners;
+  cv::goodFeaturesToTrack(frame, corners, 200, 0.01, 8);
+  const KltResult r = TrackKlt(frame, moved, corners, KltOptions{});
+  ASSERT_GT(r.tracked, 150);
+  int accurate = 0;
+  for (std::size_t i = 0; i < corners.size(); ++i) {
+    if (!r.ok[i]) continue;
+    const cv::Point2f d = r.points[i] - corners[i];
+    if (std::abs(d.x - 2.3f) < 0.1f && std::abs(d.y + 1.1f) < 0.1f) ++accurate;
+  }
+  EXPECT_GT(accurate, static_cast<int>(0.9 * r.tracked));
+}
+
+TEST(TrackKlt, LosesPointsThatLeaveTheImageOrHitAnotherView) {
+  const cv::Mat a = SimFrame("table1_almost_straight", Pose2{1.0, 0.0, 0.0});
+  const cv::Mat b = SimFrame("table1_almost_straight", Pose2{1.0, 0.0, kPi / 2});  // looking at a wall
+  std::vector<cv::Point2f> corners;
+  cv::goodFeaturesToTrack(a, corners, 200, 0.01, 8);
+  const KltResult r = TrackKlt(a, b, corners, KltOptions{});
+  EXPECT_LT(r.tracked, static_cast<int>(corners.size()) / 4);
+}
+
+}  // namespace
+}  // namespace mapless::features

@@ -1,0 +1,68 @@
+#include "mapless/features/shift.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "mapless/core/check.h"
+
+namespace mapless::features {
+
+void ShiftOptions::Validate() const {
+  features.Validate();
+  matching.Validate();
+  MAPLESS_CHECK(bin_px > 0.0, "ShiftOptions.bin_px = " << bin_px << "; must be > 0");
+  MAPLESS_CHECK(min_votes >= 1, "ShiftOptions.min_votes = " << min_votes << "; must be >= 1");
+}
+
+ShiftEstimate VoteShift(const std::vector<double>& dx_px, double bin_px, int min_votes) {
+  ShiftEstimate out;
+  out.matches = static_cast<int>(dx_px.size());
+  if (dx_px.empty()) return out;
+  std::map<long, int> histogram;
+  for (double d : dx_px) ++histogram[static_cast<long>(std::floor(d / bin_px))];
+  // The bin whose neighbourhood (itself and both neighbours) holds the most votes; ties go to the
+  // smaller offset, so the result does not depend on map order.
+  long best_bin = 0;
+  int best_votes = -1;
+  for (const auto& [bin, count] : histogram) {
+    int votes = count;
+    if (auto it = histogram.find(bin - 1); it != histogram.end()) votes += it->second;
+    if (auto it = histogram.find(bin + 1); it != histogram.end()) votes += it->second;
+    if (votes > best_votes) {
+      best_votes = votes;
+      best_bin = bin;
+    }
+  }
+  const double centre = (static_cast<double>(best_bin) + 0.5) * bin_px;
+  std::vector<double> support;
+  for (double d : dx_px) {
+    if (std::abs(d - centre) <= 1.5 * bin_px) support.push_back(d);
+  }
+  out.inliers = static_cast<int>(support.size());
+  std::nth_element(support.begin(), support.begin() + static_cast<long>(support.size() / 2), support.end());
+  out.dx_px = support[support.size() / 2];
+  out.ok = out.inliers >= min_votes;
+  return out;
+}
+
+ShiftEstimate EstimateShift(const Features& reference, const Features& current,
+                            const ShiftOptions& options) {
+  const std::vector<cv::DMatch> matches = MatchFeatures(reference, current, options.matching);
+  std::vector<double> dx;
+  dx.reserve(matches.size());
+  for (const auto& m : matches) {
+    dx.push_back(current.keypoints[static_cast<std::size_t>(m.trainIdx)].pt.x -
+                 reference.keypoints[static_cast<std::size_t>(m.queryIdx)].pt.x);
+  }
+  return VoteShift(dx, options.bin_px, options.min_votes);
+}
+
+ShiftEstimate EstimateShift(const cv::Mat& reference, const cv::Mat& current,
+                            const ShiftOptions& options) {
+  options.Validate();
+  const FeatureExtractor extractor(options.features);
+  return EstimateShift(extractor.Extract(reference), extractor.Extract(current), options);
+}
+
+}  // namespace mapless::features
