@@ -1,0 +1,54 @@
+// On-disk route store: a directory, versioned, written incrementally and crash-safe.
+//
+//   ROUTE/manifest.json          {"format": "mapless-route", "version": 1, "detector": "orb",
+//                                 "image_width": 320, "image_height": 240, "complete": true,
+//                                 "keyframes": [{"index": 0, "t_s": 0.0,
+//                                                "data": "keyframes/000000.yml",
+//                                                "thumbnail": "keyframes/000000.png"}, ...]}
+//   ROUTE/keyframes/NNNNNN.yml   OpenCV FileStorage YAML: keypoints, descriptors, segment tracks
+//   ROUTE/keyframes/NNNNNN.png   the downscaled keyframe image
+//
+// Every file is written atomically (temporary file, fsync, rename), the keyframe's files before the
+// manifest that lists it. A teach killed at any moment therefore leaves a route that loads, with
+// every keyframe completed before the kill; `complete` is false until the teach finished.
+#pragma once
+
+#include <string>
+
+#include "mapless/route/route.h"
+
+namespace mapless::route {
+
+inline constexpr int kRouteFormatVersion = 1;
+
+class RouteWriter {
+ public:
+  // Creates DIR (and DIR/keyframes) and writes an empty manifest. Throws InputError when DIR
+  // already holds a route and `overwrite` is false.
+  RouteWriter(std::string dir, std::string detector, int image_width, int image_height,
+              bool overwrite = false);
+  // Writes one keyframe, then the manifest that lists it.
+  void Append(const Keyframe& keyframe);
+  // Marks the route complete.
+  void Finish();
+  int keyframes() const { return static_cast<int>(entries_.size()); }
+
+ private:
+  void WriteManifest() const;
+  struct Entry {
+    int index;
+    Timestamp t_ns;
+  };
+  std::string dir_;
+  std::string detector_;
+  int width_;
+  int height_;
+  bool complete_ = false;
+  std::vector<Entry> entries_;
+};
+
+// Loads a route; throws InputError naming the file and what is wrong (missing, truncated,
+// corrupt, wrong version, inconsistent).
+Route LoadRoute(const std::string& dir);
+
+}  // namespace mapless::route

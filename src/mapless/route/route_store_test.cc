@@ -1,0 +1,130 @@
+#include "mapless/route/route_store.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "mapless/core/check.h"
+#include "mapless/core/rng.h"
+#include "mapless/core/testing.h"
+#include "mapless/io/atomic_file.h"
+
+namespace mapless::route {
+namespace {
+
+std::string FreshDir(const std::string& name) {
+  const std::string dir = ::testing::TempDir() + "mapless_route_" + name;
+  std::filesystem::remove_all(dir);
+  return dir;
+}
+
+Keyframe MakeKeyframe(int index) {
+  Rng rng(static_cast<std::uint64_t>(index) + 1);
+  Keyframe kf;
+  kf.index = index;
+  kf.t_ns = 100'000'000LL * index;
+  kf.thumbnail = cv::Mat(60, 80, CV_8UC1, cv::Scalar(10 * index));
+  for (int i = 0; i < 50; ++i) {
+    kf.keypoints.emplace_back(static_cast<float>(rng.Uniform(0, 320)),
+                              static_cast<float>(rng.Uniform(0, 240)), 31.0f);
+  }
+  kf.descriptors = cv::Mat(50, 32, CV_8UC1);
+  for (int r = 0; r < 50; ++r) {
+    for (int c = 0; c < 32; ++c) kf.descriptors.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(rng.UniformInt(256));
+  }
+  if (index > 0) {
+    kf.segment_start_px = {{10, 20}, {30, 40}};
+    kf.segment_end_px = {{12, 21}, {35, 41}};
+  }
+  return kf;
+}
+
+TEST(RouteStore, RoundTripsEveryField) {
+  const std::string dir = FreshDir("roundtrip");
+  RouteWriter writer(dir, "orb", 320, 240);
+  for (int i = 0; i < 3; ++i) writer.Append(MakeKeyframe(i));
+  writer.Finish();
+  const Route route = LoadRoute(dir);
+  EXPECT_TRUE(route.complete);
+  EXPECT_EQ(route.detector, "orb");
+  EXPECT_EQ(route.image_width, 320);
+  ASSERT_EQ(route.keyframes.size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    const Keyframe expected = MakeKeyframe(i);
+    const Keyframe& got = route.keyframes[static_cast<std::size_t>(i)];
+    EXPECT_EQ(got.index, i);
+    EXPECT_EQ(got.t_ns, expected.t_ns);
+    ASSERT_EQ(got.keypoints.size(), expected.keypoints.size());
+    EXPECT_FLOAT_EQ(got.keypoints[7].pt.x, expected.keypoints[7].pt.x);
+    EXPECT_EQ(cv::norm(got.descriptors, expected.descriptors, cv::NORM_INF), 0.0);
+    EXPECT_EQ(got.segment_end_px, expected.segment_end_px);
+    EXPECT_EQ(cv::norm(got.thumbnail, expected.thumbnail, cv::NORM_INF), 0.0);
+  }
+}
+
+TEST(RouteStore, AnUnfinishedTeachLoadsWithItsCompletedKeyframes) {
+  const std::string dir = FreshDir("unfinished");
+  RouteWriter writer(dir, "orb", 320, 240);
+  writer.Append(MakeKeyframe(0));
+  writer.Append(MakeKeyframe(1));
+  // No Finish(): as if the teach was killed here. A half-written next keyframe (no manifest entry
+  // yet) must not matter either.
+  io::WriteFileAtomic(dir + "/keyframes/000002.yml", "format: mapless-keyfr");
+  const Route route = LoadRoute(dir);
+  EXPECT_FALSE(route.complete);
+  EXPECT_EQ(route.keyframes.size(), 2u);
+}
+
+TEST(RouteStore, RefusesToOverwriteAnExistingRoute) {
+  const std::string dir = FreshDir("overwrite");
+  { RouteWriter writer(dir, "orb", 320, 240); }
+  EXPECT_NE(testing::InputErrorOf([&] { RouteWriter again(dir, "orb", 320, 240); }).find("already holds a route"),
+            std::string::npos);
+  EXPECT_NO_THROW(RouteWriter(dir, "orb", 320, 240, /*overwrite=*/true));
+}
+
+TEST(RouteStore, TruncatedKeyframeFileIsNamedInTheError) {
+  const std::string dir = FreshDir("truncated");
+  RouteWriter writer(dir, "orb", 320, 240);
+  writer.Append(MakeKeyframe(0));
+  writer.Append(MakeKeyframe(1));
+  const std::string path = dir + "/keyframes/000001.yml";
+  const std::string text = io::ReadFile(path);
+  io::WriteFileAtomic(path, text.substr(0, text.size() / 2));
+  const std::string err = testing::InputErrorOf([&] { LoadRoute(dir); });
+  EXPECT_NE(err.find("000001.yml"), std::string::npos) << err;
+}
+
+TEST(RouteStore, CorruptOrMissingFilesGiveOneClearError) {
+  const std::string dir = FreshDir("corrupt");
+  RouteWriter writer(dir, "orb", 320, 240);
+  writer.Append(MakeKeyframe(0));
+  // Garbage keyframe data.
+  io::WriteFileAtomic(dir + "/keyframes/000000.yml", std::string("\x01\x02garbage\xff", 11));
+  EXPECT_NE(testing::InputErrorOf([&] { LoadRoute(dir); }).find("000000.yml"), std::string::npos);
+  // Missing thumbnail.
+  writer.Append(MakeKeyframe(1));
+  std::filesystem::remove(dir + "/keyframes/000001.png");
+  io::WriteFileAtomic(dir + "/keyframes/000000.yml", io::ReadFile(dir + "/keyframes/000000.yml"));
+  // Corrupt manifest.
+  io::WriteFileAtomic(dir + "/manifest.json", "{\"format\": \"mapless-route\", \"vers");
+  EXPECT_NE(testing::InputErrorOf([&] { LoadRoute(dir); }).find("manifest.json: corrupt manifest"),
+            std::string::npos);
+  // No route at all.
+  EXPECT_NE(testing::InputErrorOf([&] { LoadRoute(dir + "/nothing"); }).find("manifest.json is missing"),
+            std::string::npos);
+}
+
+TEST(RouteStore, NewerFormatVersionIsRefusedByName) {
+  const std::string dir = FreshDir("version");
+  { RouteWriter writer(dir, "orb", 320, 240); }
+  std::string manifest = io::ReadFile(dir + "/manifest.json");
+  manifest.replace(manifest.find("\"version\": 1"), 12, "\"version\": 9");
+  io::WriteFileAtomic(dir + "/manifest.json", manifest);
+  EXPECT_NE(testing::InputErrorOf([&] { LoadRoute(dir); }).find("route format version 9 is not supported"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace mapless::route
