@@ -88,6 +88,8 @@ void SlopedFunnelLaneOptions::Validate() const {
   MAPLESS_CHECK(slope_y_for_full_speed > 0.0,
                 "SlopedFunnelLaneOptions.slope_y_for_full_speed = " << slope_y_for_full_speed
                                                                     << "; must be > 0");
+  MAPLESS_CHECK(min_median_px >= 0.0,
+                "SlopedFunnelLaneOptions.min_median_px = " << min_median_px << "; must be >= 0");
   MAPLESS_CHECK(max_speed_mps > 0.0,
                 "SlopedFunnelLaneOptions.max_speed_mps = " << max_speed_mps << "; must be > 0");
   MAPLESS_CHECK(max_turn_rate_radps > 0.0,
@@ -124,11 +126,11 @@ SlopedFunnelLaneResult ComputeSlopedFunnelLane(const std::vector<FeaturePair>& f
   double slope_x = 0.0;
   if (!uc_left.empty()) {
     const double mu_j = Median(uj_left);
-    slope_x += (mu_j - Median(uc_left)) / std::abs(mu_j);
+    slope_x += (mu_j - Median(uc_left)) / std::max(std::abs(mu_j), options.min_median_px);
   }
   if (!uc_right.empty()) {
     const double mu_j = Median(uj_right);
-    slope_x += (mu_j - Median(uc_right)) / std::abs(mu_j);
+    slope_x += (mu_j - Median(uc_right)) / std::max(std::abs(mu_j), options.min_median_px);
   }
   r.slope_x = options.gamma * slope_x;
   // Section V-A: no slope around x, go straight whatever the slope around y.

@@ -58,7 +58,10 @@ struct SlopedFunnelLaneOptions {
   double beta = 1.0;                  // slope around y: beta * (1 - sigma_c / sigma_j)
   double gamma = 1.0;                 // slope around x: gamma * sum over sides of (mu_j - mu_c)/|mu_j|
   double turn_threshold = 0.05;       // |slope_x| above which the robot turns
-  double slope_x_for_full_turn = 0.4; // |slope_x| at which the turn rate reaches its maximum
+  double slope_x_for_full_turn = 1.0; // |slope_x| at which the turn rate reaches its maximum
+  // Floor on |mu_j| in the slope around x, px: a side whose destination median is near the image
+  // centre would otherwise make the slope explode (not in the paper; 0 disables it).
+  double min_median_px = 20.0;
   double slope_y_for_full_speed = 0.15;  // slope_y at which a turning robot keeps full speed
   double max_speed_mps = 0.2;         // forward speed when going straight
   double max_turn_rate_radps = 0.5;   // turn rate at full turn

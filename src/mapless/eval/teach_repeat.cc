@@ -1,0 +1,120 @@
+#include "mapless/eval/teach_repeat.h"
+
+#include <cmath>
+#include <limits>
+
+#include "mapless/core/check.h"
+#include "mapless/core/rng.h"
+
+namespace mapless::eval {
+
+void RepeatRunOptions::Validate() const {
+  repeat.Validate();
+  MAPLESS_CHECK(motion_noise_frac >= 0.0 && motion_noise_frac <= 1.0,
+                "RepeatRunOptions.motion_noise_frac = " << motion_noise_frac << "; must be in [0, 1]");
+  MAPLESS_CHECK(image_noise_sigma >= 0.0,
+                "RepeatRunOptions.image_noise_sigma = " << image_noise_sigma << "; must be >= 0");
+  MAPLESS_CHECK(timeout_factor >= 1.0,
+                "RepeatRunOptions.timeout_factor = " << timeout_factor << "; must be >= 1");
+  MAPLESS_CHECK(success_radius_m > 0.0,
+                "RepeatRunOptions.success_radius_m = " << success_radius_m << "; must be > 0");
+}
+
+double DistanceToPath(const std::vector<Pose2>& path, double x_m, double y_m) {
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i + 1 < path.size(); ++i) {
+    const double ax = path[i].x_m, ay = path[i].y_m;
+    const double bx = path[i + 1].x_m, by = path[i + 1].y_m;
+    const double dx = bx - ax, dy = by - ay;
+    const double len2 = dx * dx + dy * dy;
+    double t = len2 > 0.0 ? ((x_m - ax) * dx + (y_m - ay) * dy) / len2 : 0.0;
+    t = std::clamp(t, 0.0, 1.0);
+    best = std::min(best, std::hypot(ax + t * dx - x_m, ay + t * dy - y_m));
+  }
+  if (path.size() == 1) best = std::hypot(path[0].x_m - x_m, path[0].y_m - y_m);
+  return best;
+}
+
+TaughtRoute TeachOnSimulator(const sim::Scenario& scenario, const navigation::TeachOptions& options,
+                             const std::function<void(const route::Keyframe&)>& on_keyframe) {
+  TaughtRoute taught;
+  taught.route = std::make_shared<route::Route>();
+  taught.route->detector = features::DetectorTypeName(options.features.type);
+  taught.route->image_width = scenario.camera.model.width;
+  taught.route->image_height = scenario.camera.model.height;
+  navigation::TeachSession teach(options);
+  auto keep = [&](const std::optional<route::Keyframe>& kf) {
+    if (!kf) return;
+    if (on_keyframe) on_keyframe(*kf);
+    taught.route->keyframes.push_back(*kf);
+  };
+  sim::DriveOptions drive;
+  const sim::DriveSummary summary = sim::DriveTaughtPath(scenario, drive, [&](const sim::DriveFrame& f) {
+    taught.path.push_back(f.truth);
+    keep(teach.Update(f.image, f.t_ns));
+  });
+  keep(teach.Finish());
+  MAPLESS_CHECK(summary.completed, "teach drive of '" << scenario.name << "' did not complete: " << summary.status);
+  taught.route->complete = true;
+  taught.duration_s = summary.duration_s;
+  return taught;
+}
+
+RepeatRun RepeatOnSimulator(const sim::Scenario& scenario, const TaughtRoute& taught,
+                            const RepeatRunOptions& options, const RepeatObserver& observer) {
+  options.Validate();
+  Rng rng(options.seed);
+  sim::CameraSpec camera = scenario.camera;
+  camera.effects.noise_sigma = std::max(camera.effects.noise_sigma, options.image_noise_sigma);
+  sim::RobotOptions robot = scenario.robot;
+  robot.motion_noise_v_frac = options.motion_noise_frac;
+  robot.motion_noise_omega_frac = options.motion_noise_frac;
+  const Pose2 start = scenario.repeat_start *
+                      Pose2{rng.Uniform(-options.start_offset_m, options.start_offset_m),
+                            rng.Uniform(-options.start_offset_m, options.start_offset_m),
+                            DegToRad(rng.Uniform(-options.start_offset_deg, options.start_offset_deg))};
+  sim::Simulation sim(sim::ApplyVariant(scenario.world, scenario.repeat_variant), camera, {},
+                      rng.NextU64());
+  const int r = sim.AddRobot(start, robot);
+  navigation::RepeatSession session(taught.route, options.repeat);
+  const double period = 1.0 / scenario.camera.rate_hz;
+  const double timeout = options.timeout_factor * std::max(taught.duration_s, 1.0);
+  RepeatRun run;
+  while (true) {
+    const Pose2 pose = sim.robot(r).pose();
+    run.path.push_back(pose);
+    const cv::Mat image = sim.Render(r);
+    const navigation::RepeatStep step = session.Update(image, sim.now_ns());
+    if (observer) observer(pose, image, step);
+    run.steps.push_back(step);
+    if (session.finished()) {
+      run.completed = step.status == navigation::RepeatStatus::kCompleted;
+      run.status = step.reason;
+      break;
+    }
+    if (sim.collided(r)) {
+      run.collided = true;
+      run.status = "collision with " + sim.collisions().front().with;
+      break;
+    }
+    if (ToSeconds(sim.now_ns()) > timeout) {
+      run.status = "timeout after " + std::to_string(static_cast<int>(ToSeconds(sim.now_ns()))) + " s";
+      break;
+    }
+    sim.SetCommand(r, step.command);
+    sim.Advance(period);
+  }
+  run.duration_s = ToSeconds(sim.now_ns());
+  const Pose2& end = run.path.back();
+  run.final_error_m = end.DistanceTo(taught.path.back());
+  double sum = 0.0;
+  for (const Pose2& p : run.path) {
+    const double d = DistanceToPath(taught.path, p.x_m, p.y_m);
+    sum += d * d;
+  }
+  run.lateral_rms_m = std::sqrt(sum / static_cast<double>(run.path.size()));
+  run.success = run.completed && !run.collided && run.final_error_m <= options.success_radius_m;
+  return run;
+}
+
+}  // namespace mapless::eval

@@ -1,0 +1,60 @@
+// Closed-loop teach & repeat on the simulator, as in Section VII of Kassir et al.: teach a route by
+// driving the scenario's taught path (scripted driver, clean), then repeat it from the repeat start
+// (perturbed) with motion noise and image noise, the robot driven by the repeat session alone.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mapless/navigation/repeat.h"
+#include "mapless/navigation/teach.h"
+#include "mapless/sim/scenario.h"
+#include "mapless/sim/simulation.h"
+
+namespace mapless::eval {
+
+struct TaughtRoute {
+  std::shared_ptr<route::Route> route;
+  std::vector<Pose2> path;        // ground-truth poses of the teach drive, one per frame
+  double duration_s = 0.0;
+};
+
+// Teaches the scenario's route (no noise). `on_keyframe` may store each keyframe as it is made.
+TaughtRoute TeachOnSimulator(const sim::Scenario& scenario, const navigation::TeachOptions& options,
+                             const std::function<void(const route::Keyframe&)>& on_keyframe = {});
+
+struct RepeatRunOptions {
+  navigation::RepeatOptions repeat;
+  double motion_noise_frac = 0.1;    // of the commanded translation and rotation
+  double image_noise_sigma = 2.0;    // grey levels
+  double start_offset_m = 0.1;       // uniform in +-, x and y
+  double start_offset_deg = 3.0;     // uniform in +-
+  double timeout_factor = 3.0;       // of the taught duration
+  double success_radius_m = 0.5;     // final pose within this of the taught end
+  std::uint64_t seed = 1;
+  void Validate() const;
+};
+
+struct RepeatRun {
+  bool success = false;     // completed, no collision, in time, and near the taught end
+  bool completed = false;   // passed the last keyframe
+  bool collided = false;
+  double final_error_m = 0.0;
+  double lateral_rms_m = 0.0;  // RMS distance of the repeated poses to the taught path
+  double duration_s = 0.0;
+  std::string status;
+  std::vector<Pose2> path;     // ground-truth poses of the repeat, one per frame
+  std::vector<navigation::RepeatStep> steps;
+};
+
+// Called once per frame with the robot's true pose and the decision (for logs and pictures).
+using RepeatObserver = std::function<void(const Pose2&, const cv::Mat&, const navigation::RepeatStep&)>;
+
+RepeatRun RepeatOnSimulator(const sim::Scenario& scenario, const TaughtRoute& taught,
+                            const RepeatRunOptions& options, const RepeatObserver& observer = {});
+
+// Distance from a point to a polyline (the taught path).
+double DistanceToPath(const std::vector<Pose2>& path, double x_m, double y_m);
+
+}  // namespace mapless::eval

@@ -1,0 +1,210 @@
+#include "mapless/navigation/repeat.h"
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "mapless/core/check.h"
+
+namespace mapless::navigation {
+
+Controller ParseController(const std::string& name) {
+  if (name == "sloped") return Controller::kSloped;
+  if (name == "standard") return Controller::kStandard;
+  throw InputError("unknown controller '" + name + "' (known: sloped, standard)");
+}
+
+const char* ControllerName(Controller c) { return c == Controller::kSloped ? "sloped" : "standard"; }
+
+const char* RepeatStatusName(RepeatStatus s) {
+  switch (s) {
+    case RepeatStatus::kDriving: return "driving";
+    case RepeatStatus::kWaiting: return "waiting";
+    case RepeatStatus::kCompleted: return "completed";
+    case RepeatStatus::kAborted: return "aborted";
+  }
+  return "?";
+}
+
+void RepeatOptions::Validate() const {
+  features.Validate();
+  matching.Validate();
+  klt.Validate();
+  sloped.Validate();
+  standard.Validate();
+  switch_rule.Validate();
+  MAPLESS_CHECK(min_features >= 2, "RepeatOptions.min_features = " << min_features << "; must be >= 2");
+  MAPLESS_CHECK(abort_after_s > 0.0, "RepeatOptions.abort_after_s = " << abort_after_s << "; must be > 0");
+  MAPLESS_CHECK(switch_confirm_frames >= 1,
+                "RepeatOptions.switch_confirm_frames = " << switch_confirm_frames << "; must be >= 1");
+  MAPLESS_CHECK(ransac_threshold_px >= 0.0,
+                "RepeatOptions.ransac_threshold_px = " << ransac_threshold_px << "; must be >= 0");
+  MAPLESS_CHECK(mse_rising_frames >= 1,
+                "RepeatOptions.mse_rising_frames = " << mse_rising_frames << "; must be >= 1");
+}
+
+RepeatSession::RepeatSession(std::shared_ptr<const route::Route> route, RepeatOptions options)
+    : route_(std::move(route)),
+      options_(options),
+      extractor_((options.Validate(), options.features)),
+      mse_(options.mse_rising_frames) {
+  MAPLESS_CHECK(route_ != nullptr, "RepeatSession: no route");
+  MAPLESS_CHECK(route_->keyframes.size() >= 2,
+                "RepeatSession: the route has " << route_->keyframes.size()
+                                                << " keyframe(s); at least 2 are needed");
+  MAPLESS_CHECK(route_->detector == features::DetectorTypeName(options_.features.type),
+                "RepeatSession: the route was taught with '" << route_->detector
+                                                             << "' features but the repeat uses '"
+                                                             << features::DetectorTypeName(options_.features.type) << "'");
+  for (const auto& kf : route_->keyframes) {
+    features::Features f;
+    f.keypoints = kf.keypoints;
+    f.descriptors = kf.descriptors;
+    f.binary = options_.features.type != features::DetectorType::kSift;
+    keyframe_features_.push_back(std::move(f));
+  }
+  cx_ = 0.5 * (route_->image_width - 1);
+}
+
+std::vector<control::FeaturePair> RepeatSession::Pairs() const {
+  std::vector<control::FeaturePair> pairs;
+  pairs.reserve(current_px_.size());
+  for (std::size_t i = 0; i < current_px_.size(); ++i) {
+    pairs.push_back({current_px_[i].x - cx_, destination_px_[i].x - cx_});
+  }
+  return pairs;
+}
+
+void RepeatSession::DetectAndMatch(const cv::Mat& grey, RepeatStep* step) {
+  const features::Features current = extractor_.Extract(grey);
+  const auto& kf = keyframe_features_[static_cast<std::size_t>(destination_)];
+  const std::vector<cv::DMatch> matches = features::MatchFeatures(current, kf, options_.matching);
+  current_px_.clear();
+  destination_px_.clear();
+  for (const auto& m : matches) {
+    current_px_.push_back(current.keypoints[static_cast<std::size_t>(m.queryIdx)].pt);
+    destination_px_.push_back(kf.keypoints[static_cast<std::size_t>(m.trainIdx)].pt);
+  }
+  // Outlier rejection: matches must agree with one epipolar geometry (no calibration needed).
+  if (options_.ransac_threshold_px > 0.0 && current_px_.size() >= 12) {
+    std::vector<uchar> inlier;
+    const cv::Mat f = cv::findFundamentalMat(current_px_, destination_px_, cv::FM_RANSAC,
+                                             options_.ransac_threshold_px, 0.99, inlier);
+    if (!f.empty() && inlier.size() == current_px_.size()) {
+      std::vector<cv::Point2f> cur, dst;
+      for (std::size_t i = 0; i < inlier.size(); ++i) {
+        if (!inlier[i]) continue;
+        cur.push_back(current_px_[i]);
+        dst.push_back(destination_px_[i]);
+      }
+      current_px_ = std::move(cur);
+      destination_px_ = std::move(dst);
+    }
+  }
+  last_matches_ = static_cast<int>(current_px_.size());
+  step->redetected = true;
+}
+
+RepeatStep RepeatSession::Stop(RepeatStep step, RepeatStatus status, const std::string& reason) {
+  step.status = status;
+  step.reason = reason;
+  step.command = Twist2{};
+  status_ = status;
+  return step;
+}
+
+RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
+  RepeatStep step;
+  step.destination = destination_;
+  if (finished()) return Stop(step, status_, status_ == RepeatStatus::kCompleted ? "route completed" : "aborted");
+  MAPLESS_CHECK(!image.empty(), "RepeatSession: empty frame");
+  cv::Mat grey = image;
+  if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  MAPLESS_CHECK(grey.cols == route_->image_width && grey.rows == route_->image_height,
+                "RepeatSession: frame is " << grey.cols << "x" << grey.rows << " but the route was taught at "
+                                           << route_->image_width << "x" << route_->image_height);
+
+  // Algorithm 1, lines 16-18: track the matched features inside the segment.
+  if (!previous_.empty() && !current_px_.empty()) {
+    const features::KltResult tracked = features::TrackKlt(previous_, grey, current_px_, options_.klt);
+    std::vector<cv::Point2f> cur, dst;
+    for (std::size_t i = 0; i < current_px_.size(); ++i) {
+      if (!tracked.ok[i]) continue;
+      cur.push_back(tracked.points[i]);
+      dst.push_back(destination_px_[i]);
+    }
+    current_px_ = std::move(cur);
+    destination_px_ = std::move(dst);
+  }
+  previous_ = grey.clone();
+  // Lines 20-27: too few features left, detect and match again.
+  if (static_cast<int>(current_px_.size()) < options_.min_features) DetectAndMatch(grey, &step);
+  step.matches = last_matches_;
+  step.tracked = static_cast<int>(current_px_.size());
+  if (step.tracked < options_.min_features) {
+    // Stop while features are insufficient; abort if that lasts too long.
+    if (!waiting_) {
+      waiting_ = true;
+      waiting_since_ns_ = t_ns;
+    }
+    const double waited = ToSeconds(t_ns - waiting_since_ns_);
+    if (waited > options_.abort_after_s) {
+      return Stop(step, RepeatStatus::kAborted,
+                  "aborted: fewer than " + std::to_string(options_.min_features) +
+                      " features matched keyframe " + std::to_string(destination_) + " for " +
+                      std::to_string(static_cast<int>(waited)) + " s");
+    }
+    step = Stop(step, RepeatStatus::kWaiting,
+                "stopped: only " + std::to_string(step.tracked) + " features match keyframe " +
+                    std::to_string(destination_) + " (need " + std::to_string(options_.min_features) + ")");
+    status_ = RepeatStatus::kDriving;  // waiting is per frame; the session is not finished
+    return step;
+  }
+  waiting_ = false;
+
+  // Line 9: switch to the next segment.
+  std::vector<control::FeaturePair> pairs = Pairs();
+  step.switching = control::CheckSwitch(pairs, options_.switch_rule);
+  switch_votes_ = step.switching.switch_now ? switch_votes_ + 1 : 0;
+  const bool switch_now = options_.switching == Switching::kStdRatio
+                              ? switch_votes_ >= options_.switch_confirm_frames
+                              : mse_.Update(pairs);
+  if (switch_now) {
+    step.switched = true;
+    ++destination_;
+    mse_.Reset();
+    switch_votes_ = 0;
+    step.destination = destination_;
+    if (destination_ >= static_cast<int>(route_->keyframes.size())) {
+      destination_ = static_cast<int>(route_->keyframes.size()) - 1;
+      step.destination = destination_;
+      return Stop(step, RepeatStatus::kCompleted, "route completed: passed the last keyframe");
+    }
+    // Lines 11-14: detect and match against the new destination.
+    DetectAndMatch(grey, &step);
+    step.matches = last_matches_;
+    step.tracked = static_cast<int>(current_px_.size());
+    if (step.tracked < options_.min_features) {
+      waiting_ = true;
+      waiting_since_ns_ = t_ns;
+      step = Stop(step, RepeatStatus::kWaiting,
+                  "stopped: only " + std::to_string(step.tracked) + " features match keyframe " +
+                      std::to_string(destination_));
+      status_ = RepeatStatus::kDriving;
+      return step;
+    }
+    pairs = Pairs();
+  }
+
+  // Line 19: control with the funnel lane.
+  if (options_.controller == Controller::kSloped) {
+    step.sloped = control::ComputeSlopedFunnelLane(pairs, options_.sloped);
+    step.command = step.sloped.twist;
+  } else {
+    step.standard = control::ComputeStandardFunnelLane(pairs, options_.standard);
+    step.command = step.standard.twist;
+  }
+  step.status = RepeatStatus::kDriving;
+  return step;
+}
+
+}  // namespace mapless::navigation

@@ -1,0 +1,102 @@
+// The repeat phase of visual teach & repeat: Algorithm 1 of Kassir et al.
+//
+// At the start of each segment the current frame's features are detected and matched with the
+// segment's destination keyframe; inside the segment the matched features are tracked with KLT and
+// the funnel-lane controller (sloped or standard) turns their image coordinates into a command.
+// When fewer than `min_features` remain, features are detected and matched again; while that still
+// gives too few, the robot stops, and if it cannot recover within `abort_after_s` the repeat aborts
+// with a clear status: it never drives blind. The segment switches to the next keyframe by the
+// StdRatio/ED criterion (Section VI) or, as an option, Chen & Birchfield's MSE criterion.
+//
+// Indexing: the robot starts at keyframe 0; segment j runs from keyframe j to its destination,
+// keyframe j + 1 (Algorithm 1 writes it KF_{j+1}). Image coordinates are relative to the principal
+// point, taken as the image centre: no calibration.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mapless/control/funnel_lane.h"
+#include "mapless/features/features.h"
+#include "mapless/features/klt.h"
+#include "mapless/route/route.h"
+
+namespace mapless::navigation {
+
+enum class Controller { kSloped, kStandard };
+enum class Switching { kStdRatio, kMse };
+Controller ParseController(const std::string& name);  // "sloped", "standard"
+const char* ControllerName(Controller c);
+
+struct RepeatOptions {
+  Controller controller = Controller::kSloped;
+  Switching switching = Switching::kStdRatio;
+  features::FeatureOptions features;            // must describe like the route's detector
+  features::MatchOptions matching{0.8, 60.0, true};  // ratio, max |dy| px, mutual
+  features::KltOptions klt;
+  control::SlopedFunnelLaneOptions sloped;
+  control::StandardFunnelLaneOptions standard;
+  control::SwitchOptions switch_rule;
+  int mse_rising_frames = 2;
+  int switch_confirm_frames = 2;       // the StdRatio/ED condition must hold this many frames
+  double ransac_threshold_px = 3.0;    // outlier rejection of matches by a fundamental matrix
+                                       // (RANSAC, needs no calibration); 0 disables it
+  int min_features = 10;        // NoF threshold of Algorithm 1
+  double abort_after_s = 10.0;  // stopped this long without enough features: abort
+  void Validate() const;
+};
+
+enum class RepeatStatus { kDriving, kWaiting, kCompleted, kAborted };
+const char* RepeatStatusName(RepeatStatus s);
+
+// What one frame decided (logged as JSON lines by the apps).
+struct RepeatStep {
+  RepeatStatus status = RepeatStatus::kDriving;
+  std::string reason;          // why the robot is waiting, stopped or aborted
+  int destination = 1;         // destination keyframe of the current segment
+  int matches = 0;             // matches at the last detection
+  int tracked = 0;             // features in use this frame
+  bool redetected = false;     // features were detected and matched this frame
+  bool switched = false;       // the segment switched this frame
+  control::SwitchDecision switching;
+  control::SlopedFunnelLaneResult sloped;
+  control::StandardFunnelLaneResult standard;
+  Twist2 command;              // zero unless driving
+};
+
+class RepeatSession {
+ public:
+  RepeatSession(std::shared_ptr<const route::Route> route, RepeatOptions options);
+
+  RepeatStep Update(const cv::Mat& image, Timestamp t_ns);
+  bool finished() const {
+    return status_ == RepeatStatus::kCompleted || status_ == RepeatStatus::kAborted;
+  }
+  int destination() const { return destination_; }
+
+ private:
+  void DetectAndMatch(const cv::Mat& grey, RepeatStep* step);
+  std::vector<control::FeaturePair> Pairs() const;
+  RepeatStep Stop(RepeatStep step, RepeatStatus status, const std::string& reason);
+
+  std::shared_ptr<const route::Route> route_;
+  RepeatOptions options_;
+  features::FeatureExtractor extractor_;
+  std::vector<features::Features> keyframe_features_;
+  control::MseSwitch mse_;
+  double cx_ = 0.0;
+  int destination_ = 1;
+  RepeatStatus status_ = RepeatStatus::kDriving;
+  cv::Mat previous_;
+  std::vector<cv::Point2f> current_px_;      // matched features, tracked in the current images
+  std::vector<cv::Point2f> destination_px_;  // their matches in the destination keyframe
+  int last_matches_ = 0;
+  int switch_votes_ = 0;
+  bool waiting_ = false;
+  Timestamp waiting_since_ns_ = 0;
+};
+
+}  // namespace mapless::navigation

@@ -1,0 +1,81 @@
+#include "mapless/navigation/teach.h"
+
+#include <opencv2/imgproc.hpp>
+
+#include "mapless/core/check.h"
+
+namespace mapless::navigation {
+
+void TeachOptions::Validate() const {
+  features.Validate();
+  klt.Validate();
+  MAPLESS_CHECK(keyframe_tracked_fraction > 0.0 && keyframe_tracked_fraction < 1.0,
+                "TeachOptions.keyframe_tracked_fraction = " << keyframe_tracked_fraction
+                                                            << "; must be in (0, 1)");
+  MAPLESS_CHECK(thumbnail_width_px >= 16,
+                "TeachOptions.thumbnail_width_px = " << thumbnail_width_px << "; must be >= 16");
+}
+
+TeachSession::TeachSession(TeachOptions options)
+    : options_(options), extractor_((options.Validate(), options.features)) {}
+
+double TeachSession::tracked_fraction() const {
+  return initial_count_ == 0 ? 0.0
+                             : static_cast<double>(current_.size()) / static_cast<double>(initial_count_);
+}
+
+route::Keyframe TeachSession::MakeKeyframe(const cv::Mat& grey, Timestamp t_ns) {
+  route::Keyframe kf;
+  kf.index = next_index_++;
+  kf.t_ns = t_ns;
+  const double scale = static_cast<double>(options_.thumbnail_width_px) / grey.cols;
+  cv::resize(grey, kf.thumbnail, cv::Size(), scale, scale, cv::INTER_AREA);
+  const features::Features f = extractor_.Extract(grey);
+  kf.keypoints = f.keypoints;
+  kf.descriptors = f.descriptors;
+  kf.segment_start_px = start_;
+  kf.segment_end_px = current_;
+  // The next segment tracks this keyframe's features.
+  start_.clear();
+  for (const auto& k : kf.keypoints) start_.push_back(k.pt);
+  current_ = start_;
+  initial_count_ = start_.size();
+  return kf;
+}
+
+std::optional<route::Keyframe> TeachSession::Update(const cv::Mat& image, Timestamp t_ns) {
+  MAPLESS_CHECK(!image.empty(), "TeachSession: empty frame");
+  cv::Mat grey = image;
+  if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  std::optional<route::Keyframe> out;
+  if (previous_.empty()) {
+    out = MakeKeyframe(grey, t_ns);
+  } else {
+    MAPLESS_CHECK(grey.size() == previous_.size(), "TeachSession: frame size changed from "
+                                                       << previous_.cols << "x" << previous_.rows << " to "
+                                                       << grey.cols << "x" << grey.rows);
+    const features::KltResult tracked = features::TrackKlt(previous_, grey, current_, options_.klt);
+    std::vector<cv::Point2f> kept_start;
+    std::vector<cv::Point2f> kept_current;
+    for (std::size_t i = 0; i < current_.size(); ++i) {
+      if (!tracked.ok[i]) continue;
+      kept_start.push_back(start_[i]);
+      kept_current.push_back(tracked.points[i]);
+    }
+    start_ = std::move(kept_start);
+    current_ = std::move(kept_current);
+    if (tracked_fraction() < options_.keyframe_tracked_fraction) out = MakeKeyframe(grey, t_ns);
+  }
+  previous_is_keyframe_ = out.has_value();
+  previous_ = grey.clone();
+  previous_t_ns_ = t_ns;
+  return out;
+}
+
+std::optional<route::Keyframe> TeachSession::Finish() {
+  if (previous_.empty() || previous_is_keyframe_) return std::nullopt;
+  previous_is_keyframe_ = true;
+  return MakeKeyframe(previous_, previous_t_ns_);
+}
+
+}  // namespace mapless::navigation

@@ -1,0 +1,54 @@
+// The teach phase of visual teach & repeat (Kassir et al., Section III): detect features in the
+// first frame and track them with KLT through the video; when fewer than half of them (by default)
+// are still tracked, the frame becomes a keyframe, features are detected afresh, and tracking goes
+// on. The features that survived a whole segment are stored with their coordinates at both ends.
+// Pure: frames in, keyframes out; storing them is the caller's business (route::RouteWriter).
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <optional>
+#include <vector>
+
+#include "mapless/features/features.h"
+#include "mapless/features/klt.h"
+#include "mapless/route/route.h"
+
+namespace mapless::navigation {
+
+struct TeachOptions {
+  features::FeatureOptions features;       // ORB, 500 features by default
+  features::KltOptions klt;                // 31x31 window, as in the paper
+  double keyframe_tracked_fraction = 0.5;  // new keyframe when fewer than this survive
+  int thumbnail_width_px = 160;            // width of the stored downscaled image
+  void Validate() const;
+};
+
+class TeachSession {
+ public:
+  explicit TeachSession(TeachOptions options);
+
+  // Feeds one frame; returns the keyframe this frame became, if it did.
+  std::optional<route::Keyframe> Update(const cv::Mat& image, Timestamp t_ns);
+  // Ends the teach: the last frame becomes the final keyframe unless it already is one.
+  std::optional<route::Keyframe> Finish();
+
+  int keyframe_count() const { return next_index_; }
+  // Fraction of the current segment's features still tracked (1 right after a keyframe).
+  double tracked_fraction() const;
+
+ private:
+  route::Keyframe MakeKeyframe(const cv::Mat& grey, Timestamp t_ns);
+
+  TeachOptions options_;
+  features::FeatureExtractor extractor_;
+  int next_index_ = 0;
+  cv::Mat previous_;
+  Timestamp previous_t_ns_ = 0;
+  bool previous_is_keyframe_ = false;
+  std::vector<cv::Point2f> start_;    // tracked features at the segment's first keyframe
+  std::vector<cv::Point2f> current_;  // ... where they are now
+  std::size_t initial_count_ = 0;
+};
+
+}  // namespace mapless::navigation
