@@ -26,6 +26,21 @@ double StdDev(const std::vector<double>& values) {
   return std::sqrt(var / static_cast<double>(values.size()));
 }
 
+double Mad(const std::vector<double>& values) {
+  if (values.size() < 2) return 0.0;
+  const double m = Median(values);
+  std::vector<double> dev;
+  dev.reserve(values.size());
+  for (double v : values) dev.push_back(std::abs(v - m));
+  return 1.4826 * Median(dev);
+}
+
+namespace {
+double SpreadOf(const std::vector<double>& values, Spread spread) {
+  return spread == Spread::kStdDev ? StdDev(values) : Mad(values);
+}
+}  // namespace
+
 double Median(std::vector<double> values) {
   if (values.empty()) return 0.0;
   const auto mid = values.begin() + static_cast<long>(values.size() / 2);
@@ -115,11 +130,11 @@ SlopedFunnelLaneResult ComputeSlopedFunnelLane(const std::vector<FeaturePair>& f
   }
   r.left_features = static_cast<int>(uc_left.size());
   r.right_features = static_cast<int>(uc_right.size());
-  const double sigma_j = StdDev(uj_all);
+  const double sigma_j = SpreadOf(uj_all, options.spread);
   if (sigma_j <= 1e-9) return r;
   r.ok = true;
   // Eq. (5) and the slope around y.
-  r.std_ratio = StdDev(uc_all) / sigma_j;
+  r.std_ratio = SpreadOf(uc_all, options.spread) / sigma_j;
   r.slope_y = options.beta * (1.0 - r.std_ratio);
   // Slope around x: the sum of the two sides' normalised median offsets (one side if the other
   // has no features).
@@ -164,9 +179,9 @@ SwitchDecision CheckSwitch(const std::vector<FeaturePair>& features, const Switc
     uc.push_back(f.u_current_px);
     uj.push_back(f.u_destination_px);
   }
-  const double sigma_j = StdDev(uj);
+  const double sigma_j = SpreadOf(uj, options.spread);
   if (sigma_j <= 1e-9) return d;
-  d.std_ratio = StdDev(uc) / sigma_j;
+  d.std_ratio = SpreadOf(uc, options.spread) / sigma_j;
   d.ed_px = std::abs(Median(uc) - Median(uj));
   d.switch_now = d.std_ratio > options.min_std_ratio && d.ed_px < options.max_ed_px;
   return d;

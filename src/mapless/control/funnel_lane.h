@@ -26,6 +26,10 @@ struct FeaturePair {
   double u_destination_px = 0.0;
 };
 
+// How the spread of x coordinates is measured for StdRatio: the paper's standard deviation, or the
+// median absolute deviation (scaled to match it for Gaussian data), which outliers cannot inflate.
+enum class Spread { kStdDev, kMad };
+
 enum class TurnCommand { kStraight, kLeft, kRight };
 const char* TurnCommandName(TurnCommand command);
 
@@ -65,6 +69,7 @@ struct SlopedFunnelLaneOptions {
   double slope_y_for_full_speed = 0.15;  // slope_y at which a turning robot keeps full speed
   double max_speed_mps = 0.2;         // forward speed when going straight
   double max_turn_rate_radps = 0.5;   // turn rate at full turn
+  Spread spread = Spread::kStdDev;    // spread used for StdRatio
   void Validate() const;
 };
 
@@ -93,6 +98,7 @@ SlopedFunnelLaneResult ComputeSlopedFunnelLane(const std::vector<FeaturePair>& f
 struct SwitchOptions {
   double max_ed_px = 12.0;      // ED threshold: |median u_c - median u_j|
   double min_std_ratio = 1.0;   // StdRatio must exceed this (the robot reached the keyframe)
+  Spread spread = Spread::kStdDev;
   void Validate() const;
 };
 
@@ -125,6 +131,7 @@ class MseSwitch {
 
 // Statistics used above, exposed for tests and logs.
 double StdDev(const std::vector<double>& values);
+double Mad(const std::vector<double>& values);  // 1.4826 * median |v - median(v)|
 double Median(std::vector<double> values);
 
 }  // namespace mapless::control

@@ -1,5 +1,7 @@
 #include "mapless/navigation/repeat.h"
 
+#include <algorithm>
+
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -33,9 +35,13 @@ void RepeatOptions::Validate() const {
   standard.Validate();
   switch_rule.Validate();
   MAPLESS_CHECK(min_features >= 2, "RepeatOptions.min_features = " << min_features << "; must be >= 2");
+  MAPLESS_CHECK(redetect_every_frames >= 0,
+                "RepeatOptions.redetect_every_frames = " << redetect_every_frames << "; must be >= 0");
   MAPLESS_CHECK(abort_after_s > 0.0, "RepeatOptions.abort_after_s = " << abort_after_s << "; must be > 0");
   MAPLESS_CHECK(switch_confirm_frames >= 1,
                 "RepeatOptions.switch_confirm_frames = " << switch_confirm_frames << "; must be >= 1");
+  MAPLESS_CHECK(min_switch_features >= 2,
+                "RepeatOptions.min_switch_features = " << min_switch_features << "; must be >= 2");
   MAPLESS_CHECK(ransac_threshold_px >= 0.0,
                 "RepeatOptions.ransac_threshold_px = " << ransac_threshold_px << "; must be >= 0");
   MAPLESS_CHECK(mse_rising_frames >= 1,
@@ -84,12 +90,21 @@ void RepeatSession::DetectAndMatch(const cv::Mat& grey, RepeatStep* step) {
     current_px_.push_back(current.keypoints[static_cast<std::size_t>(m.queryIdx)].pt);
     destination_px_.push_back(kf.keypoints[static_cast<std::size_t>(m.trainIdx)].pt);
   }
-  // Outlier rejection: matches must agree with one epipolar geometry (no calibration needed).
+  // Outlier rejection: matches must agree with one epipolar geometry, or, for a rotation in place
+  // or a distant scene (where the epipolar geometry degenerates), with one homography. Whichever
+  // model explains more matches wins. Neither needs calibration.
   if (options_.ransac_threshold_px > 0.0 && current_px_.size() >= 12) {
-    std::vector<uchar> inlier;
+    std::vector<uchar> inlier_f;
+    std::vector<uchar> inlier_h;
     const cv::Mat f = cv::findFundamentalMat(current_px_, destination_px_, cv::FM_RANSAC,
-                                             options_.ransac_threshold_px, 0.99, inlier);
-    if (!f.empty() && inlier.size() == current_px_.size()) {
+                                             options_.ransac_threshold_px, 0.99, inlier_f);
+    const cv::Mat hom = cv::findHomography(current_px_, destination_px_, cv::RANSAC,
+                                           options_.ransac_threshold_px, inlier_h);
+    const auto count = [](const std::vector<uchar>& m) { return std::count(m.begin(), m.end(), 1); };
+    const long nf = f.empty() || inlier_f.size() != current_px_.size() ? 0 : count(inlier_f);
+    const long nh = hom.empty() || inlier_h.size() != current_px_.size() ? 0 : count(inlier_h);
+    if (nf > 0 || nh > 0) {
+      const std::vector<uchar>& inlier = nf >= nh ? inlier_f : inlier_h;
       std::vector<cv::Point2f> cur, dst;
       for (std::size_t i = 0; i < inlier.size(); ++i) {
         if (!inlier[i]) continue;
@@ -102,6 +117,7 @@ void RepeatSession::DetectAndMatch(const cv::Mat& grey, RepeatStep* step) {
   }
   last_matches_ = static_cast<int>(current_px_.size());
   step->redetected = true;
+  frames_since_detect_ = 0;
 }
 
 RepeatStep RepeatSession::Stop(RepeatStep step, RepeatStatus status, const std::string& reason) {
@@ -136,8 +152,11 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
     destination_px_ = std::move(dst);
   }
   previous_ = grey.clone();
-  // Lines 20-27: too few features left, detect and match again.
-  if (static_cast<int>(current_px_.size()) < options_.min_features) DetectAndMatch(grey, &step);
+  // Lines 20-27: too few features left, detect and match again (and, as an option, periodically).
+  ++frames_since_detect_;
+  const bool refresh = options_.redetect_every_frames > 0 &&
+                       frames_since_detect_ >= options_.redetect_every_frames;
+  if (static_cast<int>(current_px_.size()) < options_.min_features || refresh) DetectAndMatch(grey, &step);
   step.matches = last_matches_;
   step.tracked = static_cast<int>(current_px_.size());
   if (step.tracked < options_.min_features) {
@@ -164,10 +183,11 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
   // Line 9: switch to the next segment.
   std::vector<control::FeaturePair> pairs = Pairs();
   step.switching = control::CheckSwitch(pairs, options_.switch_rule);
-  switch_votes_ = step.switching.switch_now ? switch_votes_ + 1 : 0;
+  const bool enough = static_cast<int>(pairs.size()) >= options_.min_switch_features;
+  switch_votes_ = (step.switching.switch_now && enough) ? switch_votes_ + 1 : 0;
   const bool switch_now = options_.switching == Switching::kStdRatio
                               ? switch_votes_ >= options_.switch_confirm_frames
-                              : mse_.Update(pairs);
+                              : (mse_.Update(pairs) && enough);
   if (switch_now) {
     step.switched = true;
     ++destination_;

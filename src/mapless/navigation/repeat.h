@@ -42,9 +42,13 @@ struct RepeatOptions {
   control::SwitchOptions switch_rule;
   int mse_rising_frames = 2;
   int switch_confirm_frames = 2;       // the StdRatio/ED condition must hold this many frames
+  int min_switch_features = 20;        // no switching on fewer features (their spread is noise)
   double ransac_threshold_px = 3.0;    // outlier rejection of matches by a fundamental matrix
                                        // (RANSAC, needs no calibration); 0 disables it
   int min_features = 10;        // NoF threshold of Algorithm 1
+  // Also detect and match afresh every this many frames (0: only when features run short, as in
+  // Algorithm 1). KLT tracks drift over long segments and bias StdRatio; fresh matches do not.
+  int redetect_every_frames = 0;
   double abort_after_s = 10.0;  // stopped this long without enough features: abort
   void Validate() const;
 };
@@ -95,6 +99,7 @@ class RepeatSession {
   std::vector<cv::Point2f> destination_px_;  // their matches in the destination keyframe
   int last_matches_ = 0;
   int switch_votes_ = 0;
+  int frames_since_detect_ = 0;
   bool waiting_ = false;
   Timestamp waiting_since_ns_ = 0;
 };

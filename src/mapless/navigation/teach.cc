@@ -12,6 +12,8 @@ void TeachOptions::Validate() const {
   MAPLESS_CHECK(keyframe_tracked_fraction > 0.0 && keyframe_tracked_fraction < 1.0,
                 "TeachOptions.keyframe_tracked_fraction = " << keyframe_tracked_fraction
                                                             << "; must be in (0, 1)");
+  MAPLESS_CHECK(min_keyframe_features >= 0,
+                "TeachOptions.min_keyframe_features = " << min_keyframe_features << "; must be >= 0");
   MAPLESS_CHECK(thumbnail_width_px >= 16,
                 "TeachOptions.thumbnail_width_px = " << thumbnail_width_px << "; must be >= 16");
 }
@@ -64,7 +66,14 @@ std::optional<route::Keyframe> TeachSession::Update(const cv::Mat& image, Timest
     }
     start_ = std::move(kept_start);
     current_ = std::move(kept_current);
-    if (tracked_fraction() < options_.keyframe_tracked_fraction) out = MakeKeyframe(grey, t_ns);
+    if (tracked_fraction() < options_.keyframe_tracked_fraction) {
+      const features::Features f = extractor_.Extract(grey);
+      if (static_cast<int>(f.keypoints.size()) >= options_.min_keyframe_features) {
+        out = MakeKeyframe(grey, t_ns);
+      } else {
+        ++deferred_;
+      }
+    }
   }
   previous_is_keyframe_ = out.has_value();
   previous_ = grey.clone();

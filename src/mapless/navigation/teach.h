@@ -20,6 +20,9 @@ struct TeachOptions {
   features::FeatureOptions features;       // ORB, 500 features by default
   features::KltOptions klt;                // 31x31 window, as in the paper
   double keyframe_tracked_fraction = 0.5;  // new keyframe when fewer than this survive
+  // A frame with fewer features than this never becomes a keyframe (the repeat could not match
+  // it); the keyframe is deferred to the next frame that has enough, and the deferral counted.
+  int min_keyframe_features = 30;
   int thumbnail_width_px = 160;            // width of the stored downscaled image
   void Validate() const;
 };
@@ -34,6 +37,8 @@ class TeachSession {
   std::optional<route::Keyframe> Finish();
 
   int keyframe_count() const { return next_index_; }
+  // Frames that should have become keyframes but had too few features (a weak stretch of route).
+  int deferred_keyframes() const { return deferred_; }
   // Fraction of the current segment's features still tracked (1 right after a keyframe).
   double tracked_fraction() const;
 
@@ -49,6 +54,7 @@ class TeachSession {
   std::vector<cv::Point2f> start_;    // tracked features at the segment's first keyframe
   std::vector<cv::Point2f> current_;  // ... where they are now
   std::size_t initial_count_ = 0;
+  int deferred_ = 0;
 };
 
 }  // namespace mapless::navigation
