@@ -39,5 +39,6 @@ void AddSimCommands(CLI::App* app);
 void AddDemoCommand(CLI::App* app);
 void AddBenchCommand(CLI::App* app);
 void AddShiftCommand(CLI::App* app);
+void AddEvalCommand(CLI::App* app);
 
 }  // namespace mapless::app

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   mapless::app::AddDemoCommand(&app);
   mapless::app::AddSimCommands(&app);
   mapless::app::AddShiftCommand(&app);
+  mapless::app::AddEvalCommand(&app);
   mapless::app::AddBenchCommand(&app);
   try {
     app.parse(argc, argv);

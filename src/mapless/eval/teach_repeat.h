@@ -31,6 +31,7 @@ struct RepeatRunOptions {
   double start_offset_m = 0.1;       // uniform in +-, x and y
   double start_offset_deg = 3.0;     // uniform in +-
   double timeout_factor = 3.0;       // of the taught duration
+  double max_repeat_speed_mps = 0.2; // suites: repeat at the teach speed, at most this
   double success_radius_m = 0.5;     // final pose within this of the taught end
   std::uint64_t seed = 1;
   void Validate() const;

@@ -21,7 +21,8 @@ const char* DetectorTypeName(DetectorType type);
 struct FeatureOptions {
   DetectorType type = DetectorType::kOrb;
   int max_features = 500;            // ORB and SIFT: keep at most this many (strongest first)
-  int orb_fast_threshold = 20;       // ORB: FAST corner threshold, grey levels
+  int orb_fast_threshold = 10;       // ORB: FAST corner threshold, grey levels (OpenCV's default
+                                     // is 20; 10 keeps features on low-texture walls)
   double akaze_threshold = 0.0005;   // AKAZE: detector response threshold
   void Validate() const;             // throws InputError naming the field
 };

@@ -41,14 +41,15 @@ struct RepeatOptions {
   control::StandardFunnelLaneOptions standard;
   control::SwitchOptions switch_rule;
   int mse_rising_frames = 2;
-  int switch_confirm_frames = 2;       // the StdRatio/ED condition must hold this many frames
+  int switch_confirm_frames = 3;       // the StdRatio/ED condition must hold this many frames
   int min_switch_features = 20;        // no switching on fewer features (their spread is noise)
   double ransac_threshold_px = 3.0;    // outlier rejection of matches by a fundamental matrix
                                        // (RANSAC, needs no calibration); 0 disables it
   int min_features = 10;        // NoF threshold of Algorithm 1
   // Also detect and match afresh every this many frames (0: only when features run short, as in
-  // Algorithm 1). KLT tracks drift over long segments and bias StdRatio; fresh matches do not.
-  int redetect_every_frames = 0;
+  // Algorithm 1). KLT tracks drift over long segments and bias StdRatio (the switch then comes
+  // up to 1 m early or late); fresh matches do not. Default: every frame.
+  int redetect_every_frames = 1;
   double abort_after_s = 10.0;  // stopped this long without enough features: abort
   void Validate() const;
 };

@@ -19,7 +19,11 @@ namespace mapless::navigation {
 struct TeachOptions {
   features::FeatureOptions features;       // ORB, 500 features by default
   features::KltOptions klt;                // 31x31 window, as in the paper
-  double keyframe_tracked_fraction = 0.5;  // new keyframe when fewer than this survive
+  // New keyframe when fewer than this fraction of the tracked features survive. The paper uses
+  // 0.5; our KLT (with a forward-backward check) keeps features longer than the paper's tracker,
+  // and 0.5 leaves keyframes 3-4 m apart: too sparse through sharp low-texture turns (see
+  // docs/teach_and_repeat.md). 0.7 is the default.
+  double keyframe_tracked_fraction = 0.7;
   // A frame with fewer features than this never becomes a keyframe (the repeat could not match
   // it); the keyframe is deferred to the next frame that has enough, and the deferral counted.
   int min_keyframe_features = 30;

@@ -1,0 +1,82 @@
+#include "mapless/eval/suite.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "mapless/core/check.h"
+
+namespace mapless::eval {
+
+std::vector<std::string> SuiteNames() { return {"table1", "funnel-scenarios"}; }
+
+std::vector<SuiteEntry> SuiteEntries(const std::string& suite) {
+  std::vector<std::string> scenarios;
+  if (suite == "table1") {
+    scenarios = {"table1_sharp_turn_low_texture", "table1_almost_straight"};
+  } else if (suite == "funnel-scenarios") {
+    scenarios = {"narrow_room_sharp_turn", "wide_left_turn_offset_start", "corridor_25m",
+                 "parking_between_cars",   "outdoor_loop_cars_removed",   "outdoor_wide_turn",
+                 "indoor_30m",             "outdoor_70m",                 "rotation_in_place"};
+  } else {
+    throw InputError("unknown suite '" + suite + "' (known: table1, funnel-scenarios)");
+  }
+  std::vector<SuiteEntry> out;
+  for (const auto& s : scenarios) {
+    out.push_back({s, navigation::Controller::kSloped});
+    out.push_back({s, navigation::Controller::kStandard});
+  }
+  return out;
+}
+
+EntryResult RunEntry(const sim::Scenario& scenario, const TaughtRoute& taught,
+                     navigation::Controller controller, int runs, std::uint64_t seed,
+                     const RepeatRunOptions& base) {
+  MAPLESS_CHECK(runs >= 1, "runs = " << runs << "; must be >= 1");
+  EntryResult r;
+  r.scenario = scenario.name;
+  r.controller = navigation::ControllerName(controller);
+  r.runs = runs;
+  std::vector<double> finals;
+  double lateral_sum_sq = 0.0;
+  std::size_t lateral_count = 0;
+  for (int i = 0; i < runs; ++i) {
+    RepeatRunOptions o = base;
+    o.seed = seed + static_cast<std::uint64_t>(i);
+    o.repeat.controller = controller;
+    // The teach speed, capped for accuracy, but never below half of it (the run must end within
+    // timeout_factor = 3x the taught duration).
+    const double speed = std::min(scenario.teach_speed_mps,
+                                  std::max(base.max_repeat_speed_mps, 0.5 * scenario.teach_speed_mps));
+    o.repeat.sloped.max_speed_mps = speed;
+    o.repeat.standard.forward_speed_mps = speed;
+    const RepeatRun run = RepeatOnSimulator(scenario, taught, o);
+    finals.push_back(run.final_error_m);
+    for (const Pose2& p : run.path) {
+      const double d = DistanceToPath(taught.path, p.x_m, p.y_m);
+      lateral_sum_sq += d * d;
+      ++lateral_count;
+    }
+    if (run.success) ++r.successes;
+    else r.failures.push_back("run " + std::to_string(i) + " (seed " + std::to_string(o.seed) + "): " + run.status +
+                              (run.completed && !run.collided ? ", ended " + std::to_string(run.final_error_m).substr(0, 4) +
+                                                                    " m from the taught end"
+                                                              : ""));
+    if (run.collided) ++r.collisions;
+  }
+  double sum_sq = 0.0;
+  double sum = 0.0;
+  for (double f : finals) {
+    sum_sq += f * f;
+    sum += f;
+  }
+  const double n = static_cast<double>(finals.size());
+  r.final_error_m_rms = std::sqrt(sum_sq / n);
+  const double mean = sum / n;
+  double var = 0.0;
+  for (double f : finals) var += (f - mean) * (f - mean);
+  r.final_error_m_std = std::sqrt(var / n);
+  r.lateral_rms_m = lateral_count > 0 ? std::sqrt(lateral_sum_sq / static_cast<double>(lateral_count)) : 0.0;
+  return r;
+}
+
+}  // namespace mapless::eval

@@ -1,0 +1,42 @@
+// Evaluation suites that reproduce Section VII of Kassir et al. on the simulator: each entry is a
+// scenario and a controller, repeated `runs` times with their own noise and start perturbation.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mapless/eval/teach_repeat.h"
+
+namespace mapless::eval {
+
+struct SuiteEntry {
+  std::string scenario;
+  navigation::Controller controller = navigation::Controller::kSloped;
+};
+
+// "table1": the two 10 m paths of Table I, both controllers.
+// "funnel-scenarios": the six scenarios of Section VII-A, the 30 m and 70 m paths, and the
+// rotation in place, both controllers.
+std::vector<std::string> SuiteNames();
+std::vector<SuiteEntry> SuiteEntries(const std::string& suite);  // throws InputError if unknown
+
+struct EntryResult {
+  std::string scenario;
+  std::string controller;
+  int runs = 0;
+  int successes = 0;
+  double final_error_m_rms = 0.0;  // RMS over runs of the final distance to the taught end
+  double final_error_m_std = 0.0;  // standard deviation of that distance over runs
+  double lateral_rms_m = 0.0;      // RMS over all repeated poses of the distance to the taught path
+  int collisions = 0;
+  std::vector<std::string> failures;  // one status line per failed run
+};
+
+// Runs one entry: the route is taught once (clean), then repeated `runs` times with seeds
+// seed, seed + 1, ... The repeat drives at the scenario's teach speed, capped at
+// base.max_repeat_speed_mps but not below half the teach speed.
+EntryResult RunEntry(const sim::Scenario& scenario, const TaughtRoute& taught,
+                     navigation::Controller controller, int runs, std::uint64_t seed,
+                     const RepeatRunOptions& base);
+
+}  // namespace mapless::eval
