@@ -40,5 +40,6 @@ void AddDemoCommand(CLI::App* app);
 void AddBenchCommand(CLI::App* app);
 void AddShiftCommand(CLI::App* app);
 void AddEvalCommand(CLI::App* app);
+void AddTeachRepeatCommands(CLI::App* app);
 
 }  // namespace mapless::app

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   cv::setNumThreads(1);
   mapless::app::AddDemoCommand(&app);
   mapless::app::AddSimCommands(&app);
+  mapless::app::AddTeachRepeatCommands(&app);
   mapless::app::AddShiftCommand(&app);
   mapless::app::AddEvalCommand(&app);
   mapless::app::AddBenchCommand(&app);

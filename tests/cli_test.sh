@@ -27,7 +27,7 @@ expect_exit() {
 }
 
 # Every subcommand answers --help with exit 0 and a usage text.
-for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench" "shift"; do
+for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench" "shift" "teach" "repeat" "route" "route info" "eval"; do
   # shellcheck disable=SC2086
   expect_exit "help: mapless $sub --help" 0 "$MAPLESS" $sub --help
   grep -qi "usage" "$TMP/out"; check "help text: mapless $sub" $?
@@ -89,6 +89,39 @@ dx=$(sed 's/.*"dx_px":\([-0-9.e]*\).*/\1/' "$TMP/out")
 awk -v d="$dx" 'BEGIN { exit !(d > 40.5 - 17.5 && d < 40.5 + 17.5) }'; check "shift of Stromovka place 1, session 12 vs 01 is 40.5 +- 17.5 px (got $dx)" $?
 expect_exit "shift of a missing image exits 2" 2 "$MAPLESS" shift "$S/0101.png" "$TMP/none.png"
 grep -q "none.png: cannot read image" "$TMP/err"; check "shift names the missing image" $?
+
+# Teach from a recorded image folder, inspect, repeat open loop: one JSON line per frame.
+expect_exit "teach from an image folder" 0 "$MAPLESS" teach --source "$TMP/d1/frames" --out "$TMP/route"
+expect_exit "route info --json" 0 "$MAPLESS" route info "$TMP/route" --json
+grep -q '"complete":true' "$TMP/out" && grep -Eq '"keyframes":([2-9]|[1-9][0-9]+)[,}]' "$TMP/out"; check "route is complete with >= 2 keyframes" $?
+expect_exit "teach refuses to overwrite" 2 "$MAPLESS" teach --source "$TMP/d1/frames" --out "$TMP/route"
+grep -q "already holds a route" "$TMP/err"; check "overwrite refusal is explained" $?
+expect_exit "repeat open loop" 0 "$MAPLESS" repeat --route "$TMP/route" --source "$TMP/d1/frames" --log "$TMP/rep.jsonl"
+[ "$(wc -l <"$TMP/rep.jsonl")" -eq "$n_frames" ]; check "one decision line per frame" $?
+head -1 "$TMP/rep.jsonl" | grep -q '"destination":' && head -1 "$TMP/rep.jsonl" | grep -q '"v_mps":'; check "decision lines carry segment and command" $?
+
+# Bad routes: one line naming the file, exit 2, never a crash.
+expect_exit "missing route exits 2" 2 "$MAPLESS" repeat --route "$TMP/nothing" --source "$TMP/d1/frames"
+grep -q "manifest.json is missing" "$TMP/err"; check "missing route is named" $?
+cp -r "$TMP/route" "$TMP/broken"
+printf 'format: mapless-keyframe\nversion: 1\nkeypo' > "$TMP/broken/keyframes/000001.yml"
+expect_exit "truncated keyframe exits 2" 2 "$MAPLESS" route info "$TMP/broken"
+grep -q "000001.yml" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "truncated keyframe: one line naming the file" $?
+head -c 100 "$TMP/route/manifest.json" > "$TMP/broken/manifest.json"
+expect_exit "truncated manifest exits 2" 2 "$MAPLESS" route info "$TMP/broken"
+grep -q "manifest.json: corrupt manifest" "$TMP/err"; check "truncated manifest is named" $?
+
+# A teach killed with SIGKILL leaves a route that loads, with every keyframe completed before.
+"$MAPLESS" teach --source sim:outdoor_70m --out "$TMP/killed" >/dev/null 2>&1 &
+pid=$!
+for _ in $(seq 1 100); do [ -f "$TMP/killed/keyframes/000002.png" ] && break; sleep 0.05; done
+if kill -9 "$pid" 2>/dev/null; then
+  wait "$pid" 2>/dev/null
+  expect_exit "killed teach: route loads" 0 "$MAPLESS" route info "$TMP/killed" --json
+  grep -q '"complete":false' "$TMP/out" && grep -q '"keyframes":[1-9]' "$TMP/out"; check "killed teach keeps its completed keyframes ($(cat "$TMP/out"))" $?
+else
+  wait "$pid"; check "teach was still running when killed (machine too fast?)" 1
+fi
 
 # Bench: one JSON object with the render stage and its reference.
 expect_exit "bench --json" 0 "$MAPLESS" bench --json --repeats 5

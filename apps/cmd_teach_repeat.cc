@@ -1,0 +1,236 @@
+// `mapless teach`, `mapless repeat`, `mapless route info`: visual teach & repeat with the funnel
+// lanes on the simulator (closed loop) or on recorded sources (open loop, decisions as JSON lines).
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "cli_common.h"
+#include "mapless/core/check.h"
+#include "mapless/eval/teach_repeat.h"
+#include "mapless/io/frame_source.h"
+#include "mapless/route/route_store.h"
+
+namespace mapless::app {
+namespace {
+
+bool IsSim(const std::string& source) { return source.rfind("sim:", 0) == 0; }
+
+nlohmann::json StepJson(int frame, Timestamp t_ns, const navigation::RepeatStep& s) {
+  nlohmann::json j;
+  j["frame"] = frame;
+  j["t_s"] = ToSeconds(t_ns);
+  j["status"] = navigation::RepeatStatusName(s.status);
+  j["destination"] = s.destination;
+  j["matches"] = s.matches;
+  j["tracked"] = s.tracked;
+  j["switched"] = s.switched;
+  j["std_ratio"] = s.switching.std_ratio;
+  j["ed_px"] = s.switching.ed_px;
+  j["slope_x"] = s.sloped.slope_x;
+  j["slope_y"] = s.sloped.slope_y;
+  j["v_mps"] = s.command.v_mps;
+  j["omega_radps"] = s.command.omega_radps;
+  if (!s.reason.empty()) j["reason"] = s.reason;
+  return j;
+}
+
+// Journal of JSON lines: each line is flushed as it is written, so an interrupted run keeps every
+// complete line.
+class JsonLines {
+ public:
+  explicit JsonLines(const std::string& path) {
+    if (path.empty() || path == "-") return;
+    file_.open(path, std::ios::out | std::ios::trunc);
+    if (!file_) throw InputError(path + ": cannot write");
+  }
+  void Write(const nlohmann::json& j) {
+    std::ostream& out = file_.is_open() ? static_cast<std::ostream&>(file_) : std::cout;
+    out << j.dump() << "\n";
+    out.flush();
+  }
+
+ private:
+  std::ofstream file_;
+};
+
+}  // namespace
+
+void AddTeachRepeatCommands(CLI::App* app) {
+  struct TeachArgs {
+    std::string source;
+    std::string out;
+    bool overwrite = false;
+    std::string detector = "orb";
+    double fps = 10.0;
+  };
+  auto t = std::make_shared<TeachArgs>();
+  CLI::App* teach = app->add_subcommand(
+      "teach", "Teach a route: keyframes from a video, an image folder, a camera or sim:SCENARIO");
+  teach->add_option("--source", t->source, "sim:SCENARIO, a video file, an image folder, camera:N")->required();
+  teach->add_option("--out", t->out, "Route directory to create")->required();
+  teach->add_flag("--overwrite", t->overwrite, "Replace a route already in --out");
+  teach->add_option("--detector", t->detector, "orb, akaze, akaze_upright or sift")->capture_default_str();
+  teach->add_option("--fps", t->fps, "Frame rate of image folders (timestamps)")->capture_default_str();
+  teach->callback([t] {
+    navigation::TeachOptions options;
+    options.features.type = features::ParseDetectorType(t->detector);
+    options.Validate();
+    int keyframes = 0;
+    int frames = 0;
+    if (IsSim(t->source)) {
+      const sim::Scenario scenario = sim::LoadScenario(t->source.substr(4));
+      route::RouteWriter writer(t->out, t->detector, scenario.camera.model.width,
+                                scenario.camera.model.height, t->overwrite);
+      const eval::TaughtRoute taught = eval::TeachOnSimulator(scenario, options, [&](const route::Keyframe& kf) {
+        writer.Append(kf);
+        ++keyframes;
+      });
+      frames = static_cast<int>(taught.path.size());
+      writer.Finish();
+    } else {
+      auto source = io::OpenFrameSource(t->source, t->fps);
+      navigation::TeachSession session(options);
+      std::unique_ptr<route::RouteWriter> writer;
+      io::Frame frame;
+      while (source->Next(&frame)) {
+        if (!writer) {
+          writer = std::make_unique<route::RouteWriter>(t->out, t->detector, frame.image.cols,
+                                                        frame.image.rows, t->overwrite);
+        }
+        if (auto kf = session.Update(frame.image, frame.t_ns)) {
+          writer->Append(*kf);
+          ++keyframes;
+        }
+        ++frames;
+      }
+      if (!writer) throw InputError(t->source + ": no frames");
+      if (auto kf = session.Finish()) {
+        writer->Append(*kf);
+        ++keyframes;
+      }
+      writer->Finish();
+      if (session.deferred_keyframes() > 0) {
+        spdlog::warn("teach: {} keyframes were deferred for lack of features (a weak stretch)",
+                     session.deferred_keyframes());
+      }
+    }
+    spdlog::info("teach: {} frames, {} keyframes written to {}", frames, keyframes, t->out);
+    if (keyframes < 2) throw RunFailed("teach: fewer than 2 keyframes; the route cannot be repeated");
+  });
+
+  struct RepeatArgs {
+    std::string route;
+    std::string source;
+    std::string controller = "sloped";
+    std::string switching = "stdratio";
+    std::string log;
+    std::uint64_t seed = 1;
+    double motion_noise = 0.1;
+    double image_noise = 2.0;
+    double fps = 10.0;
+  };
+  auto r = std::make_shared<RepeatArgs>();
+  CLI::App* repeat = app->add_subcommand(
+      "repeat", "Repeat a taught route: drive the simulator, or decide frame by frame on a recording");
+  repeat->add_option("--route", r->route, "Route directory (from mapless teach)")->required();
+  repeat->add_option("--source", r->source, "sim:SCENARIO, a video file, an image folder, camera:N")->required();
+  repeat->add_option("--controller", r->controller, "sloped or standard")->capture_default_str();
+  repeat->add_option("--switching", r->switching, "stdratio (Kassir et al.) or mse (Chen & Birchfield)")
+      ->capture_default_str();
+  repeat->add_option("--log", r->log, "Per-frame decisions as JSON lines to this file (default: stdout)");
+  repeat->add_option("--seed", r->seed, "Simulator: seed of the noise")->capture_default_str();
+  repeat->add_option("--motion-noise", r->motion_noise, "Simulator: fraction of the command")->capture_default_str();
+  repeat->add_option("--image-noise", r->image_noise, "Simulator: grey levels")->capture_default_str();
+  repeat->add_option("--fps", r->fps, "Frame rate of image folders (timestamps)")->capture_default_str();
+  repeat->callback([r] {
+    auto route = std::make_shared<route::Route>(route::LoadRoute(r->route));
+    if (!route->complete) spdlog::warn("repeat: {} is an interrupted teach; repeating its {} keyframes",
+                                       r->route, route->keyframes.size());
+    navigation::RepeatOptions options;
+    options.controller = navigation::ParseController(r->controller);
+    if (r->switching == "stdratio") options.switching = navigation::Switching::kStdRatio;
+    else if (r->switching == "mse") options.switching = navigation::Switching::kMse;
+    else throw InputError("--switching '" + r->switching + "': expected stdratio or mse");
+    options.features.type = features::ParseDetectorType(route->detector);
+    JsonLines log(r->log);
+    int frame_index = 0;
+    if (IsSim(r->source)) {
+      const sim::Scenario scenario = sim::LoadScenario(r->source.substr(4));
+      eval::TaughtRoute taught;
+      taught.route = route;
+      sim::DriveOptions drive;
+      drive.render_frames = false;
+      const sim::DriveSummary summary = sim::DriveTaughtPath(scenario, drive, [&](const sim::DriveFrame& f) {
+        taught.path.push_back(f.truth);
+      });
+      taught.duration_s = summary.duration_s;
+      eval::RepeatRunOptions run_options;
+      run_options.repeat = options;
+      run_options.seed = r->seed;
+      run_options.motion_noise_frac = r->motion_noise;
+      run_options.image_noise_sigma = r->image_noise;
+      const eval::RepeatRun run = eval::RepeatOnSimulator(
+          scenario, taught, run_options, [&](const Pose2& pose, const cv::Mat&, const navigation::RepeatStep& step) {
+            nlohmann::json j = StepJson(frame_index, FromSeconds(frame_index / scenario.camera.rate_hz), step);
+            j["x_m"] = pose.x_m;
+            j["y_m"] = pose.y_m;
+            j["theta_rad"] = pose.theta_rad;
+            log.Write(j);
+            ++frame_index;
+          });
+      spdlog::info("repeat: {} ({}): {}; final error {:.2f} m, lateral RMS {:.2f} m, {:.1f} s",
+                   scenario.name, r->controller, run.status, run.final_error_m, run.lateral_rms_m, run.duration_s);
+      if (!run.success) throw RunFailed("repeat did not succeed: " + run.status);
+      return;
+    }
+    auto source = io::OpenFrameSource(r->source, r->fps);
+    navigation::RepeatSession session(route, options);
+    io::Frame frame;
+    navigation::RepeatStep last;
+    while (source->Next(&frame)) {
+      last = session.Update(frame.image, frame.t_ns);
+      nlohmann::json j = StepJson(frame_index++, frame.t_ns, last);
+      j["image"] = frame.name;
+      log.Write(j);
+      if (session.finished()) break;
+    }
+    spdlog::info("repeat (open loop): {} frames, last destination keyframe {}, status {}", frame_index,
+                 last.destination, navigation::RepeatStatusName(last.status));
+  });
+
+  CLI::App* route_cmd = app->add_subcommand("route", "Inspect a taught route");
+  route_cmd->require_subcommand(1);
+  struct InfoArgs {
+    std::string route;
+    bool json = false;
+  };
+  auto i = std::make_shared<InfoArgs>();
+  CLI::App* info = route_cmd->add_subcommand("info", "Load a route (checking every file) and describe it");
+  info->add_option("ROUTE", i->route, "Route directory")->required();
+  info->add_flag("--json", i->json, "Print one JSON object");
+  info->callback([i] {
+    const route::Route route = route::LoadRoute(i->route);
+    std::size_t keypoints = 0;
+    for (const auto& kf : route.keyframes) keypoints += kf.keypoints.size();
+    nlohmann::json j;
+    j["keyframes"] = route.keyframes.size();
+    j["complete"] = route.complete;
+    j["detector"] = route.detector;
+    j["image_width"] = route.image_width;
+    j["image_height"] = route.image_height;
+    j["keypoints"] = keypoints;
+    j["duration_s"] = route.keyframes.empty() ? 0.0 : ToSeconds(route.keyframes.back().t_ns);
+    if (i->json) {
+      std::cout << j.dump() << "\n";
+    } else {
+      std::printf("%s: %zu keyframes (%s), %s features, %dx%d, %.1f s\n", i->route.c_str(),
+                  route.keyframes.size(), route.complete ? "complete" : "INTERRUPTED teach",
+                  route.detector.c_str(), route.image_width, route.image_height, j["duration_s"].get<double>());
+    }
+  });
+}
+
+}  // namespace mapless::app

@@ -1,0 +1,120 @@
+#include "mapless/io/frame_source.h"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "mapless/core/check.h"
+
+namespace mapless::io {
+namespace {
+
+cv::Mat ToGrey(const cv::Mat& in) {
+  if (in.channels() == 1) return in;
+  cv::Mat grey;
+  cv::cvtColor(in, grey, in.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+  return grey;
+}
+
+class FolderSource : public FrameSource {
+ public:
+  FolderSource(const std::string& dir, double fps) : dir_(dir), fps_(fps) {
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+      if (!entry.is_regular_file()) continue;
+      std::string ext = entry.path().extension().string();
+      std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+      if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".pgm" ||
+          ext == ".ppm" || ext == ".tif" || ext == ".tiff") {
+        files_.push_back(entry.path().string());
+      }
+    }
+    std::sort(files_.begin(), files_.end());
+    if (files_.empty()) throw InputError(dir + ": no image files in this folder");
+  }
+  bool Next(Frame* frame) override {
+    if (next_ >= files_.size()) return false;
+    const std::string& path = files_[next_];
+    cv::Mat img;
+    try {
+      img = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    } catch (const cv::Exception&) {
+      img.release();
+    }
+    if (img.empty()) throw InputError(path + ": cannot read image");
+    if (!size_.empty() && img.size() != size_) {
+      throw InputError(path + ": image is " + std::to_string(img.cols) + "x" + std::to_string(img.rows) +
+                       " but the folder's first image is " + std::to_string(size_.width) + "x" +
+                       std::to_string(size_.height));
+    }
+    size_ = img.size();
+    frame->image = img;
+    frame->t_ns = FromSeconds(static_cast<double>(next_) / fps_);
+    frame->name = std::filesystem::path(path).filename().string();
+    ++next_;
+    return true;
+  }
+  std::string Describe() const override {
+    return dir_ + " (" + std::to_string(files_.size()) + " images)";
+  }
+
+ private:
+  std::string dir_;
+  double fps_;
+  std::vector<std::string> files_;
+  std::size_t next_ = 0;
+  cv::Size size_;
+};
+
+class VideoSource : public FrameSource {
+ public:
+  VideoSource(const std::string& spec, bool camera, int device) : spec_(spec) {
+    const bool ok = camera ? capture_.open(device) : capture_.open(spec);
+    if (!ok || !capture_.isOpened()) {
+      throw InputError(spec + (camera ? ": cannot open camera" : ": cannot open video (missing file or unknown format)"));
+    }
+    fps_ = capture_.get(cv::CAP_PROP_FPS);
+    if (!(fps_ > 0.0 && fps_ < 1000.0)) fps_ = 30.0;
+  }
+  bool Next(Frame* frame) override {
+    cv::Mat img;
+    if (!capture_.read(img) || img.empty()) return false;
+    frame->image = ToGrey(img);
+    frame->t_ns = FromSeconds(static_cast<double>(index_) / fps_);
+    frame->name = std::to_string(index_);
+    ++index_;
+    return true;
+  }
+  std::string Describe() const override { return spec_; }
+
+ private:
+  std::string spec_;
+  cv::VideoCapture capture_;
+  double fps_ = 30.0;
+  long index_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<FrameSource> OpenFrameSource(const std::string& spec, double folder_fps) {
+  MAPLESS_CHECK(folder_fps > 0.0, "folder fps = " << folder_fps << "; must be > 0");
+  if (spec.rfind("camera:", 0) == 0) {
+    int device = 0;
+    try {
+      device = std::stoi(spec.substr(7));
+    } catch (const std::exception&) {
+      throw InputError(spec + ": expected camera:N with a device number");
+    }
+    return std::make_unique<VideoSource>(spec, true, device);
+  }
+  if (spec.rfind("/dev/video", 0) == 0) return std::make_unique<VideoSource>(spec, false, 0);
+  if (std::filesystem::is_directory(spec)) return std::make_unique<FolderSource>(spec, folder_fps);
+  if (!std::filesystem::exists(spec)) throw InputError(spec + ": no such file, folder or camera");
+  return std::make_unique<VideoSource>(spec, false, 0);
+}
+
+}  // namespace mapless::io

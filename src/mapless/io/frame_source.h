@@ -1,0 +1,33 @@
+// Recorded and live camera inputs: a video file, a folder of images (in file-name order), or a
+// camera device. Every source yields grey frames with timestamps.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <memory>
+#include <string>
+
+#include "mapless/core/pose.h"
+
+namespace mapless::io {
+
+struct Frame {
+  cv::Mat image;       // CV_8UC1
+  Timestamp t_ns = 0;  // from the video's frame times, or index / fps for folders
+  std::string name;    // file name (folders) or frame number
+};
+
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  // The next frame; false at the end. Throws InputError on an unreadable frame (naming it).
+  virtual bool Next(Frame* frame) = 0;
+  virtual std::string Describe() const = 0;
+};
+
+// Opens `spec`: "camera:N" or "/dev/videoN" for a camera, a directory for an image folder
+// (.png .jpg .jpeg .bmp .pgm .ppm .tif .tiff), anything else as a video file. `folder_fps` gives
+// the timestamps of folder frames. Throws InputError naming the source when it cannot be opened.
+std::unique_ptr<FrameSource> OpenFrameSource(const std::string& spec, double folder_fps = 10.0);
+
+}  // namespace mapless::io
