@@ -1,5 +1,6 @@
 // The `mapless` command line. Subcommands live in cmd_*.cc; this file only dispatches and turns
 // exceptions into one clear error line and an exit code (0 ok, 1 run failed, 2 bad input/usage).
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -14,6 +15,8 @@ int main(int argc, char** argv) {
   CLI::App app{"mapless: appearance-based robot navigation from one uncalibrated camera, no map"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "mapless 0.1.0");
+  // Logs go to stderr: stdout carries only results (JSON, tables, lists).
+  spdlog::set_default_logger(spdlog::stderr_color_mt("mapless"));
   spdlog::set_pattern("%^[%l]%$ %v");
   cv::setNumThreads(1);
   mapless::app::AddDemoCommand(&app);

@@ -139,8 +139,13 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
                 "RepeatSession: frame is " << grey.cols << "x" << grey.rows << " but the route was taught at "
                                            << route_->image_width << "x" << route_->image_height);
 
+  // Periodic refresh (an option; see RepeatOptions::redetect_every_frames): no point tracking
+  // features that are about to be replaced.
+  ++frames_since_detect_;
+  const bool refresh = options_.redetect_every_frames > 0 &&
+                       frames_since_detect_ >= options_.redetect_every_frames;
   // Algorithm 1, lines 16-18: track the matched features inside the segment.
-  if (!previous_.empty() && !current_px_.empty()) {
+  if (!refresh && !previous_.empty() && !current_px_.empty()) {
     const features::KltResult tracked = features::TrackKlt(previous_, grey, current_px_, options_.klt);
     std::vector<cv::Point2f> cur, dst;
     for (std::size_t i = 0; i < current_px_.size(); ++i) {
@@ -152,10 +157,7 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
     destination_px_ = std::move(dst);
   }
   previous_ = grey.clone();
-  // Lines 20-27: too few features left, detect and match again (and, as an option, periodically).
-  ++frames_since_detect_;
-  const bool refresh = options_.redetect_every_frames > 0 &&
-                       frames_since_detect_ >= options_.redetect_every_frames;
+  // Lines 20-27: too few features left, detect and match again (or refresh).
   if (static_cast<int>(current_px_.size()) < options_.min_features || refresh) DetectAndMatch(grey, &step);
   step.matches = last_matches_;
   step.tracked = static_cast<int>(current_px_.size());

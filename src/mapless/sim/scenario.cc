@@ -140,12 +140,16 @@ void ParseObject(const YamlMap& m, std::uint64_t seed, const std::string& base_d
     if (count < 1 || count > 1000) r.Fail("count", "must be in [1, 1000]");
     step = Vec2(r, "step");
   }
+  // Copies look alike only when the texture seed is given explicitly (visual aliasing on purpose);
+  // otherwise each copy gets its own derived seed.
+  const bool explicit_seed = m.Has("texture") && m.GetMap("texture").Has("seed");
   for (int k = 0; k < count; ++k) {
     for (WorldObject w : made) {
       const Eigen::Vector2d d = step * k;
       w.a += d;
       w.b += d;
       w.center += d;
+      if (!explicit_seed && k > 0) w.texture.seed = MixSeed(w.texture.seed, static_cast<std::uint64_t>(k));
       out->push_back(w);
     }
   }

@@ -103,13 +103,16 @@ TEST(Scenario, RepeatCopiesObjectsAlongAStep) {
 world:
   objects:
     - {type: poster, center: [1, 2, 1.5], size_m: [0.5, 0.7], repeat: {count: 4, step: [2.5, 0]}}
+    - {type: poster, center: [1, -2, 1.5], size_m: [0.5, 0.7], texture: {type: poster, seed: 9},
+       repeat: {count: 3, step: [2.5, 0]}}
 teach: {start: [0, 0, 0], path: [[1, 0]]}
 )";
   const Scenario s = ParseScenario(rep, "rep.yaml", "");
-  ASSERT_EQ(s.world.objects.size(), 4u);
+  ASSERT_EQ(s.world.objects.size(), 7u);
   EXPECT_DOUBLE_EQ(s.world.objects[3].center.x(), 8.5);
-  // Identical copies share one texture seed (visual aliasing).
-  EXPECT_EQ(s.world.objects[0].texture.seed, s.world.objects[3].texture.seed);
+  // Copies differ unless the seed is explicit; with an explicit seed they are identical (aliasing).
+  EXPECT_NE(s.world.objects[0].texture.seed, s.world.objects[3].texture.seed);
+  EXPECT_EQ(s.world.objects[4].texture.seed, s.world.objects[6].texture.seed);
 }
 
 }  // namespace

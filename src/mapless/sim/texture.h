@@ -26,7 +26,8 @@ struct TextureSpec {
   bool fit = false;        // stretch one copy over the whole surface (posters, pictures)
   double mean = 128.0;     // mean intensity, 0..255
   double contrast = 1.0;   // 1 = the type's normal contrast; 0.15 gives a low-texture surface
-  int size_px = 256;       // side of the texture image, a power of two (64..2048)
+  int size_px = 1024;      // side of the texture image, a power of two (64..2048); 1024 keeps
+                           // exact repeats (which fool feature matching) metres apart
   std::string file;        // image file for kImage (grayscale; resized to size_px)
 
   void Validate() const;   // throws InputError naming the field and value
