@@ -1,0 +1,137 @@
+#include <gtest/gtest.h>
+
+#include "mapless/core/check.h"
+#include "mapless/navigation/repeat.h"
+#include "mapless/navigation/teach.h"
+#include "mapless/sim/simulation.h"
+
+namespace mapless::navigation {
+namespace {
+
+struct Drive {
+  std::vector<cv::Mat> frames;
+  std::vector<Timestamp> t_ns;
+};
+
+const Drive& TaughtFrames() {
+  static const Drive drive = [] {
+    Drive d;
+    const sim::Scenario s = sim::LoadScenario("table1_almost_straight");
+    sim::DriveTaughtPath(s, sim::DriveOptions{}, [&](const sim::DriveFrame& f) {
+      d.frames.push_back(f.image);
+      d.t_ns.push_back(f.t_ns);
+    });
+    return d;
+  }();
+  return drive;
+}
+
+std::shared_ptr<route::Route> Teach(const TeachOptions& options, int* deferred = nullptr) {
+  auto route = std::make_shared<route::Route>();
+  route->image_width = 320;
+  route->image_height = 240;
+  route->detector = features::DetectorTypeName(options.features.type);
+  TeachSession teach(options);
+  const Drive& d = TaughtFrames();
+  for (std::size_t i = 0; i < d.frames.size(); ++i) {
+    if (auto kf = teach.Update(d.frames[i], d.t_ns[i])) route->keyframes.push_back(*kf);
+  }
+  if (auto kf = teach.Finish()) route->keyframes.push_back(*kf);
+  if (deferred) *deferred = teach.deferred_keyframes();
+  return route;
+}
+
+TEST(TeachSession, FirstAndLastFramesAreKeyframesAndSegmentsCarryTheirTracks) {
+  const auto route = Teach(TeachOptions{});
+  const Drive& d = TaughtFrames();
+  ASSERT_GE(route->keyframes.size(), 4u);
+  EXPECT_EQ(route->keyframes.front().t_ns, d.t_ns.front());
+  EXPECT_EQ(route->keyframes.back().t_ns, d.t_ns.back());
+  for (std::size_t k = 0; k < route->keyframes.size(); ++k) {
+    const auto& kf = route->keyframes[k];
+    EXPECT_EQ(kf.index, static_cast<int>(k));
+    EXPECT_GE(kf.keypoints.size(), 30u);
+    EXPECT_EQ(kf.segment_start_px.size(), kf.segment_end_px.size());
+    if (k > 0) {
+      EXPECT_GT(kf.segment_end_px.size(), 0u) << k;
+    }
+    EXPECT_EQ(kf.thumbnail.cols, 160);
+  }
+}
+
+TEST(TeachSession, AHigherTrackedFractionGivesDenserKeyframes) {
+  TeachOptions sparse;
+  sparse.keyframe_tracked_fraction = 0.4;
+  TeachOptions dense;
+  dense.keyframe_tracked_fraction = 0.8;
+  EXPECT_GT(Teach(dense)->keyframes.size(), Teach(sparse)->keyframes.size());
+}
+
+TEST(TeachSession, FeaturelessFramesNeverBecomeKeyframes) {
+  TeachSession teach(TeachOptions{});
+  const Drive& d = TaughtFrames();
+  ASSERT_TRUE(teach.Update(d.frames[0], 0).has_value());
+  const cv::Mat blank(240, 320, CV_8UC1, cv::Scalar(90));
+  // Every tracked feature is lost on a blank frame, but it has nothing to offer as a keyframe.
+  EXPECT_FALSE(teach.Update(blank, 100).has_value());
+  EXPECT_EQ(teach.deferred_keyframes(), 1);
+}
+
+TEST(RepeatSession, ReplayingTheTaughtFramesPassesEveryKeyframe) {
+  const auto route = Teach(TeachOptions{});
+  RepeatSession session(route, RepeatOptions{});
+  const Drive& d = TaughtFrames();
+  int last_destination = 1;
+  RepeatStep step;
+  for (std::size_t i = 0; i < d.frames.size() && !session.finished(); ++i) {
+    step = session.Update(d.frames[i], d.t_ns[i]);
+    EXPECT_GE(step.destination, last_destination);  // never goes back
+    last_destination = step.destination;
+  }
+  EXPECT_GE(last_destination, static_cast<int>(route->keyframes.size()) - 2);
+}
+
+TEST(RepeatSession, StopsOnBlackFramesSaysWhyAndResumesWhenImagesReturn) {
+  const auto route = Teach(TeachOptions{});
+  RepeatSession session(route, RepeatOptions{});
+  const Drive& d = TaughtFrames();
+  EXPECT_EQ(session.Update(d.frames[0], 0).status, RepeatStatus::kDriving);
+  const cv::Mat black(240, 320, CV_8UC1, cv::Scalar(0));
+  const RepeatStep stopped = session.Update(black, FromSeconds(0.1));
+  EXPECT_EQ(stopped.status, RepeatStatus::kWaiting);
+  EXPECT_EQ(stopped.command.v_mps, 0.0);
+  EXPECT_EQ(stopped.command.omega_radps, 0.0);
+  EXPECT_NE(stopped.reason.find("features match keyframe"), std::string::npos) << stopped.reason;
+  const RepeatStep resumed = session.Update(d.frames[1], FromSeconds(0.2));
+  EXPECT_EQ(resumed.status, RepeatStatus::kDriving);
+  EXPECT_GT(resumed.command.v_mps + std::abs(resumed.command.omega_radps), 0.0);
+}
+
+TEST(RepeatSession, AbortsWhenFeaturesStayMissingAndNeverDrivesBlind) {
+  const auto route = Teach(TeachOptions{});
+  RepeatOptions o;
+  o.abort_after_s = 2.0;
+  RepeatSession session(route, o);
+  const cv::Mat black(240, 320, CV_8UC1, cv::Scalar(0));
+  RepeatStep step;
+  for (int i = 0; i < 40 && !session.finished(); ++i) {
+    step = session.Update(black, FromSeconds(0.1 * i));
+    EXPECT_EQ(step.command.v_mps, 0.0);
+    EXPECT_EQ(step.command.omega_radps, 0.0);
+  }
+  EXPECT_TRUE(session.finished());
+  EXPECT_EQ(step.status, RepeatStatus::kAborted);
+  EXPECT_NE(step.reason.find("aborted"), std::string::npos);
+}
+
+TEST(RepeatSession, RefusesARouteTaughtWithOtherFeaturesOrTooShort) {
+  auto route = Teach(TeachOptions{});
+  RepeatOptions o;
+  o.features.type = features::DetectorType::kAkaze;
+  EXPECT_THROW(RepeatSession(route, o), InputError);
+  route->keyframes.resize(1);
+  EXPECT_THROW(RepeatSession(route, RepeatOptions{}), InputError);
+}
+
+}  // namespace
+}  // namespace mapless::navigation
