@@ -123,6 +123,13 @@ else
   wait "$pid"; check "teach was still running when killed (machine too fast?)" 1
 fi
 
+# Demo on a short scenario: teach, route, repeat, picture.
+expect_exit "demo on rotation_in_place" 0 "$MAPLESS" demo --scenario rotation_in_place --out "$TMP/demo"
+for f in topdown.png summary.json repeat.jsonl route/manifest.json teach/groundtruth.tum teach/frames/000000.png; do
+  [ -s "$TMP/demo/$f" ]; check "demo writes $f" $?
+done
+grep -q '"success": true' "$TMP/demo/summary.json"; check "demo repeat succeeded" $?
+
 # Bench: one JSON object with the render stage and its reference.
 expect_exit "bench --json" 0 "$MAPLESS" bench --json --repeats 5
 grep -q '"sim_render_320x240_ms":[0-9.]*' "$TMP/out" && grep -q '"opencv_dis_fast_320x240_ms"' "$TMP/out"; check "bench JSON has the render stage and DIS reference" $?

@@ -95,12 +95,13 @@ cv::Mat DrawTopDown(const sim::World& world, const std::vector<TopDownPath>& pat
                       px(e.x_m + 0.4 * std::cos(e.theta_rad), e.y_m + 0.4 * std::sin(e.theta_rad)),
                       path.color, 2, cv::LINE_AA, 0, 0.3);
     }
-    if (!path.label.empty()) {
-      cv::line(img, cv::Point(legend_x, height - 18), cv::Point(legend_x + 25, height - 18), path.color, 3);
-      cv::putText(img, path.label, cv::Point(legend_x + 30, height - 13), cv::FONT_HERSHEY_SIMPLEX, 0.45,
-                  cv::Scalar(40, 40, 40), 1, cv::LINE_AA);
-      legend_x += 40 + 9 * static_cast<int>(path.label.size());
-    }
+  }
+  for (const TopDownPath& path : paths) {
+    if (path.label.empty()) continue;
+    cv::line(img, cv::Point(legend_x, height - 18), cv::Point(legend_x + 25, height - 18), path.color, 3);
+    cv::putText(img, path.label, cv::Point(legend_x + 30, height - 13), cv::FONT_HERSHEY_SIMPLEX, 0.45,
+                cv::Scalar(40, 40, 40), 1, cv::LINE_AA);
+    legend_x += 40 + 9 * static_cast<int>(path.label.size());
   }
   // Scale bar: 1 m.
   const int bar = static_cast<int>(std::lround(ppm));
