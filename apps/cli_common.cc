@@ -21,7 +21,8 @@ Pose2 ParsePoseDeg(const std::string& text, const std::string& option) {
       throw InputError(option + " '" + text + "': expected X,Y,THETA_DEG (three numbers)");
     }
   }
-  if (v.size() != 3) throw InputError(option + " '" + text + "': expected X,Y,THETA_DEG (three numbers)");
+  if (v.size() != 3)
+    throw InputError(option + " '" + text + "': expected X,Y,THETA_DEG (three numbers)");
   return Pose2{v[0], v[1], WrapAngle(DegToRad(v[2]))};
 }
 
@@ -48,7 +49,8 @@ sim::DriveOptions LoadDriveOptions(const std::string& config_path) {
     const io::YamlMap s = root.GetMap("simulation");
     s.CheckKnownKeys({"physics_dt_s", "robot_body_height_m"});
     options.sim.physics_dt_s = s.GetDouble("physics_dt_s", options.sim.physics_dt_s);
-    options.sim.robot_body_height_m = s.GetDouble("robot_body_height_m", options.sim.robot_body_height_m);
+    options.sim.robot_body_height_m =
+        s.GetDouble("robot_body_height_m", options.sim.robot_body_height_m);
   }
   if (root.Has("drive")) {
     const io::YamlMap d = root.GetMap("drive");

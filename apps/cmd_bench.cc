@@ -7,7 +7,6 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
-
 #include <opencv2/core.hpp>
 #include <opencv2/video/tracking.hpp>
 
@@ -46,7 +45,8 @@ std::vector<Pose2> PosesAlong(const sim::Scenario& scenario, int count) {
   }
   std::vector<Pose2> picked;
   for (int i = 0; i < count; ++i) {
-    picked.push_back(poses[static_cast<std::size_t>(i) * poses.size() / static_cast<std::size_t>(count)]);
+    picked.push_back(
+        poses[static_cast<std::size_t>(i) * poses.size() / static_cast<std::size_t>(count)]);
   }
   return picked;
 }
@@ -57,7 +57,8 @@ std::vector<double> TimesMs(int n, const std::function<void(int)>& fn) {
   for (int i = 0; i < n; ++i) {
     const auto t0 = std::chrono::steady_clock::now();
     fn(i);
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
   return ms;
 }
@@ -72,24 +73,30 @@ void BenchTeachRepeat(nlohmann::json* j) {
   const sim::Scenario scenario = sim::LoadScenario("table1_almost_straight");
   std::vector<cv::Mat> frames;
   sim::DriveOptions drive;
-  sim::DriveTaughtPath(scenario, drive, [&](const sim::DriveFrame& f) { frames.push_back(f.image); });
+  sim::DriveTaughtPath(scenario, drive,
+                       [&](const sim::DriveFrame& f) { frames.push_back(f.image); });
   const int n = static_cast<int>(frames.size());
   // Teach: KLT tracking + keyframe test per frame (keyframe frames also detect and describe).
   {
     navigation::TeachSession teach(navigation::TeachOptions{});
-    (*j)["teach_step_ms"] = Median(TimesMs(n, [&](int i) { teach.Update(frames[static_cast<std::size_t>(i)], FromSeconds(0.1 * i)); }));
+    (*j)["teach_step_ms"] = Median(TimesMs(n, [&](int i) {
+      teach.Update(frames[static_cast<std::size_t>(i)], FromSeconds(0.1 * i));
+    }));
   }
   const eval::TaughtRoute taught = eval::TeachOnSimulator(scenario, navigation::TeachOptions{});
   // Repeat along the taught frames: in-segment KLT tracking + control (Algorithm 1 as written).
-  auto repeat_median = [&](std::shared_ptr<const route::Route> route, int redetect, bool only_tracking) {
+  auto repeat_median = [&](std::shared_ptr<const route::Route> route, int redetect,
+                           bool only_tracking) {
     navigation::RepeatOptions o;
     o.redetect_every_frames = redetect;
     navigation::RepeatSession session(route, o);
     std::vector<double> ms;
     for (int i = 0; i < n; ++i) {
       const auto t0 = std::chrono::steady_clock::now();
-      const navigation::RepeatStep step = session.Update(frames[static_cast<std::size_t>(i)], FromSeconds(0.1 * i));
-      const double dt = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      const navigation::RepeatStep step =
+          session.Update(frames[static_cast<std::size_t>(i)], FromSeconds(0.1 * i));
+      const double dt =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       if (!only_tracking || !step.redetected) ms.push_back(dt);
       if (session.finished()) break;
     }
@@ -138,7 +145,8 @@ void AddBenchCommand(CLI::App* app) {
   };
   auto args = std::make_shared<Args>();
   CLI::App* bench = app->add_subcommand(
-      "bench", "Per-stage medians (ms, one thread, 320x240) with OpenCV references from the same run");
+      "bench",
+      "Per-stage medians (ms, one thread, 320x240) with OpenCV references from the same run");
   bench->add_flag("--json", args->json, "Print one JSON object instead of a table");
   bench->add_option("--repeats", args->repeats, "Timed calls per stage")
       ->capture_default_str()
@@ -164,7 +172,8 @@ void AddBenchCommand(CLI::App* app) {
       sim::Scenario scenario = sim::LoadScenario(name);
       scenario.camera.model = sim::CameraModel::FromFov(320, 240, DegToRad(60.0));
       renderers.push_back(std::make_unique<sim::Renderer>(scenario.world, sim::RenderOptions{}));
-      for (const Pose2& p : PosesAlong(scenario, 12)) views.push_back({renderers.back().get(), scenario.camera, p});
+      for (const Pose2& p : PosesAlong(scenario, 12))
+        views.push_back({renderers.back().get(), scenario.camera, p});
     }
     const sim::Scenario scenario = sim::LoadScenario(names.front());
 
@@ -205,14 +214,18 @@ void AddBenchCommand(CLI::App* app) {
       return;
     }
     std::printf("%-34s %10s\n", "stage", "median ms");
-    for (const char* key : {"sim_render_320x240_ms", "opencv_dis_fast_320x240_ms", "teach_step_ms",
-                            "repeat_step_ms", "repeat_step_1km_ms", "repeat_step_fresh_ms",
-                            "repeat_step_fresh_1km_ms", "segment_start_ms", "opencv_orb500_320x240_ms"}) {
+    for (const char* key :
+         {"sim_render_320x240_ms", "opencv_dis_fast_320x240_ms", "teach_step_ms", "repeat_step_ms",
+          "repeat_step_1km_ms", "repeat_step_fresh_ms", "repeat_step_fresh_1km_ms",
+          "segment_start_ms", "opencv_orb500_320x240_ms"}) {
       std::printf("%-34s %10.3f\n", key, j[key].get<double>());
     }
-    std::printf("%-34s %10.2f  (issue 2: <= 2.0)\n", "sim_render / dis_fast", j["sim_render_over_dis_fast"].get<double>());
-    std::printf("%-34s %10.2f  (issue 3: <= 1.5)\n", "repeat_step / orb500", j["repeat_step_over_orb"].get<double>());
-    std::printf("%-34s %10.2f  (issue 3: <= 6.0)\n", "segment_start / orb500", j["segment_start_over_orb"].get<double>());
+    std::printf("%-34s %10.2f  (issue 2: <= 2.0)\n", "sim_render / dis_fast",
+                j["sim_render_over_dis_fast"].get<double>());
+    std::printf("%-34s %10.2f  (issue 3: <= 1.5)\n", "repeat_step / orb500",
+                j["repeat_step_over_orb"].get<double>());
+    std::printf("%-34s %10.2f  (issue 3: <= 6.0)\n", "segment_start / orb500",
+                j["segment_start_over_orb"].get<double>());
   });
 }
 

@@ -25,12 +25,17 @@ void AddEvalCommand(CLI::App* app) {
     std::string only;
   };
   auto args = std::make_shared<Args>();
-  CLI::App* cmd = app->add_subcommand("eval", "Run an evaluation suite on the simulator (table1, funnel-scenarios)");
+  CLI::App* cmd = app->add_subcommand(
+      "eval", "Run an evaluation suite on the simulator (table1, funnel-scenarios)");
   cmd->add_option("SUITE", args->suite, "table1 or funnel-scenarios")->required();
-  cmd->add_option("--runs", args->runs, "Repeats per scenario and controller")->capture_default_str()->check(CLI::Range(1, 1000));
+  cmd->add_option("--runs", args->runs, "Repeats per scenario and controller")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000));
   cmd->add_option("--seed", args->seed, "First seed; run i uses seed + i")->capture_default_str();
   cmd->add_flag("--json", args->json, "Print one JSON object (the table goes to stderr)");
-  cmd->add_option("--jobs", args->jobs, "Scenarios evaluated in parallel")->capture_default_str()->check(CLI::Range(1, 64));
+  cmd->add_option("--jobs", args->jobs, "Scenarios evaluated in parallel")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 64));
   cmd->add_option("--only", args->only, "Evaluate only this scenario of the suite");
   cmd->callback([args] {
     std::vector<eval::SuiteEntry> entries = eval::SuiteEntries(args->suite);
@@ -39,7 +44,8 @@ void AddEvalCommand(CLI::App* app) {
       for (const auto& e : entries) {
         if (e.scenario == args->only) kept.push_back(e);
       }
-      if (kept.empty()) throw InputError("--only '" + args->only + "': not a scenario of suite " + args->suite);
+      if (kept.empty())
+        throw InputError("--only '" + args->only + "': not a scenario of suite " + args->suite);
       entries = kept;
     }
     // Teach each scenario once; evaluate entries in parallel (each run is independent and seeded,
@@ -49,7 +55,8 @@ void AddEvalCommand(CLI::App* app) {
       if (taught.count(e.scenario)) continue;
       sim::Scenario s = sim::LoadScenario(e.scenario);
       spdlog::info("eval: teaching {}", e.scenario);
-      taught.emplace(e.scenario, std::make_pair(s, eval::TeachOnSimulator(s, navigation::TeachOptions{})));
+      taught.emplace(e.scenario,
+                     std::make_pair(s, eval::TeachOnSimulator(s, navigation::TeachOptions{})));
     }
     std::vector<eval::EntryResult> results(entries.size());
     std::size_t next = 0;
@@ -59,8 +66,8 @@ void AddEvalCommand(CLI::App* app) {
         const std::size_t k = next;
         batch.push_back(std::async(std::launch::async, [&, k] {
           const auto& [scenario, route] = taught.at(entries[k].scenario);
-          results[k] = eval::RunEntry(scenario, route, entries[k].controller, args->runs, args->seed,
-                                      eval::RepeatRunOptions{});
+          results[k] = eval::RunEntry(scenario, route, entries[k].controller, args->runs,
+                                      args->seed, eval::RepeatRunOptions{});
           spdlog::info("eval: {} {}: {}/{} successes", entries[k].scenario, results[k].controller,
                        results[k].successes, results[k].runs);
         }));
@@ -86,8 +93,8 @@ void AddEvalCommand(CLI::App* app) {
                               {"collisions", r.collisions},
                               {"failures", r.failures}});
       std::fprintf(table, "%-30s %-9s %4d/%-4d %9.2fm %9.2fm %9.2fm %5d\n", r.scenario.c_str(),
-                   r.controller.c_str(), r.successes, r.runs, r.final_error_m_rms, r.final_error_m_std,
-                   r.lateral_rms_m, r.collisions);
+                   r.controller.c_str(), r.successes, r.runs, r.final_error_m_rms,
+                   r.final_error_m_std, r.lateral_rms_m, r.collisions);
     }
     if (args->json) std::cout << j.dump() << "\n";
   });

@@ -3,7 +3,6 @@
 #include <cstdio>
 #include <iostream>
 #include <nlohmann/json.hpp>
-
 #include <opencv2/imgcodecs.hpp>
 
 #include "cli_common.h"
@@ -36,11 +35,14 @@ void AddShiftCommand(CLI::App* app) {
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app->add_subcommand(
-      "shift", "Horizontal shift of CURRENT relative to REFERENCE: dx = x_current - x_reference (px)");
+      "shift",
+      "Horizontal shift of CURRENT relative to REFERENCE: dx = x_current - x_reference (px)");
   cmd->add_option("REFERENCE", args->reference, "Reference image")->required();
   cmd->add_option("CURRENT", args->current, "Current image")->required();
-  cmd->add_flag("--json", args->json, "Print {\"dx_px\", \"matches\", \"inliers\", \"ok\"} as JSON");
-  cmd->add_option("--detector", args->detector, "orb, akaze, akaze_upright or sift")->capture_default_str();
+  cmd->add_flag("--json", args->json,
+                "Print {\"dx_px\", \"matches\", \"inliers\", \"ok\"} as JSON");
+  cmd->add_option("--detector", args->detector, "orb, akaze, akaze_upright or sift")
+      ->capture_default_str();
   cmd->add_option("--ratio", args->ratio, "Ratio-test threshold")->capture_default_str();
   cmd->callback([args] {
     features::ShiftOptions options;

@@ -40,11 +40,11 @@ sim::DriveSummary DriveToDirectory(const sim::Scenario& scenario, const sim::Dri
   std::vector<Pose2> odom_poses;
   for (const auto& p : truth) truth_poses.push_back(p.pose);
   for (const auto& p : odom) odom_poses.push_back(p.pose);
-  const cv::Mat top = viz::DrawTopDown(
-      scenario.world,
-      {{truth_poses, cv::Scalar(30, 30, 220), "taught path (ground truth)"},
-       {odom_poses, cv::Scalar(200, 120, 30), "wheel odometry"}},
-      scenario.destinations);
+  const cv::Mat top =
+      viz::DrawTopDown(scenario.world,
+                       {{truth_poses, cv::Scalar(30, 30, 220), "taught path (ground truth)"},
+                        {odom_poses, cv::Scalar(200, 120, 30), "wheel odometry"}},
+                       scenario.destinations);
   io::WriteImageAtomic((dir / "topdown.png").string(), top);
   nlohmann::json j;
   j["scenario"] = scenario.name;
@@ -60,10 +60,12 @@ sim::DriveSummary DriveToDirectory(const sim::Scenario& scenario, const sim::Dri
 }
 
 void AddSimCommands(CLI::App* app) {
-  CLI::App* simcmd = app->add_subcommand("sim", "The built-in simulator: scenarios, renders, drives");
+  CLI::App* simcmd =
+      app->add_subcommand("sim", "The built-in simulator: scenarios, renders, drives");
   simcmd->require_subcommand(1);
 
-  CLI::App* list = simcmd->add_subcommand("list", "Print the built-in scenario names, one per line");
+  CLI::App* list =
+      simcmd->add_subcommand("list", "Print the built-in scenario names, one per line");
   list->callback([] {
     for (const auto& name : sim::BuiltinScenarioNames()) std::cout << name << "\n";
   });
@@ -82,7 +84,8 @@ void AddSimCommands(CLI::App* app) {
   render->add_option("--pose", render_args->pose, "Robot pose X,Y,THETA_DEG (metres, degrees)")
       ->required();
   render->add_option("--out", render_args->out, "Output image file (.png)")->required();
-  render->add_option("--seed", render_args->seed, "Seed of the image noise (when the scenario has any)");
+  render->add_option("--seed", render_args->seed,
+                     "Seed of the image noise (when the scenario has any)");
   render->add_flag("--repeat-variant", render_args->repeat_variant,
                    "Render the world as the repeat phase sees it (objects removed or moved)");
   render->callback([render_args] {
@@ -107,10 +110,12 @@ void AddSimCommands(CLI::App* app) {
   auto drive_args = std::make_shared<DriveArgs>();
   CLI::App* drive = simcmd->add_subcommand(
       "drive", "Drive a scenario's taught path; write frames, poses (TUM) and a top-down picture");
-  drive->add_option("--scenario", drive_args->scenario, "Built-in scenario name or YAML file")->required();
+  drive->add_option("--scenario", drive_args->scenario, "Built-in scenario name or YAML file")
+      ->required();
   drive->add_option("--out", drive_args->out, "Output directory")->required();
   drive->add_option("--seed", drive_args->seed, "Seed of motion, odometry and image noise");
-  drive->add_option("--config", drive_args->config, "Run configuration YAML (see config/default.yaml)");
+  drive->add_option("--config", drive_args->config,
+                    "Run configuration YAML (see config/default.yaml)");
   drive->callback([drive_args] {
     const sim::Scenario scenario = sim::LoadScenario(drive_args->scenario);
     sim::DriveOptions options = LoadDriveOptions(drive_args->config);

@@ -69,11 +69,14 @@ void AddTeachRepeatCommands(CLI::App* app) {
   auto t = std::make_shared<TeachArgs>();
   CLI::App* teach = app->add_subcommand(
       "teach", "Teach a route: keyframes from a video, an image folder, a camera or sim:SCENARIO");
-  teach->add_option("--source", t->source, "sim:SCENARIO, a video file, an image folder, camera:N")->required();
+  teach->add_option("--source", t->source, "sim:SCENARIO, a video file, an image folder, camera:N")
+      ->required();
   teach->add_option("--out", t->out, "Route directory to create")->required();
   teach->add_flag("--overwrite", t->overwrite, "Replace a route already in --out");
-  teach->add_option("--detector", t->detector, "orb, akaze, akaze_upright or sift")->capture_default_str();
-  teach->add_option("--fps", t->fps, "Frame rate of image folders (timestamps)")->capture_default_str();
+  teach->add_option("--detector", t->detector, "orb, akaze, akaze_upright or sift")
+      ->capture_default_str();
+  teach->add_option("--fps", t->fps, "Frame rate of image folders (timestamps)")
+      ->capture_default_str();
   teach->callback([t] {
     navigation::TeachOptions options;
     options.features.type = features::ParseDetectorType(t->detector);
@@ -84,10 +87,11 @@ void AddTeachRepeatCommands(CLI::App* app) {
       const sim::Scenario scenario = sim::LoadScenario(t->source.substr(4));
       route::RouteWriter writer(t->out, t->detector, scenario.camera.model.width,
                                 scenario.camera.model.height, t->overwrite);
-      const eval::TaughtRoute taught = eval::TeachOnSimulator(scenario, options, [&](const route::Keyframe& kf) {
-        writer.Append(kf);
-        ++keyframes;
-      });
+      const eval::TaughtRoute taught =
+          eval::TeachOnSimulator(scenario, options, [&](const route::Keyframe& kf) {
+            writer.Append(kf);
+            ++keyframes;
+          });
       frames = static_cast<int>(taught.path.size());
       writer.Finish();
     } else {
@@ -118,7 +122,8 @@ void AddTeachRepeatCommands(CLI::App* app) {
       }
     }
     spdlog::info("teach: {} frames, {} keyframes written to {}", frames, keyframes, t->out);
-    if (keyframes < 2) throw RunFailed("teach: fewer than 2 keyframes; the route cannot be repeated");
+    if (keyframes < 2)
+      throw RunFailed("teach: fewer than 2 keyframes; the route cannot be repeated");
   });
 
   struct RepeatArgs {
@@ -134,26 +139,38 @@ void AddTeachRepeatCommands(CLI::App* app) {
   };
   auto r = std::make_shared<RepeatArgs>();
   CLI::App* repeat = app->add_subcommand(
-      "repeat", "Repeat a taught route: drive the simulator, or decide frame by frame on a recording");
+      "repeat",
+      "Repeat a taught route: drive the simulator, or decide frame by frame on a recording");
   repeat->add_option("--route", r->route, "Route directory (from mapless teach)")->required();
-  repeat->add_option("--source", r->source, "sim:SCENARIO, a video file, an image folder, camera:N")->required();
+  repeat->add_option("--source", r->source, "sim:SCENARIO, a video file, an image folder, camera:N")
+      ->required();
   repeat->add_option("--controller", r->controller, "sloped or standard")->capture_default_str();
-  repeat->add_option("--switching", r->switching, "stdratio (Kassir et al.) or mse (Chen & Birchfield)")
+  repeat
+      ->add_option("--switching", r->switching,
+                   "stdratio (Kassir et al.) or mse (Chen & Birchfield)")
       ->capture_default_str();
-  repeat->add_option("--log", r->log, "Per-frame decisions as JSON lines to this file (default: stdout)");
+  repeat->add_option("--log", r->log,
+                     "Per-frame decisions as JSON lines to this file (default: stdout)");
   repeat->add_option("--seed", r->seed, "Simulator: seed of the noise")->capture_default_str();
-  repeat->add_option("--motion-noise", r->motion_noise, "Simulator: fraction of the command")->capture_default_str();
-  repeat->add_option("--image-noise", r->image_noise, "Simulator: grey levels")->capture_default_str();
-  repeat->add_option("--fps", r->fps, "Frame rate of image folders (timestamps)")->capture_default_str();
+  repeat->add_option("--motion-noise", r->motion_noise, "Simulator: fraction of the command")
+      ->capture_default_str();
+  repeat->add_option("--image-noise", r->image_noise, "Simulator: grey levels")
+      ->capture_default_str();
+  repeat->add_option("--fps", r->fps, "Frame rate of image folders (timestamps)")
+      ->capture_default_str();
   repeat->callback([r] {
     auto route = std::make_shared<route::Route>(route::LoadRoute(r->route));
-    if (!route->complete) spdlog::warn("repeat: {} is an interrupted teach; repeating its {} keyframes",
-                                       r->route, route->keyframes.size());
+    if (!route->complete)
+      spdlog::warn("repeat: {} is an interrupted teach; repeating its {} keyframes", r->route,
+                   route->keyframes.size());
     navigation::RepeatOptions options;
     options.controller = navigation::ParseController(r->controller);
-    if (r->switching == "stdratio") options.switching = navigation::Switching::kStdRatio;
-    else if (r->switching == "mse") options.switching = navigation::Switching::kMse;
-    else throw InputError("--switching '" + r->switching + "': expected stdratio or mse");
+    if (r->switching == "stdratio")
+      options.switching = navigation::Switching::kStdRatio;
+    else if (r->switching == "mse")
+      options.switching = navigation::Switching::kMse;
+    else
+      throw InputError("--switching '" + r->switching + "': expected stdratio or mse");
     options.features.type = features::ParseDetectorType(route->detector);
     JsonLines log(r->log);
     int frame_index = 0;
@@ -163,9 +180,8 @@ void AddTeachRepeatCommands(CLI::App* app) {
       taught.route = route;
       sim::DriveOptions drive;
       drive.render_frames = false;
-      const sim::DriveSummary summary = sim::DriveTaughtPath(scenario, drive, [&](const sim::DriveFrame& f) {
-        taught.path.push_back(f.truth);
-      });
+      const sim::DriveSummary summary = sim::DriveTaughtPath(
+          scenario, drive, [&](const sim::DriveFrame& f) { taught.path.push_back(f.truth); });
       taught.duration_s = summary.duration_s;
       eval::RepeatRunOptions run_options;
       run_options.repeat = options;
@@ -173,8 +189,10 @@ void AddTeachRepeatCommands(CLI::App* app) {
       run_options.motion_noise_frac = r->motion_noise;
       run_options.image_noise_sigma = r->image_noise;
       const eval::RepeatRun run = eval::RepeatOnSimulator(
-          scenario, taught, run_options, [&](const Pose2& pose, const cv::Mat&, const navigation::RepeatStep& step) {
-            nlohmann::json j = StepJson(frame_index, FromSeconds(frame_index / scenario.camera.rate_hz), step);
+          scenario, taught, run_options,
+          [&](const Pose2& pose, const cv::Mat&, const navigation::RepeatStep& step) {
+            nlohmann::json j =
+                StepJson(frame_index, FromSeconds(frame_index / scenario.camera.rate_hz), step);
             j["x_m"] = pose.x_m;
             j["y_m"] = pose.y_m;
             j["theta_rad"] = pose.theta_rad;
@@ -182,7 +200,8 @@ void AddTeachRepeatCommands(CLI::App* app) {
             ++frame_index;
           });
       spdlog::info("repeat: {} ({}): {}; final error {:.2f} m, lateral RMS {:.2f} m, {:.1f} s",
-                   scenario.name, r->controller, run.status, run.final_error_m, run.lateral_rms_m, run.duration_s);
+                   scenario.name, r->controller, run.status, run.final_error_m, run.lateral_rms_m,
+                   run.duration_s);
       if (!run.success) throw RunFailed("repeat did not succeed: " + run.status);
       return;
     }
@@ -197,8 +216,8 @@ void AddTeachRepeatCommands(CLI::App* app) {
       log.Write(j);
       if (session.finished()) break;
     }
-    spdlog::info("repeat (open loop): {} frames, last destination keyframe {}, status {}", frame_index,
-                 last.destination, navigation::RepeatStatusName(last.status));
+    spdlog::info("repeat (open loop): {} frames, last destination keyframe {}, status {}",
+                 frame_index, last.destination, navigation::RepeatStatusName(last.status));
   });
 
   CLI::App* route_cmd = app->add_subcommand("route", "Inspect a taught route");
@@ -208,7 +227,8 @@ void AddTeachRepeatCommands(CLI::App* app) {
     bool json = false;
   };
   auto i = std::make_shared<InfoArgs>();
-  CLI::App* info = route_cmd->add_subcommand("info", "Load a route (checking every file) and describe it");
+  CLI::App* info =
+      route_cmd->add_subcommand("info", "Load a route (checking every file) and describe it");
   info->add_option("ROUTE", i->route, "Route directory")->required();
   info->add_flag("--json", i->json, "Print one JSON object");
   info->callback([i] {
@@ -228,7 +248,8 @@ void AddTeachRepeatCommands(CLI::App* app) {
     } else {
       std::printf("%s: %zu keyframes (%s), %s features, %dx%d, %.1f s\n", i->route.c_str(),
                   route.keyframes.size(), route.complete ? "complete" : "INTERRUPTED teach",
-                  route.detector.c_str(), route.image_width, route.image_height, j["duration_s"].get<double>());
+                  route.detector.c_str(), route.image_width, route.image_height,
+                  j["duration_s"].get<double>());
     }
   });
 }

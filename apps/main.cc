@@ -5,7 +5,6 @@
 
 #include <CLI/CLI.hpp>
 #include <iostream>
-
 #include <opencv2/core.hpp>
 
 #include "cli_common.h"

@@ -9,9 +9,12 @@ namespace mapless::control {
 
 const char* TurnCommandName(TurnCommand command) {
   switch (command) {
-    case TurnCommand::kStraight: return "straight";
-    case TurnCommand::kLeft: return "left";
-    case TurnCommand::kRight: return "right";
+    case TurnCommand::kStraight:
+      return "straight";
+    case TurnCommand::kLeft:
+      return "left";
+    case TurnCommand::kRight:
+      return "right";
   }
   return "?";
 }
@@ -52,10 +55,10 @@ double Median(std::vector<double> values) {
 }
 
 void StandardFunnelLaneOptions::Validate() const {
-  MAPLESS_CHECK(forward_speed_mps > 0.0,
-                "StandardFunnelLaneOptions.forward_speed_mps = " << forward_speed_mps << "; must be > 0");
-  MAPLESS_CHECK(turn_rate_radps > 0.0,
-                "StandardFunnelLaneOptions.turn_rate_radps = " << turn_rate_radps << "; must be > 0");
+  MAPLESS_CHECK(forward_speed_mps > 0.0, "StandardFunnelLaneOptions.forward_speed_mps = "
+                                             << forward_speed_mps << "; must be > 0");
+  MAPLESS_CHECK(turn_rate_radps > 0.0, "StandardFunnelLaneOptions.turn_rate_radps = "
+                                           << turn_rate_radps << "; must be > 0");
 }
 
 StandardFunnelLaneResult ComputeStandardFunnelLane(const std::vector<FeaturePair>& features,
@@ -76,15 +79,21 @@ StandardFunnelLaneResult ComputeStandardFunnelLane(const std::vector<FeaturePair
     // far right (u_c >= u_j) asks for a right turn; one that crossed to the left (u_c <= 0) asks
     // for a left turn. Mirrored for left-side features.
     if (uj > 0.0) {
-      if (uc >= uj) ++r.right_votes;
-      else ++r.left_votes;
+      if (uc >= uj)
+        ++r.right_votes;
+      else
+        ++r.left_votes;
     } else {
-      if (uc <= uj) ++r.left_votes;
-      else ++r.right_votes;
+      if (uc <= uj)
+        ++r.left_votes;
+      else
+        ++r.right_votes;
     }
   }
-  if (r.left_votes > r.right_votes) r.command = TurnCommand::kLeft;
-  else if (r.right_votes > r.left_votes) r.command = TurnCommand::kRight;
+  if (r.left_votes > r.right_votes)
+    r.command = TurnCommand::kLeft;
+  else if (r.right_votes > r.left_votes)
+    r.command = TurnCommand::kRight;
   r.twist.v_mps = options.forward_speed_mps;
   r.twist.omega_radps = r.command == TurnCommand::kLeft    ? options.turn_rate_radps
                         : r.command == TurnCommand::kRight ? -options.turn_rate_radps
@@ -100,15 +109,14 @@ void SlopedFunnelLaneOptions::Validate() const {
   MAPLESS_CHECK(slope_x_for_full_turn > turn_threshold,
                 "SlopedFunnelLaneOptions.slope_x_for_full_turn = " << slope_x_for_full_turn
                                                                    << "; must be > turn_threshold");
-  MAPLESS_CHECK(slope_y_for_full_speed > 0.0,
-                "SlopedFunnelLaneOptions.slope_y_for_full_speed = " << slope_y_for_full_speed
-                                                                    << "; must be > 0");
+  MAPLESS_CHECK(slope_y_for_full_speed > 0.0, "SlopedFunnelLaneOptions.slope_y_for_full_speed = "
+                                                  << slope_y_for_full_speed << "; must be > 0");
   MAPLESS_CHECK(min_median_px >= 0.0,
                 "SlopedFunnelLaneOptions.min_median_px = " << min_median_px << "; must be >= 0");
   MAPLESS_CHECK(max_speed_mps > 0.0,
                 "SlopedFunnelLaneOptions.max_speed_mps = " << max_speed_mps << "; must be > 0");
-  MAPLESS_CHECK(max_turn_rate_radps > 0.0,
-                "SlopedFunnelLaneOptions.max_turn_rate_radps = " << max_turn_rate_radps << "; must be > 0");
+  MAPLESS_CHECK(max_turn_rate_radps > 0.0, "SlopedFunnelLaneOptions.max_turn_rate_radps = "
+                                               << max_turn_rate_radps << "; must be > 0");
 }
 
 SlopedFunnelLaneResult ComputeSlopedFunnelLane(const std::vector<FeaturePair>& features,

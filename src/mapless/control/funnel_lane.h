@@ -43,9 +43,9 @@ struct StandardFunnelLaneOptions {
 
 struct StandardFunnelLaneResult {
   TurnCommand command = TurnCommand::kStraight;
-  int inside = 0;        // features whose constraints (1) and (2) both hold
-  int left_votes = 0;    // features outside their funnel lane asking for a left turn
-  int right_votes = 0;   // ... asking for a right turn
+  int inside = 0;       // features whose constraints (1) and (2) both hold
+  int left_votes = 0;   // features outside their funnel lane asking for a left turn
+  int right_votes = 0;  // ... asking for a right turn
   Twist2 twist;
 };
 
@@ -59,26 +59,26 @@ StandardFunnelLaneResult ComputeStandardFunnelLane(const std::vector<FeaturePair
 // ---- Sloped funnel lane (Section V) ------------------------------------------------------------
 
 struct SlopedFunnelLaneOptions {
-  double beta = 1.0;                  // slope around y: beta * (1 - sigma_c / sigma_j)
-  double gamma = 1.0;                 // slope around x: gamma * sum over sides of (mu_j - mu_c)/|mu_j|
-  double turn_threshold = 0.05;       // |slope_x| above which the robot turns
-  double slope_x_for_full_turn = 1.0; // |slope_x| at which the turn rate reaches its maximum
+  double beta = 1.0;             // slope around y: beta * (1 - sigma_c / sigma_j)
+  double gamma = 1.0;            // slope around x: gamma * sum over sides of (mu_j - mu_c)/|mu_j|
+  double turn_threshold = 0.05;  // |slope_x| above which the robot turns
+  double slope_x_for_full_turn = 1.0;  // |slope_x| at which the turn rate reaches its maximum
   // Floor on |mu_j| in the slope around x, px: a side whose destination median is near the image
   // centre would otherwise make the slope explode (not in the paper; 0 disables it).
   double min_median_px = 20.0;
   double slope_y_for_full_speed = 0.15;  // slope_y at which a turning robot keeps full speed
-  double max_speed_mps = 0.2;         // forward speed when going straight
-  double max_turn_rate_radps = 0.5;   // turn rate at full turn
-  Spread spread = Spread::kStdDev;    // spread used for StdRatio
+  double max_speed_mps = 0.2;            // forward speed when going straight
+  double max_turn_rate_radps = 0.5;      // turn rate at full turn
+  Spread spread = Spread::kStdDev;       // spread used for StdRatio
   void Validate() const;
 };
 
 struct SlopedFunnelLaneResult {
-  bool ok = false;            // false: fewer than 2 features (no standard deviation)
-  double std_ratio = 0.0;     // sigma_c / sigma_j, constraint (5) holds when < 1
-  double slope_y = 0.0;       // beta * (1 - std_ratio): the type of turn
-  double slope_x = 0.0;       // the decision to turn: > 0 left, < 0 right
-  int left_features = 0;      // classified by their side in the destination keyframe
+  bool ok = false;         // false: fewer than 2 features (no standard deviation)
+  double std_ratio = 0.0;  // sigma_c / sigma_j, constraint (5) holds when < 1
+  double slope_y = 0.0;    // beta * (1 - std_ratio): the type of turn
+  double slope_x = 0.0;    // the decision to turn: > 0 left, < 0 right
+  int left_features = 0;   // classified by their side in the destination keyframe
   int right_features = 0;
   TurnCommand command = TurnCommand::kStraight;
   Twist2 twist;
@@ -96,8 +96,8 @@ SlopedFunnelLaneResult ComputeSlopedFunnelLane(const std::vector<FeaturePair>& f
 // ---- Keyframe switching (Section VI) -----------------------------------------------------------
 
 struct SwitchOptions {
-  double max_ed_px = 12.0;      // ED threshold: |median u_c - median u_j|
-  double min_std_ratio = 1.0;   // StdRatio must exceed this (the robot reached the keyframe)
+  double max_ed_px = 12.0;     // ED threshold: |median u_c - median u_j|
+  double min_std_ratio = 1.0;  // StdRatio must exceed this (the robot reached the keyframe)
   Spread spread = Spread::kStdDev;
   void Validate() const;
 };

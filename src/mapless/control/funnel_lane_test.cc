@@ -73,7 +73,7 @@ TEST(SlopedFunnelLane, SymmetricApproachHasNoSlopeXAndGoesStraight) {
   SlopedFunnelLaneOptions o;
   const auto r = ComputeSlopedFunnelLane(Map(kDest, 0.8, 0.0), o);
   ASSERT_TRUE(r.ok);
-  EXPECT_NEAR(r.std_ratio, 0.8, 1e-9);   // constraint (5) holds
+  EXPECT_NEAR(r.std_ratio, 0.8, 1e-9);  // constraint (5) holds
   EXPECT_NEAR(r.slope_y, 0.2, 1e-9);
   EXPECT_LT(std::abs(r.slope_x), o.turn_threshold);
   EXPECT_EQ(r.command, TurnCommand::kStraight);
@@ -109,7 +109,7 @@ TEST(SlopedFunnelLane, NeedsTwoFeaturesWithSpread) {
 
 TEST(CheckSwitch, SwitchesOnceTheSpreadExceedsTheKeyframesAndMediansAgree) {
   SwitchOptions o;
-  EXPECT_FALSE(CheckSwitch(Map(kDest, 0.9, 0.0), o).switch_now);   // not yet there
+  EXPECT_FALSE(CheckSwitch(Map(kDest, 0.9, 0.0), o).switch_now);  // not yet there
   const SwitchDecision passed = CheckSwitch(Map(kDest, 1.05, 0.0), o);
   EXPECT_TRUE(passed.switch_now);
   EXPECT_NEAR(passed.std_ratio, 1.05, 1e-9);
@@ -123,11 +123,11 @@ TEST(MseSwitch, SwitchesWhenTheErrorRisesAfterFalling) {
   EXPECT_FALSE(s.Update(Map(kDest, 0.7, 0.0)));
   EXPECT_FALSE(s.Update(Map(kDest, 0.8, 0.0)));
   EXPECT_FALSE(s.Update(Map(kDest, 0.95, 0.0)));
-  EXPECT_FALSE(s.Update(Map(kDest, 1.1, 0.0)));   // |error| 0.05 -> 0.1: rises once
-  EXPECT_TRUE(s.Update(Map(kDest, 1.2, 0.0)));    // twice: switch
+  EXPECT_FALSE(s.Update(Map(kDest, 1.1, 0.0)));  // |error| 0.05 -> 0.1: rises once
+  EXPECT_TRUE(s.Update(Map(kDest, 1.2, 0.0)));   // twice: switch
   s.Reset();
   EXPECT_FALSE(s.Update(Map(kDest, 1.2, 0.0)));
-  EXPECT_FALSE(s.Update(Map(kDest, 1.3, 0.0)));   // rising from the start: no decrease seen yet
+  EXPECT_FALSE(s.Update(Map(kDest, 1.3, 0.0)));  // rising from the start: no decrease seen yet
   EXPECT_FALSE(s.Update(Map(kDest, 1.4, 0.0)));
 }
 
@@ -138,8 +138,9 @@ TEST(FunnelLaneOptions, InvalidValuesNameTheField) {
     o.Validate();
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("SlopedFunnelLaneOptions.turn_threshold = -0.2; must be >= 0"),
-              std::string::npos);
+    EXPECT_NE(
+        std::string(e.what()).find("SlopedFunnelLaneOptions.turn_threshold = -0.2; must be >= 0"),
+        std::string::npos);
   }
 }
 

@@ -17,11 +17,11 @@ class InputError : public std::runtime_error {
 }  // namespace mapless
 
 // MAPLESS_CHECK(cond, "message " << value): throws mapless::InputError with the message.
-#define MAPLESS_CHECK(cond, msg)                 \
-  do {                                           \
-    if (!(cond)) {                               \
-      std::ostringstream mapless_check_stream_;  \
-      mapless_check_stream_ << msg;              \
+#define MAPLESS_CHECK(cond, msg)                                \
+  do {                                                          \
+    if (!(cond)) {                                              \
+      std::ostringstream mapless_check_stream_;                 \
+      mapless_check_stream_ << msg;                             \
       throw ::mapless::InputError(mapless_check_stream_.str()); \
-    }                                            \
+    }                                                           \
   } while (false)

@@ -27,7 +27,9 @@ struct Pose2 {
   Pose2 Inverse() const;
   // Maps a point given in this frame into the parent frame.
   void Apply(double px, double py, double* out_x, double* out_y) const;
-  double DistanceTo(const Pose2& other) const { return std::hypot(x_m - other.x_m, y_m - other.y_m); }
+  double DistanceTo(const Pose2& other) const {
+    return std::hypot(x_m - other.x_m, y_m - other.y_m);
+  }
 };
 
 // Velocity of a differential-drive robot in its own frame.

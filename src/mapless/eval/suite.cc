@@ -14,9 +14,15 @@ std::vector<SuiteEntry> SuiteEntries(const std::string& suite) {
   if (suite == "table1") {
     scenarios = {"table1_sharp_turn_low_texture", "table1_almost_straight"};
   } else if (suite == "funnel-scenarios") {
-    scenarios = {"narrow_room_sharp_turn", "wide_left_turn_offset_start", "corridor_25m",
-                 "parking_between_cars",   "outdoor_loop_cars_removed",   "outdoor_wide_turn",
-                 "indoor_30m",             "outdoor_70m",                 "rotation_in_place"};
+    scenarios = {"narrow_room_sharp_turn",
+                 "wide_left_turn_offset_start",
+                 "corridor_25m",
+                 "parking_between_cars",
+                 "outdoor_loop_cars_removed",
+                 "outdoor_wide_turn",
+                 "indoor_30m",
+                 "outdoor_70m",
+                 "rotation_in_place"};
   } else {
     throw InputError("unknown suite '" + suite + "' (known: table1, funnel-scenarios)");
   }
@@ -45,8 +51,9 @@ EntryResult RunEntry(const sim::Scenario& scenario, const TaughtRoute& taught,
     o.repeat.controller = controller;
     // The teach speed, capped for accuracy, but never below half of it (the run must end within
     // timeout_factor = 3x the taught duration).
-    const double speed = std::min(scenario.teach_speed_mps,
-                                  std::max(base.max_repeat_speed_mps, 0.5 * scenario.teach_speed_mps));
+    const double speed =
+        std::min(scenario.teach_speed_mps,
+                 std::max(base.max_repeat_speed_mps, 0.5 * scenario.teach_speed_mps));
     o.repeat.sloped.max_speed_mps = speed;
     o.repeat.standard.forward_speed_mps = speed;
     const RepeatRun run = RepeatOnSimulator(scenario, taught, o);
@@ -56,11 +63,15 @@ EntryResult RunEntry(const sim::Scenario& scenario, const TaughtRoute& taught,
       lateral_sum_sq += d * d;
       ++lateral_count;
     }
-    if (run.success) ++r.successes;
-    else r.failures.push_back("run " + std::to_string(i) + " (seed " + std::to_string(o.seed) + "): " + run.status +
-                              (run.completed && !run.collided ? ", ended " + std::to_string(run.final_error_m).substr(0, 4) +
-                                                                    " m from the taught end"
-                                                              : ""));
+    if (run.success)
+      ++r.successes;
+    else
+      r.failures.push_back("run " + std::to_string(i) + " (seed " + std::to_string(o.seed) +
+                           "): " + run.status +
+                           (run.completed && !run.collided
+                                ? ", ended " + std::to_string(run.final_error_m).substr(0, 4) +
+                                      " m from the taught end"
+                                : ""));
     if (run.collided) ++r.collisions;
   }
   double sum_sq = 0.0;
@@ -75,7 +86,8 @@ EntryResult RunEntry(const sim::Scenario& scenario, const TaughtRoute& taught,
   double var = 0.0;
   for (double f : finals) var += (f - mean) * (f - mean);
   r.final_error_m_std = std::sqrt(var / n);
-  r.lateral_rms_m = lateral_count > 0 ? std::sqrt(lateral_sum_sq / static_cast<double>(lateral_count)) : 0.0;
+  r.lateral_rms_m =
+      lateral_count > 0 ? std::sqrt(lateral_sum_sq / static_cast<double>(lateral_count)) : 0.0;
   return r;
 }
 

@@ -10,8 +10,9 @@ namespace mapless::eval {
 
 void RepeatRunOptions::Validate() const {
   repeat.Validate();
-  MAPLESS_CHECK(motion_noise_frac >= 0.0 && motion_noise_frac <= 1.0,
-                "RepeatRunOptions.motion_noise_frac = " << motion_noise_frac << "; must be in [0, 1]");
+  MAPLESS_CHECK(
+      motion_noise_frac >= 0.0 && motion_noise_frac <= 1.0,
+      "RepeatRunOptions.motion_noise_frac = " << motion_noise_frac << "; must be in [0, 1]");
   MAPLESS_CHECK(image_noise_sigma >= 0.0,
                 "RepeatRunOptions.image_noise_sigma = " << image_noise_sigma << "; must be >= 0");
   MAPLESS_CHECK(timeout_factor >= 1.0,
@@ -49,12 +50,14 @@ TaughtRoute TeachOnSimulator(const sim::Scenario& scenario, const navigation::Te
     taught.route->keyframes.push_back(*kf);
   };
   sim::DriveOptions drive;
-  const sim::DriveSummary summary = sim::DriveTaughtPath(scenario, drive, [&](const sim::DriveFrame& f) {
-    taught.path.push_back(f.truth);
-    keep(teach.Update(f.image, f.t_ns));
-  });
+  const sim::DriveSummary summary =
+      sim::DriveTaughtPath(scenario, drive, [&](const sim::DriveFrame& f) {
+        taught.path.push_back(f.truth);
+        keep(teach.Update(f.image, f.t_ns));
+      });
   keep(teach.Finish());
-  MAPLESS_CHECK(summary.completed, "teach drive of '" << scenario.name << "' did not complete: " << summary.status);
+  MAPLESS_CHECK(summary.completed,
+                "teach drive of '" << scenario.name << "' did not complete: " << summary.status);
   taught.route->complete = true;
   taught.duration_s = summary.duration_s;
   return taught;
@@ -69,10 +72,11 @@ RepeatRun RepeatOnSimulator(const sim::Scenario& scenario, const TaughtRoute& ta
   sim::RobotOptions robot = scenario.robot;
   robot.motion_noise_v_frac = options.motion_noise_frac;
   robot.motion_noise_omega_frac = options.motion_noise_frac;
-  const Pose2 start = scenario.repeat_start *
-                      Pose2{rng.Uniform(-options.start_offset_m, options.start_offset_m),
-                            rng.Uniform(-options.start_offset_m, options.start_offset_m),
-                            DegToRad(rng.Uniform(-options.start_offset_deg, options.start_offset_deg))};
+  const Pose2 start =
+      scenario.repeat_start *
+      Pose2{rng.Uniform(-options.start_offset_m, options.start_offset_m),
+            rng.Uniform(-options.start_offset_m, options.start_offset_m),
+            DegToRad(rng.Uniform(-options.start_offset_deg, options.start_offset_deg))};
   sim::Simulation sim(sim::ApplyVariant(scenario.world, scenario.repeat_variant), camera, {},
                       rng.NextU64());
   const int r = sim.AddRobot(start, robot);
@@ -98,7 +102,8 @@ RepeatRun RepeatOnSimulator(const sim::Scenario& scenario, const TaughtRoute& ta
       break;
     }
     if (ToSeconds(sim.now_ns()) > timeout) {
-      run.status = "timeout after " + std::to_string(static_cast<int>(ToSeconds(sim.now_ns()))) + " s";
+      run.status =
+          "timeout after " + std::to_string(static_cast<int>(ToSeconds(sim.now_ns()))) + " s";
       break;
     }
     sim.SetCommand(r, step.command);

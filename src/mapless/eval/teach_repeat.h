@@ -16,7 +16,7 @@ namespace mapless::eval {
 
 struct TaughtRoute {
   std::shared_ptr<route::Route> route;
-  std::vector<Pose2> path;        // ground-truth poses of the teach drive, one per frame
+  std::vector<Pose2> path;  // ground-truth poses of the teach drive, one per frame
   double duration_s = 0.0;
 };
 
@@ -26,31 +26,32 @@ TaughtRoute TeachOnSimulator(const sim::Scenario& scenario, const navigation::Te
 
 struct RepeatRunOptions {
   navigation::RepeatOptions repeat;
-  double motion_noise_frac = 0.1;    // of the commanded translation and rotation
-  double image_noise_sigma = 2.0;    // grey levels
-  double start_offset_m = 0.1;       // uniform in +-, x and y
-  double start_offset_deg = 3.0;     // uniform in +-
-  double timeout_factor = 3.0;       // of the taught duration
-  double max_repeat_speed_mps = 0.2; // suites: repeat at the teach speed, at most this
-  double success_radius_m = 0.5;     // final pose within this of the taught end
+  double motion_noise_frac = 0.1;     // of the commanded translation and rotation
+  double image_noise_sigma = 2.0;     // grey levels
+  double start_offset_m = 0.1;        // uniform in +-, x and y
+  double start_offset_deg = 3.0;      // uniform in +-
+  double timeout_factor = 3.0;        // of the taught duration
+  double max_repeat_speed_mps = 0.2;  // suites: repeat at the teach speed, at most this
+  double success_radius_m = 0.5;      // final pose within this of the taught end
   std::uint64_t seed = 1;
   void Validate() const;
 };
 
 struct RepeatRun {
-  bool success = false;     // completed, no collision, in time, and near the taught end
-  bool completed = false;   // passed the last keyframe
+  bool success = false;    // completed, no collision, in time, and near the taught end
+  bool completed = false;  // passed the last keyframe
   bool collided = false;
   double final_error_m = 0.0;
   double lateral_rms_m = 0.0;  // RMS distance of the repeated poses to the taught path
   double duration_s = 0.0;
   std::string status;
-  std::vector<Pose2> path;     // ground-truth poses of the repeat, one per frame
+  std::vector<Pose2> path;  // ground-truth poses of the repeat, one per frame
   std::vector<navigation::RepeatStep> steps;
 };
 
 // Called once per frame with the robot's true pose and the decision (for logs and pictures).
-using RepeatObserver = std::function<void(const Pose2&, const cv::Mat&, const navigation::RepeatStep&)>;
+using RepeatObserver =
+    std::function<void(const Pose2&, const cv::Mat&, const navigation::RepeatStep&)>;
 
 RepeatRun RepeatOnSimulator(const sim::Scenario& scenario, const TaughtRoute& taught,
                             const RepeatRunOptions& options, const RepeatObserver& observer = {});

@@ -35,14 +35,16 @@ const char* DetectorTypeName(DetectorType type) {
 void FeatureOptions::Validate() const {
   MAPLESS_CHECK(max_features >= 10 && max_features <= 100000,
                 "FeatureOptions.max_features = " << max_features << "; must be in [10, 100000]");
-  MAPLESS_CHECK(orb_fast_threshold >= 1 && orb_fast_threshold <= 255,
-                "FeatureOptions.orb_fast_threshold = " << orb_fast_threshold << "; must be in [1, 255]");
+  MAPLESS_CHECK(
+      orb_fast_threshold >= 1 && orb_fast_threshold <= 255,
+      "FeatureOptions.orb_fast_threshold = " << orb_fast_threshold << "; must be in [1, 255]");
   MAPLESS_CHECK(akaze_threshold > 0.0,
                 "FeatureOptions.akaze_threshold = " << akaze_threshold << "; must be > 0");
 }
 
 void MatchOptions::Validate() const {
-  MAPLESS_CHECK(ratio > 0.0 && ratio <= 1.0, "MatchOptions.ratio = " << ratio << "; must be in (0, 1]");
+  MAPLESS_CHECK(ratio > 0.0 && ratio <= 1.0,
+                "MatchOptions.ratio = " << ratio << "; must be in (0, 1]");
   MAPLESS_CHECK(max_dy_px > 0.0, "MatchOptions.max_dy_px = " << max_dy_px << "; must be > 0");
 }
 
@@ -91,7 +93,8 @@ std::vector<cv::DMatch> MatchFeatures(const Features& query, const Features& tra
     std::vector<cv::DMatch> back;
     matcher.match(train.descriptors, query.descriptors, back);
     best_query_for_train.assign(train.keypoints.size(), -1);
-    for (const auto& m : back) best_query_for_train[static_cast<std::size_t>(m.queryIdx)] = m.trainIdx;
+    for (const auto& m : back)
+      best_query_for_train[static_cast<std::size_t>(m.queryIdx)] = m.trainIdx;
   }
   for (const auto& k : knn) {
     if (k.empty()) continue;
@@ -99,7 +102,8 @@ std::vector<cv::DMatch> MatchFeatures(const Features& query, const Features& tra
     const cv::Point2f& a = query.keypoints[static_cast<std::size_t>(k[0].queryIdx)].pt;
     const cv::Point2f& b = train.keypoints[static_cast<std::size_t>(k[0].trainIdx)].pt;
     if (std::abs(b.y - a.y) > options.max_dy_px) continue;
-    if (options.mutual && best_query_for_train[static_cast<std::size_t>(k[0].trainIdx)] != k[0].queryIdx) {
+    if (options.mutual &&
+        best_query_for_train[static_cast<std::size_t>(k[0].trainIdx)] != k[0].queryIdx) {
       continue;
     }
     out.push_back(k[0]);

@@ -6,7 +6,6 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
-
 #include <string>
 #include <vector>
 
@@ -20,11 +19,11 @@ const char* DetectorTypeName(DetectorType type);
 
 struct FeatureOptions {
   DetectorType type = DetectorType::kOrb;
-  int max_features = 500;            // ORB and SIFT: keep at most this many (strongest first)
-  int orb_fast_threshold = 10;       // ORB: FAST corner threshold, grey levels (OpenCV's default
-                                     // is 20; 10 keeps features on low-texture walls)
-  double akaze_threshold = 0.0005;   // AKAZE: detector response threshold
-  void Validate() const;             // throws InputError naming the field
+  int max_features = 500;           // ORB and SIFT: keep at most this many (strongest first)
+  int orb_fast_threshold = 10;      // ORB: FAST corner threshold, grey levels (OpenCV's default
+                                    // is 20; 10 keeps features on low-texture walls)
+  double akaze_threshold = 0.0005;  // AKAZE: detector response threshold
+  void Validate() const;            // throws InputError naming the field
 };
 
 struct Features {
@@ -47,9 +46,9 @@ class FeatureExtractor {
 };
 
 struct MatchOptions {
-  double ratio = 0.85;          // Lowe's ratio test: best distance < ratio * second best
-  double max_dy_px = 1e9;       // reject matches whose vertical offset exceeds this
-  bool mutual = false;          // keep only matches that are also best in the other direction
+  double ratio = 0.85;     // Lowe's ratio test: best distance < ratio * second best
+  double max_dy_px = 1e9;  // reject matches whose vertical offset exceeds this
+  bool mutual = false;     // keep only matches that are also best in the other direction
   void Validate() const;
 };
 

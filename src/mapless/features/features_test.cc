@@ -79,7 +79,8 @@ TEST(TrackKlt, RecoversASubPixelTranslation) {
 
 TEST(TrackKlt, LosesPointsThatLeaveTheImageOrHitAnotherView) {
   const cv::Mat a = SimFrame("table1_almost_straight", Pose2{1.0, 0.0, 0.0});
-  const cv::Mat b = SimFrame("table1_almost_straight", Pose2{1.0, 0.0, kPi / 2});  // looking at a wall
+  const cv::Mat b =
+      SimFrame("table1_almost_straight", Pose2{1.0, 0.0, kPi / 2});  // looking at a wall
   std::vector<cv::Point2f> corners;
   cv::goodFeaturesToTrack(a, corners, 200, 0.01, 8);
   const KltResult r = TrackKlt(a, b, corners, KltOptions{});

@@ -11,8 +11,8 @@ void KltOptions::Validate() const {
                 "KltOptions.window_px = " << window_px << "; must be odd and in [5, 101]");
   MAPLESS_CHECK(pyramid_levels >= 0 && pyramid_levels <= 8,
                 "KltOptions.pyramid_levels = " << pyramid_levels << "; must be in [0, 8]");
-  MAPLESS_CHECK(max_forward_backward_px > 0.0,
-                "KltOptions.max_forward_backward_px = " << max_forward_backward_px << "; must be > 0");
+  MAPLESS_CHECK(max_forward_backward_px > 0.0, "KltOptions.max_forward_backward_px = "
+                                                   << max_forward_backward_px << "; must be > 0");
 }
 
 KltResult TrackKlt(const cv::Mat& previous, const cv::Mat& current,

@@ -40,7 +40,8 @@ ShiftEstimate VoteShift(const std::vector<double>& dx_px, double bin_px, int min
     if (std::abs(d - centre) <= 1.5 * bin_px) support.push_back(d);
   }
   out.inliers = static_cast<int>(support.size());
-  std::nth_element(support.begin(), support.begin() + static_cast<long>(support.size() / 2), support.end());
+  std::nth_element(support.begin(), support.begin() + static_cast<long>(support.size() / 2),
+                   support.end());
   out.dx_px = support[support.size() / 2];
   out.ok = out.inliers >= min_votes;
   return out;

@@ -6,7 +6,6 @@
 #pragma once
 
 #include <opencv2/core.hpp>
-
 #include <vector>
 
 #include "mapless/features/features.h"
@@ -15,17 +14,17 @@ namespace mapless::features {
 
 struct ShiftOptions {
   FeatureOptions features{DetectorType::kAkazeUpright};
-  MatchOptions matching;           // ratio 0.85 by default
-  double bin_px = 10.0;            // histogram bin width
-  int min_votes = 5;               // fewer supporting matches: not ok
+  MatchOptions matching;  // ratio 0.85 by default
+  double bin_px = 10.0;   // histogram bin width
+  int min_votes = 5;      // fewer supporting matches: not ok
   void Validate() const;
 };
 
 struct ShiftEstimate {
   bool ok = false;
-  double dx_px = 0.0;   // x_in_current - x_in_reference
-  int matches = 0;      // matches after the ratio test
-  int inliers = 0;      // matches that support dx
+  double dx_px = 0.0;  // x_in_current - x_in_reference
+  int matches = 0;     // matches after the ratio test
+  int inliers = 0;     // matches that support dx
 };
 
 // Votes over horizontal offsets (one per match); pure, for tests and other estimators.

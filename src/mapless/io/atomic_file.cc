@@ -7,10 +7,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <vector>
-
-#include <opencv2/imgcodecs.hpp>
 
 #include "mapless/core/check.h"
 
@@ -55,7 +54,8 @@ void WriteImageAtomic(const std::string& path, const cv::Mat& image) {
     ok = false;
   }
   if (!ok) throw InputError(path + ": cannot encode an image as '" + ext + "'");
-  WriteFileAtomic(path, std::string_view(reinterpret_cast<const char*>(buffer.data()), buffer.size()));
+  WriteFileAtomic(path,
+                  std::string_view(reinterpret_cast<const char*>(buffer.data()), buffer.size()));
 }
 
 std::string ReadFile(const std::string& path) {

@@ -3,11 +3,10 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
-#include <vector>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+#include <vector>
 
 #include "mapless/core/check.h"
 
@@ -27,7 +26,8 @@ class FolderSource : public FrameSource {
     for (const auto& entry : std::filesystem::directory_iterator(dir)) {
       if (!entry.is_regular_file()) continue;
       std::string ext = entry.path().extension().string();
-      std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+      std::transform(ext.begin(), ext.end(), ext.begin(),
+                     [](unsigned char c) { return std::tolower(c); });
       if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".pgm" ||
           ext == ".ppm" || ext == ".tif" || ext == ".tiff") {
         files_.push_back(entry.path().string());
@@ -47,9 +47,9 @@ class FolderSource : public FrameSource {
     }
     if (img.empty()) throw InputError(path + ": cannot read image");
     if (!size_.empty() && img.size() != size_) {
-      throw InputError(path + ": image is " + std::to_string(img.cols) + "x" + std::to_string(img.rows) +
-                       " but the folder's first image is " + std::to_string(size_.width) + "x" +
-                       std::to_string(size_.height));
+      throw InputError(path + ": image is " + std::to_string(img.cols) + "x" +
+                       std::to_string(img.rows) + " but the folder's first image is " +
+                       std::to_string(size_.width) + "x" + std::to_string(size_.height));
     }
     size_ = img.size();
     frame->image = img;
@@ -75,7 +75,8 @@ class VideoSource : public FrameSource {
   VideoSource(const std::string& spec, bool camera, int device) : spec_(spec) {
     const bool ok = camera ? capture_.open(device) : capture_.open(spec);
     if (!ok || !capture_.isOpened()) {
-      throw InputError(spec + (camera ? ": cannot open camera" : ": cannot open video (missing file or unknown format)"));
+      throw InputError(spec + (camera ? ": cannot open camera"
+                                      : ": cannot open video (missing file or unknown format)"));
     }
     fps_ = capture_.get(cv::CAP_PROP_FPS);
     if (!(fps_ > 0.0 && fps_ < 1000.0)) fps_ = 30.0;

@@ -2,9 +2,8 @@
 // camera device. Every source yields grey frames with timestamps.
 #pragma once
 
-#include <opencv2/core.hpp>
-
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 
 #include "mapless/core/pose.h"

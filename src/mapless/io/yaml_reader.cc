@@ -33,7 +33,8 @@ YamlMap YamlMap::LoadString(const std::string& text, const std::string& name) {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     std::ostringstream out;
-    out << name << ":" << e.mark.line + 1 << ":" << e.mark.column + 1 << ": malformed YAML: " << e.msg;
+    out << name << ":" << e.mark.line + 1 << ":" << e.mark.column + 1
+        << ": malformed YAML: " << e.msg;
     throw InputError(out.str());
   }
   if (!root.IsMap()) throw InputError(name + ":1:1: expected a YAML mapping at the top level");
@@ -174,8 +175,8 @@ void YamlMap::CheckKnownKeys(std::initializer_list<const char*> known) const {
   if (!node_.IsMap()) Fail("", "expected a mapping, got " + ShortValue(node_));
   for (const auto& kv : node_) {
     const std::string key = kv.first.as<std::string>();
-    const bool ok = std::any_of(known.begin(), known.end(),
-                                [&](const char* k) { return key == k; });
+    const bool ok =
+        std::any_of(known.begin(), known.end(), [&](const char* k) { return key == k; });
     if (!ok) {
       std::string list;
       for (const char* k : known) list += (list.empty() ? "" : ", ") + std::string(k);

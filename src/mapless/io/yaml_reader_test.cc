@@ -2,7 +2,6 @@
 
 #include <gtest/gtest.h>
 
-
 #include "mapless/core/check.h"
 #include "mapless/core/testing.h"
 
@@ -10,7 +9,8 @@ namespace mapless::io {
 namespace {
 
 TEST(YamlMap, ReadsTypedFieldsAndDefaults) {
-  const YamlMap m = YamlMap::LoadString("a: 1.5\nb: 3\nc: hello\nd: [1, 2, 3]\ne: true\n", "t.yaml");
+  const YamlMap m =
+      YamlMap::LoadString("a: 1.5\nb: 3\nc: hello\nd: [1, 2, 3]\ne: true\n", "t.yaml");
   EXPECT_DOUBLE_EQ(m.GetDouble("a"), 1.5);
   EXPECT_EQ(m.GetInt("b"), 3);
   EXPECT_EQ(m.GetString("c"), "hello");
@@ -20,16 +20,16 @@ TEST(YamlMap, ReadsTypedFieldsAndDefaults) {
 }
 
 TEST(YamlMap, MalformedYamlNamesFileAndLine) {
-  const std::string err = testing::InputErrorOf([] { YamlMap::LoadString("a: 1\nb: [1, 2\n", "bad.yaml"); });
+  const std::string err =
+      testing::InputErrorOf([] { YamlMap::LoadString("a: 1\nb: [1, 2\n", "bad.yaml"); });
   EXPECT_NE(err.find("bad.yaml:"), std::string::npos) << err;
   EXPECT_NE(err.find("malformed YAML"), std::string::npos) << err;
 }
 
 TEST(YamlMap, WrongTypeNamesFieldPathAndLine) {
   const YamlMap m = YamlMap::LoadString("world:\n  objects:\n    - size: [1, x]\n", "w.yaml");
-  const std::string err = testing::InputErrorOf([&] {
-    m.GetMap("world").GetMapList("objects")[0].GetDoubles("size", 2);
-  });
+  const std::string err = testing::InputErrorOf(
+      [&] { m.GetMap("world").GetMapList("objects")[0].GetDoubles("size", 2); });
   EXPECT_NE(err.find("w.yaml:3:"), std::string::npos) << err;
   EXPECT_NE(err.find("world.objects[0].size"), std::string::npos) << err;
 }

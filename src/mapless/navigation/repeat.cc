@@ -1,7 +1,6 @@
 #include "mapless/navigation/repeat.h"
 
 #include <algorithm>
-
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -15,14 +14,20 @@ Controller ParseController(const std::string& name) {
   throw InputError("unknown controller '" + name + "' (known: sloped, standard)");
 }
 
-const char* ControllerName(Controller c) { return c == Controller::kSloped ? "sloped" : "standard"; }
+const char* ControllerName(Controller c) {
+  return c == Controller::kSloped ? "sloped" : "standard";
+}
 
 const char* RepeatStatusName(RepeatStatus s) {
   switch (s) {
-    case RepeatStatus::kDriving: return "driving";
-    case RepeatStatus::kWaiting: return "waiting";
-    case RepeatStatus::kCompleted: return "completed";
-    case RepeatStatus::kAborted: return "aborted";
+    case RepeatStatus::kDriving:
+      return "driving";
+    case RepeatStatus::kWaiting:
+      return "waiting";
+    case RepeatStatus::kCompleted:
+      return "completed";
+    case RepeatStatus::kAborted:
+      return "aborted";
   }
   return "?";
 }
@@ -34,12 +39,14 @@ void RepeatOptions::Validate() const {
   sloped.Validate();
   standard.Validate();
   switch_rule.Validate();
-  MAPLESS_CHECK(min_features >= 2, "RepeatOptions.min_features = " << min_features << "; must be >= 2");
-  MAPLESS_CHECK(redetect_every_frames >= 0,
-                "RepeatOptions.redetect_every_frames = " << redetect_every_frames << "; must be >= 0");
-  MAPLESS_CHECK(abort_after_s > 0.0, "RepeatOptions.abort_after_s = " << abort_after_s << "; must be > 0");
-  MAPLESS_CHECK(switch_confirm_frames >= 1,
-                "RepeatOptions.switch_confirm_frames = " << switch_confirm_frames << "; must be >= 1");
+  MAPLESS_CHECK(min_features >= 2,
+                "RepeatOptions.min_features = " << min_features << "; must be >= 2");
+  MAPLESS_CHECK(redetect_every_frames >= 0, "RepeatOptions.redetect_every_frames = "
+                                                << redetect_every_frames << "; must be >= 0");
+  MAPLESS_CHECK(abort_after_s > 0.0,
+                "RepeatOptions.abort_after_s = " << abort_after_s << "; must be > 0");
+  MAPLESS_CHECK(switch_confirm_frames >= 1, "RepeatOptions.switch_confirm_frames = "
+                                                << switch_confirm_frames << "; must be >= 1");
   MAPLESS_CHECK(min_switch_features >= 2,
                 "RepeatOptions.min_switch_features = " << min_switch_features << "; must be >= 2");
   MAPLESS_CHECK(ransac_threshold_px >= 0.0,
@@ -54,13 +61,13 @@ RepeatSession::RepeatSession(std::shared_ptr<const route::Route> route, RepeatOp
       extractor_((options.Validate(), options.features)),
       mse_(options.mse_rising_frames) {
   MAPLESS_CHECK(route_ != nullptr, "RepeatSession: no route");
-  MAPLESS_CHECK(route_->keyframes.size() >= 2,
-                "RepeatSession: the route has " << route_->keyframes.size()
-                                                << " keyframe(s); at least 2 are needed");
+  MAPLESS_CHECK(route_->keyframes.size() >= 2, "RepeatSession: the route has "
+                                                   << route_->keyframes.size()
+                                                   << " keyframe(s); at least 2 are needed");
   MAPLESS_CHECK(route_->detector == features::DetectorTypeName(options_.features.type),
-                "RepeatSession: the route was taught with '" << route_->detector
-                                                             << "' features but the repeat uses '"
-                                                             << features::DetectorTypeName(options_.features.type) << "'");
+                "RepeatSession: the route was taught with '"
+                    << route_->detector << "' features but the repeat uses '"
+                    << features::DetectorTypeName(options_.features.type) << "'");
   for (const auto& kf : route_->keyframes) {
     features::Features f;
     f.keypoints = kf.keypoints;
@@ -100,7 +107,9 @@ void RepeatSession::DetectAndMatch(const cv::Mat& grey, RepeatStep* step) {
                                              options_.ransac_threshold_px, 0.99, inlier_f);
     const cv::Mat hom = cv::findHomography(current_px_, destination_px_, cv::RANSAC,
                                            options_.ransac_threshold_px, inlier_h);
-    const auto count = [](const std::vector<uchar>& m) { return std::count(m.begin(), m.end(), 1); };
+    const auto count = [](const std::vector<uchar>& m) {
+      return std::count(m.begin(), m.end(), 1);
+    };
     const long nf = f.empty() || inlier_f.size() != current_px_.size() ? 0 : count(inlier_f);
     const long nh = hom.empty() || inlier_h.size() != current_px_.size() ? 0 : count(inlier_h);
     if (nf > 0 || nh > 0) {
@@ -131,22 +140,25 @@ RepeatStep RepeatSession::Stop(RepeatStep step, RepeatStatus status, const std::
 RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
   RepeatStep step;
   step.destination = destination_;
-  if (finished()) return Stop(step, status_, status_ == RepeatStatus::kCompleted ? "route completed" : "aborted");
+  if (finished())
+    return Stop(step, status_, status_ == RepeatStatus::kCompleted ? "route completed" : "aborted");
   MAPLESS_CHECK(!image.empty(), "RepeatSession: empty frame");
   cv::Mat grey = image;
   if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
   MAPLESS_CHECK(grey.cols == route_->image_width && grey.rows == route_->image_height,
-                "RepeatSession: frame is " << grey.cols << "x" << grey.rows << " but the route was taught at "
-                                           << route_->image_width << "x" << route_->image_height);
+                "RepeatSession: frame is " << grey.cols << "x" << grey.rows
+                                           << " but the route was taught at " << route_->image_width
+                                           << "x" << route_->image_height);
 
   // Periodic refresh (an option; see RepeatOptions::redetect_every_frames): no point tracking
   // features that are about to be replaced.
   ++frames_since_detect_;
-  const bool refresh = options_.redetect_every_frames > 0 &&
-                       frames_since_detect_ >= options_.redetect_every_frames;
+  const bool refresh =
+      options_.redetect_every_frames > 0 && frames_since_detect_ >= options_.redetect_every_frames;
   // Algorithm 1, lines 16-18: track the matched features inside the segment.
   if (!refresh && !previous_.empty() && !current_px_.empty()) {
-    const features::KltResult tracked = features::TrackKlt(previous_, grey, current_px_, options_.klt);
+    const features::KltResult tracked =
+        features::TrackKlt(previous_, grey, current_px_, options_.klt);
     std::vector<cv::Point2f> cur, dst;
     for (std::size_t i = 0; i < current_px_.size(); ++i) {
       if (!tracked.ok[i]) continue;
@@ -158,7 +170,8 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
   }
   previous_ = grey.clone();
   // Lines 20-27: too few features left, detect and match again (or refresh).
-  if (static_cast<int>(current_px_.size()) < options_.min_features || refresh) DetectAndMatch(grey, &step);
+  if (static_cast<int>(current_px_.size()) < options_.min_features || refresh)
+    DetectAndMatch(grey, &step);
   step.matches = last_matches_;
   step.tracked = static_cast<int>(current_px_.size());
   if (step.tracked < options_.min_features) {
@@ -176,7 +189,8 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
     }
     step = Stop(step, RepeatStatus::kWaiting,
                 "stopped: only " + std::to_string(step.tracked) + " features match keyframe " +
-                    std::to_string(destination_) + " (need " + std::to_string(options_.min_features) + ")");
+                    std::to_string(destination_) + " (need " +
+                    std::to_string(options_.min_features) + ")");
     status_ = RepeatStatus::kDriving;  // waiting is per frame; the session is not finished
     return step;
   }

@@ -13,9 +13,8 @@
 // point, taken as the image centre: no calibration.
 #pragma once
 
-#include <opencv2/core.hpp>
-
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
@@ -34,18 +33,18 @@ const char* ControllerName(Controller c);
 struct RepeatOptions {
   Controller controller = Controller::kSloped;
   Switching switching = Switching::kStdRatio;
-  features::FeatureOptions features;            // must describe like the route's detector
+  features::FeatureOptions features;                 // must describe like the route's detector
   features::MatchOptions matching{0.8, 60.0, true};  // ratio, max |dy| px, mutual
   features::KltOptions klt;
   control::SlopedFunnelLaneOptions sloped;
   control::StandardFunnelLaneOptions standard;
   control::SwitchOptions switch_rule;
   int mse_rising_frames = 2;
-  int switch_confirm_frames = 3;       // the StdRatio/ED condition must hold this many frames
-  int min_switch_features = 20;        // no switching on fewer features (their spread is noise)
-  double ransac_threshold_px = 3.0;    // outlier rejection of matches by a fundamental matrix
-                                       // (RANSAC, needs no calibration); 0 disables it
-  int min_features = 10;        // NoF threshold of Algorithm 1
+  int switch_confirm_frames = 3;     // the StdRatio/ED condition must hold this many frames
+  int min_switch_features = 20;      // no switching on fewer features (their spread is noise)
+  double ransac_threshold_px = 3.0;  // outlier rejection of matches by a fundamental matrix
+                                     // (RANSAC, needs no calibration); 0 disables it
+  int min_features = 10;             // NoF threshold of Algorithm 1
   // Also detect and match afresh every this many frames (0: only when features run short, as in
   // Algorithm 1). KLT tracks drift over long segments and bias StdRatio (the switch then comes
   // up to 1 m early or late); fresh matches do not. Default: every frame.
@@ -60,16 +59,16 @@ const char* RepeatStatusName(RepeatStatus s);
 // What one frame decided (logged as JSON lines by the apps).
 struct RepeatStep {
   RepeatStatus status = RepeatStatus::kDriving;
-  std::string reason;          // why the robot is waiting, stopped or aborted
-  int destination = 1;         // destination keyframe of the current segment
-  int matches = 0;             // matches at the last detection
-  int tracked = 0;             // features in use this frame
-  bool redetected = false;     // features were detected and matched this frame
-  bool switched = false;       // the segment switched this frame
+  std::string reason;       // why the robot is waiting, stopped or aborted
+  int destination = 1;      // destination keyframe of the current segment
+  int matches = 0;          // matches at the last detection
+  int tracked = 0;          // features in use this frame
+  bool redetected = false;  // features were detected and matched this frame
+  bool switched = false;    // the segment switched this frame
   control::SwitchDecision switching;
   control::SlopedFunnelLaneResult sloped;
   control::StandardFunnelLaneResult standard;
-  Twist2 command;              // zero unless driving
+  Twist2 command;  // zero unless driving
 };
 
 class RepeatSession {

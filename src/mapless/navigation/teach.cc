@@ -12,8 +12,8 @@ void TeachOptions::Validate() const {
   MAPLESS_CHECK(keyframe_tracked_fraction > 0.0 && keyframe_tracked_fraction < 1.0,
                 "TeachOptions.keyframe_tracked_fraction = " << keyframe_tracked_fraction
                                                             << "; must be in (0, 1)");
-  MAPLESS_CHECK(min_keyframe_features >= 0,
-                "TeachOptions.min_keyframe_features = " << min_keyframe_features << "; must be >= 0");
+  MAPLESS_CHECK(min_keyframe_features >= 0, "TeachOptions.min_keyframe_features = "
+                                                << min_keyframe_features << "; must be >= 0");
   MAPLESS_CHECK(thumbnail_width_px >= 16,
                 "TeachOptions.thumbnail_width_px = " << thumbnail_width_px << "; must be >= 16");
 }
@@ -22,8 +22,9 @@ TeachSession::TeachSession(TeachOptions options)
     : options_(options), extractor_((options.Validate(), options.features)) {}
 
 double TeachSession::tracked_fraction() const {
-  return initial_count_ == 0 ? 0.0
-                             : static_cast<double>(current_.size()) / static_cast<double>(initial_count_);
+  return initial_count_ == 0
+             ? 0.0
+             : static_cast<double>(current_.size()) / static_cast<double>(initial_count_);
 }
 
 route::Keyframe TeachSession::MakeKeyframe(const cv::Mat& grey, Timestamp t_ns) {
@@ -54,8 +55,8 @@ std::optional<route::Keyframe> TeachSession::Update(const cv::Mat& image, Timest
     out = MakeKeyframe(grey, t_ns);
   } else {
     MAPLESS_CHECK(grey.size() == previous_.size(), "TeachSession: frame size changed from "
-                                                       << previous_.cols << "x" << previous_.rows << " to "
-                                                       << grey.cols << "x" << grey.rows);
+                                                       << previous_.cols << "x" << previous_.rows
+                                                       << " to " << grey.cols << "x" << grey.rows);
     const features::KltResult tracked = features::TrackKlt(previous_, grey, current_, options_.klt);
     std::vector<cv::Point2f> kept_start;
     std::vector<cv::Point2f> kept_current;

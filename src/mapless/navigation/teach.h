@@ -6,7 +6,6 @@
 #pragma once
 
 #include <opencv2/core.hpp>
-
 #include <optional>
 #include <vector>
 
@@ -17,8 +16,8 @@
 namespace mapless::navigation {
 
 struct TeachOptions {
-  features::FeatureOptions features;       // ORB, 500 features by default
-  features::KltOptions klt;                // 31x31 window, as in the paper
+  features::FeatureOptions features;  // ORB, 500 features by default
+  features::KltOptions klt;           // 31x31 window, as in the paper
   // New keyframe when fewer than this fraction of the tracked features survive. The paper uses
   // 0.5; our KLT (with a forward-backward check) keeps features longer than the paper's tracker,
   // and 0.5 leaves keyframes 3-4 m apart: too sparse through sharp low-texture turns (see
@@ -27,7 +26,7 @@ struct TeachOptions {
   // A frame with fewer features than this never becomes a keyframe (the repeat could not match
   // it); the keyframe is deferred to the next frame that has enough, and the deferral counted.
   int min_keyframe_features = 30;
-  int thumbnail_width_px = 160;            // width of the stored downscaled image
+  int thumbnail_width_px = 160;  // width of the stored downscaled image
   void Validate() const;
 };
 

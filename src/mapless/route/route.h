@@ -5,7 +5,6 @@
 #pragma once
 
 #include <opencv2/core.hpp>
-
 #include <string>
 #include <vector>
 
@@ -16,19 +15,19 @@ namespace mapless::route {
 struct Keyframe {
   int index = 0;
   Timestamp t_ns = 0;
-  cv::Mat thumbnail;                       // downscaled grey image
-  std::vector<cv::KeyPoint> keypoints;     // in full-image pixels
-  cv::Mat descriptors;                     // one row per keypoint
+  cv::Mat thumbnail;                    // downscaled grey image
+  std::vector<cv::KeyPoint> keypoints;  // in full-image pixels
+  cv::Mat descriptors;                  // one row per keypoint
   // Features tracked from the previous keyframe to this one (empty for the first keyframe).
   std::vector<cv::Point2f> segment_start_px;
   std::vector<cv::Point2f> segment_end_px;
 };
 
 struct Route {
-  std::string detector = "orb";   // features::DetectorTypeName of the descriptors
-  int image_width = 0;             // size of the images the features were measured in
+  std::string detector = "orb";  // features::DetectorTypeName of the descriptors
+  int image_width = 0;           // size of the images the features were measured in
   int image_height = 0;
-  bool complete = false;           // false: the teach was interrupted (the keyframes are intact)
+  bool complete = false;  // false: the teach was interrupted (the keyframes are intact)
   std::vector<Keyframe> keyframes;
 };
 

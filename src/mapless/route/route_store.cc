@@ -3,7 +3,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
-
 #include <opencv2/core/persistence.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -20,9 +19,10 @@ std::string KeyframeStem(int index) {
 }
 
 std::string SerializeKeyframe(const Keyframe& kf) {
-  cv::FileStorage fs(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY |
-                                 cv::FileStorage::FORMAT_YAML);
-  fs << "format" << "mapless-keyframe";
+  cv::FileStorage fs(
+      ".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+  fs << "format"
+     << "mapless-keyframe";
   fs << "version" << kRouteFormatVersion;
   fs << "index" << kf.index;
   fs << "t_ns" << std::to_string(kf.t_ns);
@@ -69,7 +69,8 @@ Keyframe ReadKeyframe(const std::string& path, const std::string& thumbnail_path
   } catch (const cv::Exception&) {
     kf.thumbnail.release();
   }
-  if (kf.thumbnail.empty()) throw InputError(thumbnail_path + ": missing or corrupt keyframe image");
+  if (kf.thumbnail.empty())
+    throw InputError(thumbnail_path + ": missing or corrupt keyframe image");
   return kf;
 }
 
@@ -77,9 +78,13 @@ Keyframe ReadKeyframe(const std::string& path, const std::string& thumbnail_path
 
 RouteWriter::RouteWriter(std::string dir, std::string detector, int image_width, int image_height,
                          bool overwrite)
-    : dir_(std::move(dir)), detector_(std::move(detector)), width_(image_width), height_(image_height) {
-  MAPLESS_CHECK(image_width > 0 && image_height > 0,
-                "RouteWriter: image size " << image_width << "x" << image_height << " must be positive");
+    : dir_(std::move(dir)),
+      detector_(std::move(detector)),
+      width_(image_width),
+      height_(image_height) {
+  MAPLESS_CHECK(image_width > 0 && image_height > 0, "RouteWriter: image size "
+                                                         << image_width << "x" << image_height
+                                                         << " must be positive");
   const std::filesystem::path manifest = std::filesystem::path(dir_) / "manifest.json";
   if (std::filesystem::exists(manifest) && !overwrite) {
     throw InputError(dir_ + ": already holds a route (manifest.json); choose another directory");
@@ -94,7 +99,8 @@ RouteWriter::RouteWriter(std::string dir, std::string detector, int image_width,
 void RouteWriter::Append(const Keyframe& keyframe) {
   MAPLESS_CHECK(keyframe.index == keyframes(),
                 "RouteWriter: keyframe index " << keyframe.index << ", expected " << keyframes());
-  MAPLESS_CHECK(!keyframe.thumbnail.empty(), "RouteWriter: keyframe " << keyframe.index << " has no image");
+  MAPLESS_CHECK(!keyframe.thumbnail.empty(),
+                "RouteWriter: keyframe " << keyframe.index << " has no image");
   const std::filesystem::path base = std::filesystem::path(dir_) / KeyframeStem(keyframe.index);
   io::WriteFileAtomic(base.string() + ".yml", SerializeKeyframe(keyframe));
   io::WriteImageAtomic(base.string() + ".png", keyframe.thumbnail);
@@ -152,7 +158,8 @@ Route LoadRoute(const std::string& dir) {
     route.image_height = j.at("image_height").get<int>();
     route.complete = j.at("complete").get<bool>();
     for (const auto& entry : j.at("keyframes")) {
-      const std::string data = (std::filesystem::path(dir) / entry.at("data").get<std::string>()).string();
+      const std::string data =
+          (std::filesystem::path(dir) / entry.at("data").get<std::string>()).string();
       const std::string thumb =
           (std::filesystem::path(dir) / entry.at("thumbnail").get<std::string>()).string();
       Keyframe kf = ReadKeyframe(data, thumb);

@@ -31,7 +31,8 @@ Keyframe MakeKeyframe(int index) {
   }
   kf.descriptors = cv::Mat(50, 32, CV_8UC1);
   for (int r = 0; r < 50; ++r) {
-    for (int c = 0; c < 32; ++c) kf.descriptors.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(rng.UniformInt(256));
+    for (int c = 0; c < 32; ++c)
+      kf.descriptors.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(rng.UniformInt(256));
   }
   if (index > 0) {
     kf.segment_start_px = {{10, 20}, {30, 40}};
@@ -79,7 +80,9 @@ TEST(RouteStore, AnUnfinishedTeachLoadsWithItsCompletedKeyframes) {
 TEST(RouteStore, RefusesToOverwriteAnExistingRoute) {
   const std::string dir = FreshDir("overwrite");
   { RouteWriter writer(dir, "orb", 320, 240); }
-  EXPECT_NE(testing::InputErrorOf([&] { RouteWriter again(dir, "orb", 320, 240); }).find("already holds a route"),
+  EXPECT_NE(testing::InputErrorOf([&] {
+              RouteWriter again(dir, "orb", 320, 240);
+            }).find("already holds a route"),
             std::string::npos);
   EXPECT_NO_THROW(RouteWriter(dir, "orb", 320, 240, /*overwrite=*/true));
 }
@@ -112,8 +115,9 @@ TEST(RouteStore, CorruptOrMissingFilesGiveOneClearError) {
   EXPECT_NE(testing::InputErrorOf([&] { LoadRoute(dir); }).find("manifest.json: corrupt manifest"),
             std::string::npos);
   // No route at all.
-  EXPECT_NE(testing::InputErrorOf([&] { LoadRoute(dir + "/nothing"); }).find("manifest.json is missing"),
-            std::string::npos);
+  EXPECT_NE(
+      testing::InputErrorOf([&] { LoadRoute(dir + "/nothing"); }).find("manifest.json is missing"),
+      std::string::npos);
 }
 
 TEST(RouteStore, NewerFormatVersionIsRefusedByName) {
@@ -122,7 +126,9 @@ TEST(RouteStore, NewerFormatVersionIsRefusedByName) {
   std::string manifest = io::ReadFile(dir + "/manifest.json");
   manifest.replace(manifest.find("\"version\": 1"), 12, "\"version\": 9");
   io::WriteFileAtomic(dir + "/manifest.json", manifest);
-  EXPECT_NE(testing::InputErrorOf([&] { LoadRoute(dir); }).find("route format version 9 is not supported"),
+  EXPECT_NE(testing::InputErrorOf([&] {
+              LoadRoute(dir);
+            }).find("route format version 9 is not supported"),
             std::string::npos);
 }
 

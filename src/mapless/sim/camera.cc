@@ -18,10 +18,12 @@ CameraModel CameraModel::FromFov(int width, int height, double hfov_rad) {
 }
 
 void CameraModel::Validate() const {
-  MAPLESS_CHECK(width >= 16 && width <= 4096, "CameraModel.width = " << width << "; must be in [16, 4096]");
+  MAPLESS_CHECK(width >= 16 && width <= 4096,
+                "CameraModel.width = " << width << "; must be in [16, 4096]");
   MAPLESS_CHECK(height >= 16 && height <= 4096,
                 "CameraModel.height = " << height << "; must be in [16, 4096]");
-  MAPLESS_CHECK(fx > 0.0 && fy > 0.0, "CameraModel.fx, fy = " << fx << ", " << fy << "; must be > 0");
+  MAPLESS_CHECK(fx > 0.0 && fy > 0.0,
+                "CameraModel.fx, fy = " << fx << ", " << fy << "; must be > 0");
 }
 
 std::optional<Eigen::Vector2d> CameraModel::Project(const Eigen::Vector3d& p_cam) const {

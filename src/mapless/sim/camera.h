@@ -7,7 +7,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
 #include <optional>
 
 #include "mapless/core/pose.h"
@@ -31,10 +30,10 @@ struct CameraModel {
 };
 
 struct CameraMount {
-  double height_m = 0.4;    // optical centre above the ground
-  double pitch_rad = 0.0;   // downward tilt of the optical axis
-  double forward_m = 0.0;   // optical centre ahead of the rotation axis
-  double lateral_m = 0.0;   // optical centre to the left of the rotation axis
+  double height_m = 0.4;   // optical centre above the ground
+  double pitch_rad = 0.0;  // downward tilt of the optical axis
+  double forward_m = 0.0;  // optical centre ahead of the rotation axis
+  double lateral_m = 0.0;  // optical centre to the left of the rotation axis
   void Validate() const;
 };
 

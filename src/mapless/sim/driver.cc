@@ -8,7 +8,8 @@
 namespace mapless::sim {
 
 void DriverOptions::Validate() const {
-  MAPLESS_CHECK(lookahead_m > 0.0, "DriverOptions.lookahead_m = " << lookahead_m << "; must be > 0");
+  MAPLESS_CHECK(lookahead_m > 0.0,
+                "DriverOptions.lookahead_m = " << lookahead_m << "; must be > 0");
   MAPLESS_CHECK(goal_tolerance_m > 0.0,
                 "DriverOptions.goal_tolerance_m = " << goal_tolerance_m << "; must be > 0");
   MAPLESS_CHECK(rotate_speed_radps > 0.0,
@@ -67,7 +68,8 @@ Twist2 ScriptedDriver::Rotate(const Pose2& pose) {
     leg_started_ = false;
     return Twist2{};
   }
-  const double omega = std::clamp(2.0 * err, -options_.rotate_speed_radps, options_.rotate_speed_radps);
+  const double omega =
+      std::clamp(2.0 * err, -options_.rotate_speed_radps, options_.rotate_speed_radps);
   return Twist2{0.0, std::abs(omega) < 0.08 ? std::copysign(0.08, err) : omega};
 }
 
@@ -121,7 +123,8 @@ Twist2 ScriptedDriver::FollowPolyline(const Pose2& pose) {
   while (seg + 2 < leg.points.size() && cum[seg + 1] < progress_m_) ++seg;
   const double speed = leg.speeds[seg];
   // Look-ahead point; near the end aim at the end itself.
-  const Eigen::Vector2d target = remaining < options_.lookahead_m ? end : point_at(progress_m_ + options_.lookahead_m);
+  const Eigen::Vector2d target =
+      remaining < options_.lookahead_m ? end : point_at(progress_m_ + options_.lookahead_m);
   const Eigen::Vector2d d = target - p;
   const double c = std::cos(pose.theta_rad);
   const double s = std::sin(pose.theta_rad);
@@ -131,7 +134,8 @@ Twist2 ScriptedDriver::FollowPolyline(const Pose2& pose) {
   const double dist = std::max(d.norm(), 1e-3);
   // Turn in place while the path is far off the heading (start of a leg, or after a rotation).
   if (std::abs(alpha) > options_.turn_in_place_above_rad || (aligning_ && std::abs(alpha) > 0.1)) {
-    return Twist2{0.0, std::clamp(2.0 * alpha, -options_.rotate_speed_radps, options_.rotate_speed_radps)};
+    return Twist2{
+        0.0, std::clamp(2.0 * alpha, -options_.rotate_speed_radps, options_.rotate_speed_radps)};
   }
   aligning_ = false;
   double v = std::min(speed, std::sqrt(2.0 * options_.decel_mps2 * remaining));

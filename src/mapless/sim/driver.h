@@ -12,12 +12,12 @@
 namespace mapless::sim {
 
 struct DriverOptions {
-  double lookahead_m = 0.35;            // pure-pursuit look-ahead distance
-  double goal_tolerance_m = 0.03;       // a leg ends within this distance of its last point
-  double rotate_tolerance_rad = 0.01;   // a rotation ends within this heading error
-  double rotate_speed_radps = 0.6;      // turn rate for rotations in place
-  double turn_in_place_above_rad = 1.2; // heading error above which the robot turns in place
-  double decel_mps2 = 0.4;              // planned deceleration before the end of a leg
+  double lookahead_m = 0.35;             // pure-pursuit look-ahead distance
+  double goal_tolerance_m = 0.03;        // a leg ends within this distance of its last point
+  double rotate_tolerance_rad = 0.01;    // a rotation ends within this heading error
+  double rotate_speed_radps = 0.6;       // turn rate for rotations in place
+  double turn_in_place_above_rad = 1.2;  // heading error above which the robot turns in place
+  double decel_mps2 = 0.4;               // planned deceleration before the end of a leg
   void Validate() const;
 };
 
@@ -43,7 +43,7 @@ class ScriptedDriver {
   DriverOptions options_;
   std::vector<Leg> legs_;
   std::size_t leg_ = 0;
-  double progress_m_ = 0.0;        // arc length reached along the current polyline
+  double progress_m_ = 0.0;  // arc length reached along the current polyline
   bool leg_started_ = false;
   double rotate_target_rad_ = 0.0;
   bool aligning_ = false;

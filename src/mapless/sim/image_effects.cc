@@ -7,7 +7,8 @@
 namespace mapless::sim {
 
 void ImageEffects::Validate() const {
-  MAPLESS_CHECK(noise_sigma >= 0.0, "ImageEffects.noise_sigma = " << noise_sigma << "; must be >= 0");
+  MAPLESS_CHECK(noise_sigma >= 0.0,
+                "ImageEffects.noise_sigma = " << noise_sigma << "; must be >= 0");
   MAPLESS_CHECK(invert_fraction >= 0.0 && invert_fraction <= 1.0,
                 "ImageEffects.invert_fraction = " << invert_fraction << "; must be in [0, 1]");
   MAPLESS_CHECK(gain >= 0.0, "ImageEffects.gain = " << gain << "; must be >= 0");
@@ -38,7 +39,8 @@ cv::Mat ApplyEffects(const cv::Mat& image, const ImageEffects& effects, Rng* rng
     for (int y = 0; y < out.rows; ++y) {
       auto* row = out.ptr<std::uint8_t>(y);
       for (int x = 0; x < out.cols; ++x) {
-        if (rng->Uniform() < effects.invert_fraction) row[x] = static_cast<std::uint8_t>(255 - row[x]);
+        if (rng->Uniform() < effects.invert_fraction)
+          row[x] = static_cast<std::uint8_t>(255 - row[x]);
       }
     }
   }

@@ -12,7 +12,8 @@ namespace {
 cv::Mat Ramp() {
   cv::Mat img(60, 80, CV_8UC1);
   for (int y = 0; y < img.rows; ++y) {
-    for (int x = 0; x < img.cols; ++x) img.at<std::uint8_t>(y, x) = static_cast<std::uint8_t>(40 + 2 * x);
+    for (int x = 0; x < img.cols; ++x)
+      img.at<std::uint8_t>(y, x) = static_cast<std::uint8_t>(40 + 2 * x);
   }
   return img;
 }
@@ -74,7 +75,8 @@ TEST(ImageEffects, InvalidValuesNameTheField) {
     e.Validate();
     FAIL();
   } catch (const InputError& err) {
-    EXPECT_NE(std::string(err.what()).find("ImageEffects.invert_fraction = 1.5"), std::string::npos);
+    EXPECT_NE(std::string(err.what()).find("ImageEffects.invert_fraction = 1.5"),
+              std::string::npos);
   }
 }
 

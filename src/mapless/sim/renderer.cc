@@ -46,8 +46,8 @@ struct Prepared {
   float shade;
   const Texture::LevelView* levels;  // mip pyramid, levels[0] finest
   int max_level;
-  int x0, x1, y0, y1;      // inclusive screen bounds
-  int group;               // edge group (see Surface::edge_group), made unique per render
+  int x0, x1, y0, y1;  // inclusive screen bounds
+  int group;           // edge group (see Surface::edge_group), made unique per render
 };
 
 struct Hit {
@@ -88,7 +88,8 @@ inline float ShadeHit(const Prepared& p, const Hit& h, float lod_slope) {
   // With t = k / (n.d) this is 0.5 log2(k^2 L) - 0.5 (3 + a) log2|n.d|: one log per pixel.
   const float lod = p.lod_base - lod_slope * FastLog2(std::max(std::abs(h.nd), 1e-6f));
   constexpr float kInv16 = 1.0f / 65536.0f;
-  if (lod <= 0.0f) return p.shade * kInv16 * static_cast<float>(BilinearFixed(p.levels[0], 0, s_fx, t_fx));
+  if (lod <= 0.0f)
+    return p.shade * kInv16 * static_cast<float>(BilinearFixed(p.levels[0], 0, s_fx, t_fx));
   if (lod >= static_cast<float>(p.max_level)) return p.shade * p.levels[p.max_level].data[0];
   const int l0 = static_cast<int>(lod);
   const float w = lod - static_cast<float>(l0);
@@ -155,7 +156,8 @@ bool Prepare(const Surface& s, const CameraModel& cam, const Rigid3& camera_from
       break;
     }
     case Surface::Shape::kDisk: {
-      const std::vector<Eigen::Vector3d> poly = {o - e1 - e2, o + e1 - e2, o + e1 + e2, o - e1 + e2};
+      const std::vector<Eigen::Vector3d> poly = {o - e1 - e2, o + e1 - e2, o + e1 + e2,
+                                                 o - e1 + e2};
       if (!ScreenBounds(poly, cam, options.near_m, &p.x0, &p.x1, &p.y0, &p.y1)) return false;
       break;
     }
@@ -234,8 +236,8 @@ struct Buffers {
 template <Surface::Shape kShape>
 void RasterRow(const Prepared& p, std::int32_t index, float nd_row, float a1_row, float a2_row,
                float near_m, float far_m, const float* __restrict xs, float* __restrict depth,
-               std::int32_t* __restrict id, float* __restrict alpha_out,
-               float* __restrict beta_out, float* __restrict nd_out) {
+               std::int32_t* __restrict id, float* __restrict alpha_out, float* __restrict beta_out,
+               float* __restrict nd_out) {
   const float nx = p.nx, k = p.k, a1x = p.a1x, c1 = p.c1, a2x = p.a2x, c2 = p.c2;
   const int x_begin = p.x0;
   const int x_end = p.x1 + 1;  // half-open, so that the trip count is computable
@@ -399,7 +401,7 @@ void AppendObjectSurfaces(const WorldObject& o, std::shared_ptr<const Texture> t
       const Eigen::Vector3d facing(std::cos(o.yaw_rad), std::sin(o.yaw_rad), 0.0);
       const Eigen::Vector3d right = up.cross(facing) * -1.0;  // viewer's right when facing it
       const Eigen::Vector3d e1 = right * o.size_m.x();
-      const Eigen::Vector3d e2 = -up * o.size_m.y();          // top to bottom, like the image
+      const Eigen::Vector3d e2 = -up * o.size_m.y();  // top to bottom, like the image
       const Eigen::Vector3d centre(o.center.x(), o.center.y(), o.z_m);
       add(Surface::Shape::kParallelogram, centre - 0.5 * e1 - 0.5 * e2, e1, e2, false);
       break;
@@ -423,7 +425,8 @@ Renderer::Renderer(const World& world, RenderOptions options) : options_(options
     if (it == cache.end()) it = cache.emplace(key, GenerateTexture(spec)).first;
     return it->second;
   };
-  for (const WorldObject& o : world.objects) AppendObjectSurfaces(o, texture_for(o.texture), &surfaces_);
+  for (const WorldObject& o : world.objects)
+    AppendObjectSurfaces(o, texture_for(o.texture), &surfaces_);
   Surface ground;
   ground.shape = Surface::Shape::kPlane;
   ground.origin = Eigen::Vector3d::Zero();
@@ -468,8 +471,10 @@ cv::Mat Renderer::Render(const CameraModel& cam, const Rigid3& world_from_camera
 
   std::vector<float> xd(static_cast<std::size_t>(w));
   std::vector<float> yd(static_cast<std::size_t>(h));
-  for (int x = 0; x < w; ++x) xd[static_cast<std::size_t>(x)] = static_cast<float>((x - cam.cx) / cam.fx);
-  for (int y = 0; y < h; ++y) yd[static_cast<std::size_t>(y)] = static_cast<float>((y - cam.cy) / cam.fy);
+  for (int x = 0; x < w; ++x)
+    xd[static_cast<std::size_t>(x)] = static_cast<float>((x - cam.cx) / cam.fx);
+  for (int y = 0; y < h; ++y)
+    yd[static_cast<std::size_t>(y)] = static_cast<float>((y - cam.cy) / cam.fy);
 
   const std::size_t npix = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
   Buffers buf;
@@ -485,13 +490,16 @@ cv::Mat Renderer::Render(const CameraModel& cam, const Rigid3& world_from_camera
     const Prepared& p = prepared[si];
     switch (p.shape) {
       case Surface::Shape::kParallelogram:
-        RasterSurface<Surface::Shape::kParallelogram>(p, static_cast<std::int32_t>(si), xd, yd, w, near_m, far_m, &buf);
+        RasterSurface<Surface::Shape::kParallelogram>(p, static_cast<std::int32_t>(si), xd, yd, w,
+                                                      near_m, far_m, &buf);
         break;
       case Surface::Shape::kDisk:
-        RasterSurface<Surface::Shape::kDisk>(p, static_cast<std::int32_t>(si), xd, yd, w, near_m, far_m, &buf);
+        RasterSurface<Surface::Shape::kDisk>(p, static_cast<std::int32_t>(si), xd, yd, w, near_m,
+                                             far_m, &buf);
         break;
       case Surface::Shape::kPlane:
-        RasterSurface<Surface::Shape::kPlane>(p, static_cast<std::int32_t>(si), xd, yd, w, near_m, far_m, &buf);
+        RasterSurface<Surface::Shape::kPlane>(p, static_cast<std::int32_t>(si), xd, yd, w, near_m,
+                                              far_m, &buf);
         break;
     }
   }
@@ -511,9 +519,10 @@ cv::Mat Renderer::Render(const CameraModel& cam, const Rigid3& world_from_camera
     const float sky_row = sky(yd[static_cast<std::size_t>(y)]);
     for (int x = 0; x < w; ++x) {
       const std::size_t i = row + static_cast<std::size_t>(x);
-      const float v = id[i] < 0 ? sky_row
-                                : ShadeHit(prepared[static_cast<std::size_t>(id[i])],
-                                           Hit{depth[i], buf.alpha[i], buf.beta[i], buf.nd[i]}, lod_slope);
+      const float v =
+          id[i] < 0 ? sky_row
+                    : ShadeHit(prepared[static_cast<std::size_t>(id[i])],
+                               Hit{depth[i], buf.alpha[i], buf.beta[i], buf.nd[i]}, lod_slope);
       out[x] = cv::saturate_cast<std::uint8_t>(v);
     }
   }
@@ -560,8 +569,8 @@ cv::Mat Renderer::Render(const CameraModel& cam, const Rigid3& world_from_camera
   for (int y = 0; y < h; ++y) {
     std::uint8_t* out = image.ptr<std::uint8_t>(y);
     for (int x = 0; x < w; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) +
-                            static_cast<std::size_t>(x);
+      const std::size_t i =
+          static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
       if (!edge[i]) continue;
       // Surfaces seen in the 3x3 neighbourhood: the candidates for this pixel's sub-rays.
       candidates.clear();

@@ -7,12 +7,12 @@
 // then supersamples the pixels on silhouettes (where the visible surface changes between
 // neighbours): an S x S grid of sub-rays measures how much of the pixel each surface covers, and
 // each covering surface is shaded once at the centroid of its sub-rays (multisample
-// anti-aliasing). Edges thus move smoothly under sub-pixel motion and optical flow is meaningful. Deterministic: the same world, camera and pose give identical bytes.
+// anti-aliasing). Edges thus move smoothly under sub-pixel motion and optical flow is meaningful.
+// Deterministic: the same world, camera and pose give identical bytes.
 #pragma once
 
-#include <opencv2/core.hpp>
-
 #include <memory>
+#include <opencv2/core.hpp>
 #include <vector>
 
 #include "mapless/sim/camera.h"
@@ -21,11 +21,11 @@
 namespace mapless::sim {
 
 struct RenderOptions {
-  int edge_supersample = 4;       // S: S x S coverage rays per silhouette pixel (1: no anti-aliasing)
-  double near_m = 0.02;           // nearest visible distance along the optical axis, metres
-  double far_m = 150.0;           // farthest visible distance, metres
-  double anisotropy = 0.5;        // mip choice: 0 = geometric mean of the footprint (sharper),
-                                  // 1 = its long side (no aliasing at grazing angles, blurrier)
+  int edge_supersample = 4;  // S: S x S coverage rays per silhouette pixel (1: no anti-aliasing)
+  double near_m = 0.02;      // nearest visible distance along the optical axis, metres
+  double far_m = 150.0;      // farthest visible distance, metres
+  double anisotropy = 0.5;   // mip choice: 0 = geometric mean of the footprint (sharper),
+                             // 1 = its long side (no aliasing at grazing angles, blurrier)
   void Validate() const;
 };
 

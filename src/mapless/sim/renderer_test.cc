@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
-
 #include <set>
 
 #include "mapless/sim/simulation.h"
@@ -51,7 +50,8 @@ std::vector<cv::Point2d> BrightBlobCentroids(const cv::Mat& image) {
   const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids);
   std::vector<cv::Point2d> out;
   for (int i = 1; i < n; ++i) {
-    // Intensity-weighted centroid over the blob's bounding box grown by 2 px (edge pixels are grey).
+    // Intensity-weighted centroid over the blob's bounding box grown by 2 px (edge pixels are
+    // grey).
     const cv::Rect box(stats.at<int>(i, 0) - 2, stats.at<int>(i, 1) - 2, stats.at<int>(i, 2) + 4,
                        stats.at<int>(i, 3) + 4);
     double sum = 0, sx = 0, sy = 0;
@@ -137,7 +137,8 @@ TEST(Renderer, SilhouetteEdgesAreAntiAliasedAndMoveSmoothlyWithSubPixelMotion) {
   std::vector<int> values;
   for (int i = 0; i < 8; ++i) {
     const double k = 0.0625 + 0.125 * i;
-    const cv::Mat img = renderer.Render(cam, WorldFromCamera(Pose2{0.0, k * px_m, 0.0}, CameraMount{}));
+    const cv::Mat img =
+        renderer.Render(cam, WorldFromCamera(Pose2{0.0, k * px_m, 0.0}, CameraMount{}));
     values.push_back(img.at<std::uint8_t>(100, 160));
   }
   // Less and less of the wall: never brighter, from nearly all wall to nearly all sky...

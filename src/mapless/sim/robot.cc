@@ -23,8 +23,9 @@ void RobotOptions::Validate() const {
                 "RobotOptions.max_accel_mps2 = " << max_accel_mps2 << "; must be > 0");
   MAPLESS_CHECK(max_alpha_radps2 > 0.0,
                 "RobotOptions.max_alpha_radps2 = " << max_alpha_radps2 << "; must be > 0");
-  MAPLESS_CHECK(motion_noise_v_frac >= 0.0 && motion_noise_v_frac <= 1.0,
-                "RobotOptions.motion_noise_v_frac = " << motion_noise_v_frac << "; must be in [0, 1]");
+  MAPLESS_CHECK(
+      motion_noise_v_frac >= 0.0 && motion_noise_v_frac <= 1.0,
+      "RobotOptions.motion_noise_v_frac = " << motion_noise_v_frac << "; must be in [0, 1]");
   MAPLESS_CHECK(motion_noise_omega_frac >= 0.0 && motion_noise_omega_frac <= 1.0,
                 "RobotOptions.motion_noise_omega_frac = " << motion_noise_omega_frac
                                                           << "; must be in [0, 1]");

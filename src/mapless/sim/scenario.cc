@@ -21,7 +21,8 @@ std::uint64_t MixSeed(std::uint64_t a, std::uint64_t b) {
   return z ^ (z >> 31);
 }
 
-TextureSpec ParseTexture(const YamlMap& m, std::uint64_t default_seed, const std::string& base_dir) {
+TextureSpec ParseTexture(const YamlMap& m, std::uint64_t default_seed,
+                         const std::string& base_dir) {
   m.CheckKnownKeys({"type", "seed", "texel_m", "fit", "mean", "contrast", "size_px", "file"});
   TextureSpec t;
   try {
@@ -37,7 +38,8 @@ TextureSpec ParseTexture(const YamlMap& m, std::uint64_t default_seed, const std
   t.size_px = m.GetInt("size_px", t.size_px);
   if (m.Has("file")) {
     const std::filesystem::path f(m.GetString("file"));
-    t.file = f.is_absolute() || base_dir.empty() ? f.string() : (std::filesystem::path(base_dir) / f).string();
+    t.file = f.is_absolute() || base_dir.empty() ? f.string()
+                                                 : (std::filesystem::path(base_dir) / f).string();
   }
   try {
     t.Validate();
@@ -88,7 +90,8 @@ void ParseObject(const YamlMap& m, std::uint64_t seed, const std::string& base_d
     } else {
       const Eigen::Vector2d lo = Vec2(m, "min");
       const Eigen::Vector2d hi = Vec2(m, "max");
-      if (!(hi.x() > lo.x() && hi.y() > lo.y())) m.Fail("max", "must be greater than min in x and y");
+      if (!(hi.x() > lo.x() && hi.y() > lo.y()))
+        m.Fail("max", "must be greater than min in x and y");
       pts = {lo, {hi.x(), lo.y()}, hi, {lo.x(), hi.y()}, lo};
     }
     for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
@@ -149,7 +152,8 @@ void ParseObject(const YamlMap& m, std::uint64_t seed, const std::string& base_d
       w.a += d;
       w.b += d;
       w.center += d;
-      if (!explicit_seed && k > 0) w.texture.seed = MixSeed(w.texture.seed, static_cast<std::uint64_t>(k));
+      if (!explicit_seed && k > 0)
+        w.texture.seed = MixSeed(w.texture.seed, static_cast<std::uint64_t>(k));
       out->push_back(w);
     }
   }
@@ -158,7 +162,8 @@ void ParseObject(const YamlMap& m, std::uint64_t seed, const std::string& base_d
 World ParseWorld(const YamlMap& m, std::uint64_t seed, const std::string& base_dir) {
   m.CheckKnownKeys({"ground", "ceiling", "sky", "objects"});
   World w;
-  w.ground = m.Has("ground") ? ParseTexture(m.GetMap("ground"), MixSeed(seed, 1), base_dir) : TextureSpec{};
+  w.ground = m.Has("ground") ? ParseTexture(m.GetMap("ground"), MixSeed(seed, 1), base_dir)
+                             : TextureSpec{};
   if (!m.Has("ground")) w.ground.seed = MixSeed(seed, 1);
   if (m.Has("ceiling")) {
     const YamlMap c = m.GetMap("ceiling");
@@ -304,8 +309,8 @@ double Scenario::PathLength() const {
 Scenario ParseScenario(const std::string& yaml_text, const std::string& source,
                        const std::string& base_dir) {
   const YamlMap root = YamlMap::LoadString(yaml_text, source);
-  root.CheckKnownKeys({"name", "description", "paper", "seed", "world", "camera", "robot",
-                       "teach", "repeat", "destinations"});
+  root.CheckKnownKeys({"name", "description", "paper", "seed", "world", "camera", "robot", "teach",
+                       "repeat", "destinations"});
   Scenario s;
   s.source = source;
   s.name = root.GetString("name", std::filesystem::path(source).stem().string());
@@ -367,7 +372,8 @@ Scenario ParseScenario(const std::string& yaml_text, const std::string& source,
 
 std::vector<std::string> BuiltinScenarioNames() {
   std::vector<std::string> names;
-  for (std::size_t i = 0; i < kBuiltinScenarioCount; ++i) names.emplace_back(kBuiltinScenarios[i].name);
+  for (std::size_t i = 0; i < kBuiltinScenarioCount; ++i)
+    names.emplace_back(kBuiltinScenarios[i].name);
   std::sort(names.begin(), names.end());
   return names;
 }

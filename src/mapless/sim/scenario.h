@@ -1,11 +1,10 @@
 // A scenario: the world, the camera and its mount, the robot, the taught path (driven by a scripted
 // driver on ground truth, as a person would drive in the teach phase) and how the repeat phase
-// starts (its start pose and the world variant it sees). Scenarios are YAML files; the built-in ones
-// live in config/scenarios/ and are compiled into the library (see docs/simulator.md).
+// starts (its start pose and the world variant it sees). Scenarios are YAML files; the built-in
+// ones live in config/scenarios/ and are compiled into the library (see docs/simulator.md).
 #pragma once
 
 #include <Eigen/Core>
-
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -37,7 +36,7 @@ struct PathStep {
 struct Scenario {
   std::string name;
   std::string description;
-  std::string source;            // file path or "builtin:NAME"
+  std::string source;  // file path or "builtin:NAME"
   std::uint64_t seed = 1;
   World world;
   CameraSpec camera;

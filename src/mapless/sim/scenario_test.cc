@@ -2,7 +2,6 @@
 
 #include <gtest/gtest.h>
 
-
 #include "mapless/core/check.h"
 #include "mapless/core/testing.h"
 
@@ -38,10 +37,11 @@ TEST(Scenario, PaperScenariosHaveThePapersPathLengths) {
     double length_m;
   };
   // Kassir et al. Section VII: 9 m, 6 m, 25 m, 10 m, 10 m, 30 m, 70 m.
-  for (const Expect& e : {Expect{"narrow_room_sharp_turn", 9}, Expect{"wide_left_turn_offset_start", 6},
-                          Expect{"corridor_25m", 25}, Expect{"table1_sharp_turn_low_texture", 10},
-                          Expect{"table1_almost_straight", 10}, Expect{"indoor_30m", 30},
-                          Expect{"outdoor_70m", 70}}) {
+  for (const Expect& e :
+       {Expect{"narrow_room_sharp_turn", 9}, Expect{"wide_left_turn_offset_start", 6},
+        Expect{"corridor_25m", 25}, Expect{"table1_sharp_turn_low_texture", 10},
+        Expect{"table1_almost_straight", 10}, Expect{"indoor_30m", 30},
+        Expect{"outdoor_70m", 70}}) {
     const Scenario s = LoadScenario(e.name);
     EXPECT_NEAR(s.PathLength(), e.length_m, 0.1 * e.length_m) << e.name;
   }
@@ -86,15 +86,21 @@ TEST(Scenario, MalformedFieldIsReportedWithFileLineAndField) {
 
 TEST(Scenario, UnknownFieldAndUnknownTagAreErrors) {
   std::string text = std::string(kMinimal) + "repeat:\n  variant: {remove: [truck]}\n";
-  EXPECT_NE(testing::InputErrorOf([&] { ParseScenario(text, "t.yaml", ""); }).find("no object has tag 'truck'"),
+  EXPECT_NE(testing::InputErrorOf([&] {
+              ParseScenario(text, "t.yaml", "");
+            }).find("no object has tag 'truck'"),
             std::string::npos);
   std::string typo = std::string(kMinimal) + "camra: {width: 10}\n";
-  EXPECT_NE(testing::InputErrorOf([&] { ParseScenario(typo, "t.yaml", ""); }).find("camra: unknown field"),
+  EXPECT_NE(testing::InputErrorOf([&] {
+              ParseScenario(typo, "t.yaml", "");
+            }).find("camra: unknown field"),
             std::string::npos);
 }
 
 TEST(Scenario, UnknownBuiltinNameSaysSo) {
-  EXPECT_NE(testing::InputErrorOf([] { LoadScenario("no_such_scenario"); }).find("unknown scenario 'no_such_scenario'"),
+  EXPECT_NE(testing::InputErrorOf([] {
+              LoadScenario("no_such_scenario");
+            }).find("unknown scenario 'no_such_scenario'"),
             std::string::npos);
 }
 

@@ -10,8 +10,8 @@ namespace mapless::sim {
 void SimulationOptions::Validate() const {
   MAPLESS_CHECK(physics_dt_s > 0.0 && physics_dt_s <= 0.1,
                 "SimulationOptions.physics_dt_s = " << physics_dt_s << "; must be in (0, 0.1]");
-  MAPLESS_CHECK(robot_body_height_m > 0.0,
-                "SimulationOptions.robot_body_height_m = " << robot_body_height_m << "; must be > 0");
+  MAPLESS_CHECK(robot_body_height_m > 0.0, "SimulationOptions.robot_body_height_m = "
+                                               << robot_body_height_m << "; must be > 0");
   render.Validate();
 }
 
@@ -34,7 +34,8 @@ Simulation::Simulation(const World& world, CameraSpec camera, SimulationOptions 
 
 int Simulation::AddRobot(const Pose2& start, const RobotOptions& options) {
   const int index = robot_count();
-  robots_.emplace_back(start, options, Rng::Derive(seed_, 1000 + static_cast<std::uint64_t>(index)).NextU64());
+  robots_.emplace_back(start, options,
+                       Rng::Derive(seed_, 1000 + static_cast<std::uint64_t>(index)).NextU64());
   frames_.push_back(0);
   stopped_.push_back(false);
   TextureSpec body;
@@ -106,7 +107,8 @@ std::vector<Surface> Simulation::OtherRobots(int robot) const {
 
 cv::Mat Simulation::RenderClean(int robot) const {
   const auto& r = robots_.at(static_cast<std::size_t>(robot));
-  return renderer_.Render(camera_.model, WorldFromCamera(r.pose(), camera_.mount), OtherRobots(robot));
+  return renderer_.Render(camera_.model, WorldFromCamera(r.pose(), camera_.mount),
+                          OtherRobots(robot));
 }
 
 cv::Mat Simulation::Render(int robot) {
@@ -161,7 +163,8 @@ DriveSummary DriveTaughtPath(const Scenario& scenario, const DriveOptions& optio
     }
     if (ToSeconds(sim.now_ns()) > timeout) {
       char buf[96];
-      std::snprintf(buf, sizeof(buf), "timeout after %.1f s (3x the nominal duration)", ToSeconds(sim.now_ns()));
+      std::snprintf(buf, sizeof(buf), "timeout after %.1f s (3x the nominal duration)",
+                    ToSeconds(sim.now_ns()));
       summary.status = buf;
       break;
     }

@@ -6,10 +6,9 @@
 
 #include <functional>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "mapless/sim/renderer.h"
 #include "mapless/sim/robot.h"
@@ -18,7 +17,7 @@
 namespace mapless::sim {
 
 struct SimulationOptions {
-  double physics_dt_s = 0.01;   // integration step
+  double physics_dt_s = 0.01;  // integration step
   double robot_body_height_m = 0.5;
   RenderOptions render;
   void Validate() const;
@@ -87,9 +86,9 @@ struct DriveFrame {
 
 struct DriveOptions {
   std::uint64_t seed = 1;
-  double timeout_factor = 3.0;    // give up after this many times the nominal path duration
+  double timeout_factor = 3.0;  // give up after this many times the nominal path duration
   bool stop_on_collision = true;
-  bool render_frames = true;      // false: frames carry no image (fast, for path-only checks)
+  bool render_frames = true;  // false: frames carry no image (fast, for path-only checks)
   SimulationOptions sim;
   void Validate() const;
 };
@@ -98,9 +97,9 @@ struct DriveSummary {
   int frames = 0;
   double duration_s = 0.0;
   double distance_m = 0.0;
-  bool completed = false;        // the driver reached the end of the path
+  bool completed = false;  // the driver reached the end of the path
   bool collided = false;
-  std::string status;            // "completed", "collision at ...", "timeout after ..."
+  std::string status;  // "completed", "collision at ...", "timeout after ..."
 };
 
 DriveSummary DriveTaughtPath(const Scenario& scenario, const DriveOptions& options,

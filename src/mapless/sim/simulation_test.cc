@@ -42,7 +42,8 @@ TEST(Simulation, EveryBuiltinTaughtPathIsDrivenToItsEndWithoutCollision) {
     DriveOptions o;
     o.render_frames = false;
     Pose2 last;
-    const DriveSummary summary = DriveTaughtPath(s, o, [&](const DriveFrame& f) { last = f.truth; });
+    const DriveSummary summary =
+        DriveTaughtPath(s, o, [&](const DriveFrame& f) { last = f.truth; });
     EXPECT_TRUE(summary.completed) << name << ": " << summary.status;
     EXPECT_FALSE(summary.collided) << name << ": " << summary.status;
     // The robot ends at the last waypoint of the path.

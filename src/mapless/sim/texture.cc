@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -17,13 +16,13 @@ struct TypeName {
   const char* name;
 };
 constexpr TypeName kTypeNames[] = {
-    {TextureType::kNoise, "noise"},   {TextureType::kBricks, "bricks"},
-    {TextureType::kTiles, "tiles"},   {TextureType::kBlobs, "blobs"},
-    {TextureType::kPoster, "poster"}, {TextureType::kPlain, "plain"},
+    {TextureType::kNoise, "noise"},     {TextureType::kBricks, "bricks"},
+    {TextureType::kTiles, "tiles"},     {TextureType::kBlobs, "blobs"},
+    {TextureType::kPoster, "poster"},   {TextureType::kPlain, "plain"},
     {TextureType::kChecker, "checker"}, {TextureType::kImage, "image"}};
 
-// Tileable value noise: a random lattice of `cells` x `cells` values, bicubic-smoothed by upsampling
-// with wrap-around, so that the result tiles.
+// Tileable value noise: a random lattice of `cells` x `cells` values, bicubic-smoothed by
+// upsampling with wrap-around, so that the result tiles.
 cv::Mat TileableNoise(int size, int cells, Rng* rng) {
   cv::Mat lattice(cells, cells, CV_32F);
   for (int y = 0; y < cells; ++y) {
@@ -174,7 +173,8 @@ cv::Mat Poster(int size, Rng* rng) {
   img += FractalNoise(size, 4, 4, rng) * 0.2;
   const int shapes = 6 + static_cast<int>(rng->UniformInt(6));
   for (int i = 0; i < shapes; ++i) {
-    const cv::Point c(static_cast<int>(rng->UniformInt(size)), static_cast<int>(rng->UniformInt(size)));
+    const cv::Point c(static_cast<int>(rng->UniformInt(size)),
+                      static_cast<int>(rng->UniformInt(size)));
     const int r = size / 16 + static_cast<int>(rng->UniformInt(size / 5));
     const double value = rng->Uniform(-1.0, 1.0);
     if (i % 2 == 0) {
@@ -232,7 +232,8 @@ const char* TextureTypeName(TextureType type) {
 
 void TextureSpec::Validate() const {
   MAPLESS_CHECK(texel_m > 0.0, "TextureSpec.texel_m = " << texel_m << "; must be > 0");
-  MAPLESS_CHECK(mean >= 0.0 && mean <= 255.0, "TextureSpec.mean = " << mean << "; must be in [0, 255]");
+  MAPLESS_CHECK(mean >= 0.0 && mean <= 255.0,
+                "TextureSpec.mean = " << mean << "; must be in [0, 255]");
   MAPLESS_CHECK(contrast >= 0.0 && contrast <= 4.0,
                 "TextureSpec.contrast = " << contrast << "; must be in [0, 4]");
   MAPLESS_CHECK(IsPowerOfTwo(size_px) && size_px >= 64 && size_px <= 2048,
@@ -254,14 +255,29 @@ cv::Mat GenerateTextureImage(const TextureSpec& spec) {
   }
   cv::Mat signal;
   switch (spec.type) {
-    case TextureType::kNoise: signal = Noise(size, &rng); break;
-    case TextureType::kBricks: signal = Bricks(size, &rng); break;
-    case TextureType::kTiles: signal = Tiles(size, &rng); break;
-    case TextureType::kBlobs: signal = Blobs(size, &rng); break;
-    case TextureType::kPoster: signal = Poster(size, &rng); break;
-    case TextureType::kPlain: signal = Plain(size, &rng); break;
-    case TextureType::kChecker: signal = Checker(size); break;
-    case TextureType::kImage: break;
+    case TextureType::kNoise:
+      signal = Noise(size, &rng);
+      break;
+    case TextureType::kBricks:
+      signal = Bricks(size, &rng);
+      break;
+    case TextureType::kTiles:
+      signal = Tiles(size, &rng);
+      break;
+    case TextureType::kBlobs:
+      signal = Blobs(size, &rng);
+      break;
+    case TextureType::kPoster:
+      signal = Poster(size, &rng);
+      break;
+    case TextureType::kPlain:
+      signal = Plain(size, &rng);
+      break;
+    case TextureType::kChecker:
+      signal = Checker(size);
+      break;
+    case TextureType::kImage:
+      break;
   }
   cv::Mat out;
   signal.convertTo(out, CV_8U, 80.0 * spec.contrast, spec.mean);

@@ -4,10 +4,9 @@
 // renderer samples it without aliasing at any distance.
 #pragma once
 
-#include <opencv2/core.hpp>
-
 #include <cstdint>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
@@ -22,15 +21,15 @@ const char* TextureTypeName(TextureType type);
 struct TextureSpec {
   TextureType type = TextureType::kNoise;
   std::uint64_t seed = 1;
-  double texel_m = 0.01;   // world size of one texel, metres (ignored when `fit` is set)
-  bool fit = false;        // stretch one copy over the whole surface (posters, pictures)
-  double mean = 128.0;     // mean intensity, 0..255
-  double contrast = 1.0;   // 1 = the type's normal contrast; 0.15 gives a low-texture surface
-  int size_px = 1024;      // side of the texture image, a power of two (64..2048); 1024 keeps
-                           // exact repeats (which fool feature matching) metres apart
-  std::string file;        // image file for kImage (grayscale; resized to size_px)
+  double texel_m = 0.01;  // world size of one texel, metres (ignored when `fit` is set)
+  bool fit = false;       // stretch one copy over the whole surface (posters, pictures)
+  double mean = 128.0;    // mean intensity, 0..255
+  double contrast = 1.0;  // 1 = the type's normal contrast; 0.15 gives a low-texture surface
+  int size_px = 1024;     // side of the texture image, a power of two (64..2048); 1024 keeps
+                          // exact repeats (which fool feature matching) metres apart
+  std::string file;       // image file for kImage (grayscale; resized to size_px)
 
-  void Validate() const;   // throws InputError naming the field and value
+  void Validate() const;  // throws InputError naming the field and value
 };
 
 // A tileable texture with its mip pyramid: levels[0] is size_px x size_px, each next level half.
@@ -40,8 +39,8 @@ struct Texture {
     const std::uint8_t* data = nullptr;
     int log2_size = 0;
   };
-  std::vector<cv::Mat> levels;     // CV_8UC1, power-of-two sides
-  std::vector<LevelView> views;    // one per level, pointing into `levels`
+  std::vector<cv::Mat> levels;   // CV_8UC1, power-of-two sides
+  std::vector<LevelView> views;  // one per level, pointing into `levels`
   double texel_m = 0.01;
   bool fit = false;
 };

@@ -58,8 +58,8 @@ TEST(Texture, ImageFileTextureIsLoadedAsGreyAndResized) {
   const cv::Mat img = GenerateTextureImage(spec);
   ASSERT_EQ(img.type(), CV_8UC1);
   ASSERT_EQ(img.size(), cv::Size(64, 64));
-  EXPECT_GT(img.at<std::uint8_t>(32, 5), 200);   // left half white
-  EXPECT_LT(img.at<std::uint8_t>(32, 58), 50);   // right half black
+  EXPECT_GT(img.at<std::uint8_t>(32, 5), 200);  // left half white
+  EXPECT_LT(img.at<std::uint8_t>(32, 58), 50);  // right half black
   spec.file = "/nonexistent/texture.png";
   try {
     GenerateTextureImage(spec);

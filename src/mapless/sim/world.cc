@@ -31,10 +31,14 @@ double DistanceToBox(const Eigen::Vector2d& p, const WorldObject& box) {
 
 const char* KindName(ObjectKind kind) {
   switch (kind) {
-    case ObjectKind::kWall: return "wall";
-    case ObjectKind::kBox: return "box";
-    case ObjectKind::kCylinder: return "cylinder";
-    case ObjectKind::kPoster: return "poster";
+    case ObjectKind::kWall:
+      return "wall";
+    case ObjectKind::kBox:
+      return "box";
+    case ObjectKind::kCylinder:
+      return "cylinder";
+    case ObjectKind::kPoster:
+      return "poster";
   }
   return "?";
 }
@@ -50,8 +54,8 @@ void World::Validate() const {
   }
   for (std::size_t i = 0; i < objects.size(); ++i) {
     const WorldObject& o = objects[i];
-    const std::string name = std::string("World.objects[") + std::to_string(i) + "] (" +
-                             KindName(o.kind) + ")";
+    const std::string name =
+        std::string("World.objects[") + std::to_string(i) + "] (" + KindName(o.kind) + ")";
     o.texture.Validate();
     MAPLESS_CHECK(o.height_m > 0.0, name << ".height_m = " << o.height_m << "; must be > 0");
     switch (o.kind) {
@@ -60,9 +64,9 @@ void World::Validate() const {
         break;
       case ObjectKind::kBox:
       case ObjectKind::kPoster:
-        MAPLESS_CHECK(o.size_m.x() > 0.0 && o.size_m.y() > 0.0,
-                      name << ".size = [" << o.size_m.x() << ", " << o.size_m.y()
-                           << "]; both must be > 0");
+        MAPLESS_CHECK(o.size_m.x() > 0.0 && o.size_m.y() > 0.0, name << ".size = [" << o.size_m.x()
+                                                                     << ", " << o.size_m.y()
+                                                                     << "]; both must be > 0");
         break;
       case ObjectKind::kCylinder:
         MAPLESS_CHECK(o.radius_m > 0.0, name << ".radius_m = " << o.radius_m << "; must be > 0");
@@ -106,10 +110,17 @@ double ClearanceTo(const World& world, double x_m, double y_m) {
   double best = std::numeric_limits<double>::infinity();
   for (const WorldObject& o : world.objects) {
     switch (o.kind) {
-      case ObjectKind::kWall: best = std::min(best, DistanceToSegment(p, o.a, o.b)); break;
-      case ObjectKind::kBox: best = std::min(best, DistanceToBox(p, o)); break;
-      case ObjectKind::kCylinder: best = std::min(best, (p - o.center).norm() - o.radius_m); break;
-      case ObjectKind::kPoster: break;
+      case ObjectKind::kWall:
+        best = std::min(best, DistanceToSegment(p, o.a, o.b));
+        break;
+      case ObjectKind::kBox:
+        best = std::min(best, DistanceToBox(p, o));
+        break;
+      case ObjectKind::kCylinder:
+        best = std::min(best, (p - o.center).norm() - o.radius_m);
+        break;
+      case ObjectKind::kPoster:
+        break;
     }
   }
   return best;
@@ -125,10 +136,19 @@ Eigen::Vector4d FootprintBounds(const World& world) {
   };
   for (const WorldObject& o : world.objects) {
     switch (o.kind) {
-      case ObjectKind::kWall: add(o.a, 0); add(o.b, 0); break;
-      case ObjectKind::kBox: add(o.center, 0.5 * o.size_m.norm()); break;
-      case ObjectKind::kCylinder: add(o.center, o.radius_m); break;
-      case ObjectKind::kPoster: add(o.center, 0.5 * o.size_m.x()); break;
+      case ObjectKind::kWall:
+        add(o.a, 0);
+        add(o.b, 0);
+        break;
+      case ObjectKind::kBox:
+        add(o.center, 0.5 * o.size_m.norm());
+        break;
+      case ObjectKind::kCylinder:
+        add(o.center, o.radius_m);
+        break;
+      case ObjectKind::kPoster:
+        add(o.center, 0.5 * o.size_m.x());
+        break;
     }
   }
   if (b[0] > b[2]) b = Eigen::Vector4d(-1, -1, 1, 1);

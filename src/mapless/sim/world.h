@@ -5,7 +5,6 @@
 #pragma once
 
 #include <Eigen/Core>
-
 #include <map>
 #include <optional>
 #include <string>
@@ -19,7 +18,7 @@ enum class ObjectKind { kWall, kBox, kCylinder, kPoster };
 
 struct WorldObject {
   ObjectKind kind = ObjectKind::kBox;
-  std::string tag;          // optional; used by variants
+  std::string tag;  // optional; used by variants
   TextureSpec texture;
   // kWall: a vertical rectangle from `a` to `b` on the ground, `height_m` tall.
   Eigen::Vector2d a = Eigen::Vector2d::Zero();
@@ -40,8 +39,8 @@ struct World {
   TextureSpec ground;
   std::optional<TextureSpec> ceiling;  // indoor worlds
   double ceiling_height_m = 2.6;
-  double sky_top = 205.0;              // sky intensity at the top of the image
-  double sky_horizon = 175.0;          // sky intensity at the bottom of the image
+  double sky_top = 205.0;      // sky intensity at the top of the image
+  double sky_horizon = 175.0;  // sky intensity at the bottom of the image
   std::vector<WorldObject> objects;
 
   void Validate() const;  // throws InputError naming the object and field
@@ -49,8 +48,8 @@ struct World {
 
 // A variant of a world: objects removed or moved by tag.
 struct WorldVariant {
-  std::vector<std::string> remove;                    // tags to remove
-  std::map<std::string, Eigen::Vector2d> move_m;      // tag -> displacement (dx, dy)
+  std::vector<std::string> remove;                // tags to remove
+  std::map<std::string, Eigen::Vector2d> move_m;  // tag -> displacement (dx, dy)
 };
 
 // Returns the world with the variant applied; throws InputError for a tag no object has.

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-
 #include <opencv2/imgproc.hpp>
 
 namespace mapless::viz {
@@ -48,7 +47,8 @@ cv::Mat DrawTopDown(const sim::World& world, const std::vector<TopDownPath>& pat
   for (const sim::WorldObject& o : world.objects) {
     switch (o.kind) {
       case sim::ObjectKind::kWall:
-        cv::line(img, px(o.a.x(), o.a.y()), px(o.b.x(), o.b.y()), cv::Scalar(60, 60, 60), 3, cv::LINE_AA);
+        cv::line(img, px(o.a.x(), o.a.y()), px(o.b.x(), o.b.y()), cv::Scalar(60, 60, 60), 3,
+                 cv::LINE_AA);
         break;
       case sim::ObjectKind::kBox: {
         const double c = std::cos(o.yaw_rad);
@@ -64,8 +64,9 @@ cv::Mat DrawTopDown(const sim::World& world, const std::vector<TopDownPath>& pat
         break;
       }
       case sim::ObjectKind::kCylinder:
-        cv::circle(img, px(o.center.x(), o.center.y()), std::max(2, static_cast<int>(o.radius_m * ppm)),
-                   cv::Scalar(180, 200, 170), cv::FILLED, cv::LINE_AA);
+        cv::circle(img, px(o.center.x(), o.center.y()),
+                   std::max(2, static_cast<int>(o.radius_m * ppm)), cv::Scalar(180, 200, 170),
+                   cv::FILLED, cv::LINE_AA);
         break;
       case sim::ObjectKind::kPoster: {
         const double c = std::cos(o.yaw_rad + kPi / 2);
@@ -98,9 +99,10 @@ cv::Mat DrawTopDown(const sim::World& world, const std::vector<TopDownPath>& pat
   }
   for (const TopDownPath& path : paths) {
     if (path.label.empty()) continue;
-    cv::line(img, cv::Point(legend_x, height - 18), cv::Point(legend_x + 25, height - 18), path.color, 3);
-    cv::putText(img, path.label, cv::Point(legend_x + 30, height - 13), cv::FONT_HERSHEY_SIMPLEX, 0.45,
-                cv::Scalar(40, 40, 40), 1, cv::LINE_AA);
+    cv::line(img, cv::Point(legend_x, height - 18), cv::Point(legend_x + 25, height - 18),
+             path.color, 3);
+    cv::putText(img, path.label, cv::Point(legend_x + 30, height - 13), cv::FONT_HERSHEY_SIMPLEX,
+                0.45, cv::Scalar(40, 40, 40), 1, cv::LINE_AA);
     legend_x += 40 + 9 * static_cast<int>(path.label.size());
   }
   // Scale bar: 1 m.

@@ -4,7 +4,6 @@
 #pragma once
 
 #include <opencv2/core.hpp>
-
 #include <string>
 #include <vector>
 
@@ -20,7 +19,7 @@ struct TopDownPath {
 };
 
 struct TopDownOptions {
-  double pixels_per_m = 60.0;   // reduced automatically so that the picture fits max_side_px
+  double pixels_per_m = 60.0;  // reduced automatically so that the picture fits max_side_px
   int max_side_px = 1400;
   double margin_m = 0.8;
 };
