@@ -26,10 +26,21 @@ Simulation::Simulation(const World& world, CameraSpec camera, SimulationOptions 
     : world_(world),
       camera_(std::move(camera)),
       options_(options),
-      seed_(seed),
-      renderer_(world_, options.render) {
+      seed_(seed) {
   options_.Validate();
   camera_.Validate();
+  world_.Validate();
+}
+
+const Renderer& Simulation::renderer() const {
+  if (!renderer_) renderer_ = std::make_unique<Renderer>(world_, options_.render);
+  return *renderer_;
+}
+
+void Simulation::PlaceRobot(int robot, const Pose2& pose) {
+  const auto i = static_cast<std::size_t>(robot);
+  robots_.at(i).Reset(pose);
+  stopped_.at(i) = false;
 }
 
 int Simulation::AddRobot(const Pose2& start, const RobotOptions& options) {
@@ -107,7 +118,7 @@ std::vector<Surface> Simulation::OtherRobots(int robot) const {
 
 cv::Mat Simulation::RenderClean(int robot) const {
   const auto& r = robots_.at(static_cast<std::size_t>(robot));
-  return renderer_.Render(camera_.model, WorldFromCamera(r.pose(), camera_.mount),
+  return renderer().Render(camera_.model, WorldFromCamera(r.pose(), camera_.mount),
                           OtherRobots(robot));
 }
 

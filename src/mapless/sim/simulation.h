@@ -40,6 +40,8 @@ class Simulation {
   const DiffDriveRobot& robot(int i) const { return robots_.at(static_cast<std::size_t>(i)); }
 
   void SetCommand(int robot, const Twist2& command);
+  // Puts a robot at a pose, at rest (clears a collision stop).
+  void PlaceRobot(int robot, const Pose2& pose);
   // Advances every robot by dt (rounded to whole physics steps); records collisions. A robot that
   // collided stops and stays where it hit.
   void Advance(double dt_s);
@@ -55,7 +57,8 @@ class Simulation {
   bool collided(int robot) const;
   const World& world() const { return world_; }
   const CameraSpec& camera() const { return camera_; }
-  const Renderer& renderer() const { return renderer_; }
+  // The renderer; its textures are generated on first use (drives that never render skip that).
+  const Renderer& renderer() const;
 
  private:
   std::vector<Surface> OtherRobots(int robot) const;
@@ -65,7 +68,7 @@ class Simulation {
   CameraSpec camera_;
   SimulationOptions options_;
   std::uint64_t seed_;
-  Renderer renderer_;
+  mutable std::unique_ptr<Renderer> renderer_;
   std::vector<DiffDriveRobot> robots_;
   std::vector<std::uint64_t> frames_;
   std::vector<bool> stopped_;

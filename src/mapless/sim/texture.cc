@@ -92,19 +92,29 @@ void Specks(cv::Mat* img, int count, int max_size, Rng* rng) {
 }
 
 // Signed content in roughly [-1, 1]; scaled to mean/contrast at the end.
+// The generators below were designed at 256 texels; larger textures keep every element's size in
+// texels (so a texture looks the same at any size_px) and only repeat less often: element counts
+// grow with the area and noise lattices with the side.
+int Scaled(int count_at_256, int size) {
+  return std::max(1, static_cast<int>(std::lround(count_at_256 * size / 256.0)));
+}
+int ScaledArea(int count_at_256, int size) {
+  return std::max(1, static_cast<int>(std::lround(count_at_256 * (size / 256.0) * (size / 256.0))));
+}
+
 cv::Mat Noise(int size, Rng* rng) {
-  cv::Mat img = FractalNoise(size, 4, 7, rng, 0.75) * 1.5;
-  Specks(&img, size * size / 400, std::max(1, size / 128), rng);
+  cv::Mat img = FractalNoise(size, Scaled(4, size), 9, rng, 0.75) * 1.5;
+  Specks(&img, size * size / 400, 2, rng);
   return img;
 }
 
 cv::Mat Bricks(int size, Rng* rng) {
-  cv::Mat img = FractalNoise(size, 16, 4, rng, 0.8) * 0.35;
-  const int rows = 8;
-  const int cols = 4;
-  const int bh = size / rows;
-  const int bw = size / cols;
-  const int mortar = std::max(2, size / 96);
+  cv::Mat img = FractalNoise(size, Scaled(16, size), 4, rng, 0.8) * 0.35;
+  const int bh = std::min(32, size / 2);  // brick height and width in texels
+  const int bw = std::min(64, size);
+  const int rows = size / bh;
+  const int cols = size / bw;
+  const int mortar = 2;
   for (int r = 0; r < rows; ++r) {
     const int shift = (r % 2) * bw / 2;
     for (int c = 0; c < cols; ++c) {
@@ -120,15 +130,15 @@ cv::Mat Bricks(int size, Rng* rng) {
       }
     }
   }
-  Specks(&img, size * size / 300, std::max(1, size / 100), rng);
+  Specks(&img, size * size / 300, 2, rng);
   return img;
 }
 
 cv::Mat Tiles(int size, Rng* rng) {
-  cv::Mat img = FractalNoise(size, 8, 5, rng, 0.75) * 0.35;
-  const int n = 8;
-  const int step = size / n;
-  const int grout = std::max(2, size / 128);
+  cv::Mat img = FractalNoise(size, Scaled(8, size), 5, rng, 0.75) * 0.35;
+  const int step = std::min(32, size);  // tile side in texels
+  const int n = size / step;
+  const int grout = 2;
   for (int ty = 0; ty < n; ++ty) {
     for (int tx = 0; tx < n; ++tx) {
       const float tone = static_cast<float>(rng->Uniform(-0.5, 0.5));
@@ -150,13 +160,13 @@ cv::Mat Tiles(int size, Rng* rng) {
 }
 
 cv::Mat Blobs(int size, Rng* rng) {
-  cv::Mat img = FractalNoise(size, 4, 7, rng, 0.7) * 0.5;
-  const int count = 180 + static_cast<int>(rng->UniformInt(60));
+  cv::Mat img = FractalNoise(size, Scaled(4, size), 9, rng, 0.7) * 0.5;
+  const int count = ScaledArea(180 + static_cast<int>(rng->UniformInt(60)), size);
   for (int i = 0; i < count; ++i) {
     const int x = static_cast<int>(rng->UniformInt(size));
     const int y = static_cast<int>(rng->UniformInt(size));
     const float value = static_cast<float>(rng->Uniform(-1.0, 1.0));
-    const int extent = 2 + static_cast<int>(rng->UniformInt(std::max(1, size / 20)));
+    const int extent = 2 + static_cast<int>(rng->UniformInt(12));
     if (rng->Uniform() < 0.5) {
       WrappedRect(&img, x, y, extent, 3 + static_cast<int>(rng->UniformInt(extent + 1)), value);
     } else {
@@ -198,7 +208,7 @@ cv::Mat Poster(int size, Rng* rng) {
   return img;
 }
 
-cv::Mat Plain(int size, Rng* rng) { return FractalNoise(size, 2, 3, rng) * 0.3; }
+cv::Mat Plain(int size, Rng* rng) { return FractalNoise(size, Scaled(2, size), 3, rng) * 0.3; }
 
 cv::Mat Checker(int size) {
   cv::Mat img(size, size, CV_32F);
