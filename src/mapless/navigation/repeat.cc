@@ -133,7 +133,8 @@ RepeatStep RepeatSession::Stop(RepeatStep step, RepeatStatus status, const std::
   step.status = status;
   step.reason = reason;
   step.command = Twist2{};
-  status_ = status;
+  // Only completion and abort end the session; waiting is decided again every frame.
+  if (status == RepeatStatus::kCompleted || status == RepeatStatus::kAborted) status_ = status;
   return step;
 }
 
@@ -191,7 +192,6 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
                 "stopped: only " + std::to_string(step.tracked) + " features match keyframe " +
                     std::to_string(destination_) + " (need " +
                     std::to_string(options_.min_features) + ")");
-    status_ = RepeatStatus::kDriving;  // waiting is per frame; the session is not finished
     return step;
   }
   waiting_ = false;
@@ -222,11 +222,9 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
     if (step.tracked < options_.min_features) {
       waiting_ = true;
       waiting_since_ns_ = t_ns;
-      step = Stop(step, RepeatStatus::kWaiting,
+      return Stop(step, RepeatStatus::kWaiting,
                   "stopped: only " + std::to_string(step.tracked) + " features match keyframe " +
                       std::to_string(destination_));
-      status_ = RepeatStatus::kDriving;
-      return step;
     }
     pairs = Pairs();
   }
