@@ -58,8 +58,7 @@ void AddDemoCommand(CLI::App* app) {
     // Repeat with the sloped funnel lane, decisions logged as JSON lines.
     eval::RepeatRunOptions run_options;
     run_options.seed = args->seed;
-    const double speed =
-        std::min(scenario.teach_speed_mps, std::max(0.2, 0.5 * scenario.teach_speed_mps));
+    const double speed = eval::RepeatSpeedFor(scenario, run_options.max_repeat_speed_mps);
     run_options.repeat.sloped.max_speed_mps = speed;
     std::ofstream log((out / "repeat.jsonl").string());
     int frame = 0;

@@ -188,6 +188,9 @@ void AddTeachRepeatCommands(CLI::App* app) {
       run_options.seed = r->seed;
       run_options.motion_noise_frac = r->motion_noise;
       run_options.image_noise_sigma = r->image_noise;
+      const double speed = eval::RepeatSpeedFor(scenario, run_options.max_repeat_speed_mps);
+      run_options.repeat.sloped.max_speed_mps = speed;
+      run_options.repeat.standard.forward_speed_mps = speed;
       const eval::RepeatRun run = eval::RepeatOnSimulator(
           scenario, taught, run_options,
           [&](const Pose2& pose, const cv::Mat&, const navigation::RepeatStep& step) {

@@ -49,11 +49,7 @@ EntryResult RunEntry(const sim::Scenario& scenario, const TaughtRoute& taught,
     RepeatRunOptions o = base;
     o.seed = seed + static_cast<std::uint64_t>(i);
     o.repeat.controller = controller;
-    // The teach speed, capped for accuracy, but never below half of it (the run must end within
-    // timeout_factor = 3x the taught duration).
-    const double speed =
-        std::min(scenario.teach_speed_mps,
-                 std::max(base.max_repeat_speed_mps, 0.5 * scenario.teach_speed_mps));
+    const double speed = RepeatSpeedFor(scenario, base.max_repeat_speed_mps);
     o.repeat.sloped.max_speed_mps = speed;
     o.repeat.standard.forward_speed_mps = speed;
     const RepeatRun run = RepeatOnSimulator(scenario, taught, o);

@@ -21,6 +21,10 @@ void RepeatRunOptions::Validate() const {
                 "RepeatRunOptions.success_radius_m = " << success_radius_m << "; must be > 0");
 }
 
+double RepeatSpeedFor(const sim::Scenario& scenario, double cap_mps) {
+  return std::min(scenario.teach_speed_mps, std::max(cap_mps, 0.5 * scenario.teach_speed_mps));
+}
+
 double DistanceToPath(const std::vector<Pose2>& path, double x_m, double y_m) {
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i + 1 < path.size(); ++i) {

@@ -56,6 +56,10 @@ using RepeatObserver =
 RepeatRun RepeatOnSimulator(const sim::Scenario& scenario, const TaughtRoute& taught,
                             const RepeatRunOptions& options, const RepeatObserver& observer = {});
 
+// Repeat speed for a scenario: its teach speed, capped at `cap_mps`, but never below half of it
+// (a repeat must end within 3x the taught duration).
+double RepeatSpeedFor(const sim::Scenario& scenario, double cap_mps);
+
 // Distance from a point to a polyline (the taught path).
 double DistanceToPath(const std::vector<Pose2>& path, double x_m, double y_m);
 
