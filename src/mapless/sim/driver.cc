@@ -105,8 +105,11 @@ Twist2 ScriptedDriver::FollowPolyline(const Pose2& pose) {
   progress_m_ = std::max(progress_m_, best_s);
   const Eigen::Vector2d end = leg.points.back();
   const double remaining = std::max(total - progress_m_, (end - p).norm());
-  if ((end - p).norm() < options_.goal_tolerance_m ||
-      (progress_m_ >= total - 1e-6 && (end - p).norm() < 3.0 * options_.goal_tolerance_m)) {
+  // A leg ends at its last point once the robot has come most of the way along it (a closed loop
+  // passes its end point near the start, too).
+  const bool near_end_of_leg = progress_m_ >= total - std::max(1.0, 2.0 * options_.lookahead_m);
+  if (near_end_of_leg && ((end - p).norm() < options_.goal_tolerance_m ||
+                          (progress_m_ >= total - 1e-6 && (end - p).norm() < 3.0 * options_.goal_tolerance_m))) {
     ++leg_;
     leg_started_ = false;
     return Twist2{};

@@ -46,6 +46,8 @@ TEST(Simulation, EveryBuiltinTaughtPathIsDrivenToItsEndWithoutCollision) {
         DriveTaughtPath(s, o, [&](const DriveFrame& f) { last = f.truth; });
     EXPECT_TRUE(summary.completed) << name << ": " << summary.status;
     EXPECT_FALSE(summary.collided) << name << ": " << summary.status;
+    // The whole path was driven (a closed loop passes its end point early on, too).
+    EXPECT_GT(summary.distance_m, 0.9 * s.PathLength()) << name;
     // The robot ends at the last waypoint of the path.
     Eigen::Vector2d end(s.teach_start.x_m, s.teach_start.y_m);
     for (const auto& step : s.teach_path) {
