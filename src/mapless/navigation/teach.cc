@@ -2,6 +2,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "mapless/control/funnel_lane.h"
 #include "mapless/core/check.h"
 
 namespace mapless::navigation {
@@ -12,6 +13,8 @@ void TeachOptions::Validate() const {
   MAPLESS_CHECK(keyframe_tracked_fraction > 0.0 && keyframe_tracked_fraction < 1.0,
                 "TeachOptions.keyframe_tracked_fraction = " << keyframe_tracked_fraction
                                                             << "; must be in (0, 1)");
+  MAPLESS_CHECK(max_spread_growth == 0.0 || max_spread_growth > 1.0,
+                "TeachOptions.max_spread_growth = " << max_spread_growth << "; must be 0 or > 1");
   MAPLESS_CHECK(min_keyframe_features >= 0, "TeachOptions.min_keyframe_features = "
                                                 << min_keyframe_features << "; must be >= 0");
   MAPLESS_CHECK(thumbnail_width_px >= 16,
@@ -67,7 +70,17 @@ std::optional<route::Keyframe> TeachSession::Update(const cv::Mat& image, Timest
     }
     start_ = std::move(kept_start);
     current_ = std::move(kept_current);
-    if (tracked_fraction() < options_.keyframe_tracked_fraction) {
+    bool spread_grew = false;
+    if (options_.max_spread_growth > 0.0 && start_.size() >= 2) {
+      std::vector<double> xs0, xs1;
+      for (std::size_t i = 0; i < start_.size(); ++i) {
+        xs0.push_back(start_[i].x);
+        xs1.push_back(current_[i].x);
+      }
+      const double s0 = control::StdDev(xs0);
+      spread_grew = s0 > 1e-9 && control::StdDev(xs1) / s0 > options_.max_spread_growth;
+    }
+    if (tracked_fraction() < options_.keyframe_tracked_fraction || spread_grew) {
       const features::Features f = extractor_.Extract(grey);
       if (static_cast<int>(f.keypoints.size()) >= options_.min_keyframe_features) {
         out = MakeKeyframe(grey, t_ns);

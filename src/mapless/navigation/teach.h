@@ -23,6 +23,11 @@ struct TeachOptions {
   // and 0.5 leaves keyframes 3-4 m apart: too sparse through sharp low-texture turns (see
   // docs/teach_and_repeat.md). 0.7 is the default.
   double keyframe_tracked_fraction = 0.7;
+  // Also a new keyframe when the tracked features' horizontal spread has grown by more than this
+  // factor since the last keyframe (not in the paper): with far-away features (outdoors) almost all
+  // survive for metres and keyframes end up ~10 m apart, too far to match across the scale change.
+  // 0 disables it.
+  double max_spread_growth = 1.3;
   // A frame with fewer features than this never becomes a keyframe (the repeat could not match
   // it); the keyframe is deferred to the next frame that has enough, and the deferral counted.
   int min_keyframe_features = 30;
