@@ -1,5 +1,6 @@
 #include "mapless/features/features.h"
 
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 
 #include "mapless/core/check.h"
@@ -46,6 +47,9 @@ void MatchOptions::Validate() const {
   MAPLESS_CHECK(ratio > 0.0 && ratio <= 1.0,
                 "MatchOptions.ratio = " << ratio << "; must be in (0, 1]");
   MAPLESS_CHECK(max_dy_px > 0.0, "MatchOptions.max_dy_px = " << max_dy_px << "; must be > 0");
+  MAPLESS_CHECK(max_ddx_px > 0.0, "MatchOptions.max_ddx_px = " << max_ddx_px << "; must be > 0");
+  MAPLESS_CHECK(std::isfinite(expected_dx_px),
+                "MatchOptions.expected_dx_px = " << expected_dx_px << "; must be finite");
 }
 
 FeatureExtractor::FeatureExtractor(FeatureOptions options) : options_(options) {
@@ -86,12 +90,27 @@ std::vector<cv::DMatch> MatchFeatures(const Features& query, const Features& tra
   MAPLESS_CHECK(query.binary == train.binary && query.descriptors.cols == train.descriptors.cols,
                 "MatchFeatures: descriptors of different kinds");
   cv::BFMatcher matcher(query.binary ? cv::NORM_HAMMING : cv::NORM_L2);
+  const bool guided = options.max_ddx_px < 1e8;
+  cv::Mat mask;  // query x train, 1 where a match is allowed (guided matching only)
+  if (guided) {
+    mask = cv::Mat::zeros(static_cast<int>(query.keypoints.size()),
+                          static_cast<int>(train.keypoints.size()), CV_8U);
+    for (int i = 0; i < mask.rows; ++i) {
+      const cv::Point2f& a = query.keypoints[static_cast<std::size_t>(i)].pt;
+      auto* row = mask.ptr<uchar>(i);
+      for (int j = 0; j < mask.cols; ++j) {
+        const cv::Point2f& b = train.keypoints[static_cast<std::size_t>(j)].pt;
+        row[j] = std::abs(a.x - b.x - options.expected_dx_px) <= options.max_ddx_px &&
+                 std::abs(a.y - b.y) <= options.max_dy_px;
+      }
+    }
+  }
   std::vector<std::vector<cv::DMatch>> knn;
-  matcher.knnMatch(query.descriptors, train.descriptors, knn, 2);
+  matcher.knnMatch(query.descriptors, train.descriptors, knn, 2, mask);
   std::vector<int> best_query_for_train;
   if (options.mutual) {
     std::vector<cv::DMatch> back;
-    matcher.match(train.descriptors, query.descriptors, back);
+    matcher.match(train.descriptors, query.descriptors, back, guided ? cv::Mat(mask.t()) : cv::Mat());
     best_query_for_train.assign(train.keypoints.size(), -1);
     for (const auto& m : back)
       best_query_for_train[static_cast<std::size_t>(m.queryIdx)] = m.trainIdx;

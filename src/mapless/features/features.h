@@ -49,6 +49,12 @@ struct MatchOptions {
   double ratio = 0.85;     // Lowe's ratio test: best distance < ratio * second best
   double max_dy_px = 1e9;  // reject matches whose vertical offset exceeds this
   bool mutual = false;     // keep only matches that are also best in the other direction
+  // Guided matching: when max_ddx_px is finite, a query feature at x may only match a train
+  // feature at x - expected_dx_px +- max_ddx_px (and within max_dy_px vertically), and the ratio
+  // test compares only candidates inside that window. A displacement predicted from the previous
+  // frame keeps a repeating texture (bricks, fences) from matching one period away.
+  double expected_dx_px = 0.0;  // predicted x_query - x_train
+  double max_ddx_px = 1e9;
   void Validate() const;
 };
 

@@ -59,6 +59,33 @@ TEST(MatchFeatures, VerticalOffsetBoundRejectsMatches) {
   EXPECT_LT(MatchFeatures(a, b, tight).size(), MatchFeatures(a, b, loose).size() / 5);
 }
 
+// A repeating texture: the query feature has two identical candidates 40 px apart. The ratio test
+// rejects the ambiguous match; a displacement prediction keeps only the candidate near it.
+TEST(MatchFeatures, GuidedMatchingResolvesARepeatingPattern) {
+  cv::Mat d = cv::Mat::zeros(1, 32, CV_8U);
+  for (int i = 0; i < 32; ++i) d.at<uchar>(0, i) = static_cast<uchar>(37 * i + 11);
+  Features query;
+  query.keypoints = {cv::KeyPoint(100.f, 50.f, 31.f)};
+  query.descriptors = d.clone();
+  Features train;
+  train.keypoints = {cv::KeyPoint(95.f, 50.f, 31.f), cv::KeyPoint(135.f, 50.f, 31.f)};
+  cv::vconcat(d, d, train.descriptors);
+  MatchOptions plain;
+  EXPECT_TRUE(MatchFeatures(query, train, plain).empty());
+  MatchOptions guided;
+  guided.expected_dx_px = -35.0;  // x_query - x_train predicted: the feature at 135
+  guided.max_ddx_px = 15.0;
+  const auto near_135 = MatchFeatures(query, train, guided);
+  ASSERT_EQ(near_135.size(), 1u);
+  EXPECT_EQ(near_135[0].trainIdx, 1);
+  guided.expected_dx_px = 5.0;  // the feature at 95
+  const auto near_95 = MatchFeatures(query, train, guided);
+  ASSERT_EQ(near_95.size(), 1u);
+  EXPECT_EQ(near_95[0].trainIdx, 0);
+  guided.expected_dx_px = 200.0;  // nothing near the prediction
+  EXPECT_TRUE(MatchFeatures(query, train, guided).empty());
+}
+
 TEST(TrackKlt, RecoversASubPixelTranslation) {
   const cv::Mat frame = SimFrame("table1_almost_straight", Pose2{1.0, 0.0, 0.0});
   cv::Mat moved;

@@ -7,6 +7,20 @@
 #include "mapless/core/check.h"
 
 namespace mapless::navigation {
+namespace {
+
+// Median of b.x - a.x over pairs (0 when empty).
+double MedianDx(const std::vector<cv::Point2f>& a, const std::vector<cv::Point2f>& b) {
+  std::vector<double> d;
+  d.reserve(a.size());
+  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) d.push_back(b[i].x - a[i].x);
+  if (d.empty()) return 0.0;
+  const auto mid = d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2);
+  std::nth_element(d.begin(), mid, d.end());
+  return *mid;
+}
+
+}  // namespace
 
 Controller ParseController(const std::string& name) {
   if (name == "sloped") return Controller::kSloped;
@@ -51,6 +65,10 @@ void RepeatOptions::Validate() const {
                 "RepeatOptions.min_switch_features = " << min_switch_features << "; must be >= 2");
   MAPLESS_CHECK(ransac_threshold_px >= 0.0,
                 "RepeatOptions.ransac_threshold_px = " << ransac_threshold_px << "; must be >= 0");
+  MAPLESS_CHECK(guided_window_px >= 0.0,
+                "RepeatOptions.guided_window_px = " << guided_window_px << "; must be >= 0");
+  MAPLESS_CHECK(guided_release_s > 0.0,
+                "RepeatOptions.guided_release_s = " << guided_release_s << "; must be > 0");
   MAPLESS_CHECK(mse_rising_frames >= 1,
                 "RepeatOptions.mse_rising_frames = " << mse_rising_frames << "; must be >= 1");
 }
@@ -90,7 +108,12 @@ std::vector<control::FeaturePair> RepeatSession::Pairs() const {
 void RepeatSession::DetectAndMatch(const cv::Mat& grey, RepeatStep* step) {
   const features::Features current = extractor_.Extract(grey);
   const auto& kf = keyframe_features_[static_cast<std::size_t>(destination_)];
-  const std::vector<cv::DMatch> matches = features::MatchFeatures(current, kf, options_.matching);
+  features::MatchOptions matching = options_.matching;
+  if (options_.guided_window_px > 0.0 && have_expected_dx_) {
+    matching.expected_dx_px = expected_dx_;
+    matching.max_ddx_px = options_.guided_window_px;
+  }
+  const std::vector<cv::DMatch> matches = features::MatchFeatures(current, kf, matching);
   current_px_.clear();
   destination_px_.clear();
   for (const auto& m : matches) {
@@ -182,6 +205,7 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
       waiting_since_ns_ = t_ns;
     }
     const double waited = ToSeconds(t_ns - waiting_since_ns_);
+    if (waited > options_.guided_release_s) have_expected_dx_ = false;
     if (waited > options_.abort_after_s) {
       return Stop(step, RepeatStatus::kAborted,
                   "aborted: fewer than " + std::to_string(options_.min_features) +
@@ -195,6 +219,8 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
     return step;
   }
   waiting_ = false;
+  expected_dx_ = MedianDx(destination_px_, current_px_);
+  have_expected_dx_ = true;
 
   // Line 9: switch to the next segment.
   std::vector<control::FeaturePair> pairs = Pairs();
@@ -215,6 +241,11 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
       step.destination = destination_;
       return Stop(step, RepeatStatus::kCompleted, "route completed: passed the last keyframe");
     }
+    // Predict the displacement against the new destination: the current one against the old
+    // destination, minus how far features moved from it to the new one during the teach.
+    const auto& next = route_->keyframes[static_cast<std::size_t>(destination_)];
+    if (!next.segment_start_px.empty())
+      expected_dx_ -= MedianDx(next.segment_start_px, next.segment_end_px);
     // Lines 11-14: detect and match against the new destination.
     DetectAndMatch(grey, &step);
     step.matches = last_matches_;

@@ -34,7 +34,7 @@ struct RepeatOptions {
   Controller controller = Controller::kSloped;
   Switching switching = Switching::kStdRatio;
   features::FeatureOptions features;                 // must describe like the route's detector
-  features::MatchOptions matching{0.8, 60.0, true};  // ratio, max |dy| px, mutual
+  features::MatchOptions matching{0.8, 30.0, true};  // ratio, max |dy| px, mutual
   features::KltOptions klt;
   control::SlopedFunnelLaneOptions sloped;
   control::StandardFunnelLaneOptions standard;
@@ -50,6 +50,13 @@ struct RepeatOptions {
   // up to 1 m early or late); fresh matches do not. Default: every frame.
   int redetect_every_frames = 1;
   double abort_after_s = 10.0;  // stopped this long without enough features: abort
+  // Guided matching (not in the paper): matches must lie within this many pixels of the
+  // horizontal displacement predicted from the previous frame (at a segment switch: the previous
+  // displacement minus the teach-time shift between the two keyframes). A repeating texture then
+  // cannot match one period away. 0 disables it. The prediction is dropped after waiting
+  // guided_release_s for features, so a wrong prediction cannot hold the robot forever.
+  double guided_window_px = 40.0;
+  double guided_release_s = 1.0;
   void Validate() const;
 };
 
@@ -98,6 +105,8 @@ class RepeatSession {
   std::vector<cv::Point2f> current_px_;      // matched features, tracked in the current images
   std::vector<cv::Point2f> destination_px_;  // their matches in the destination keyframe
   int last_matches_ = 0;
+  bool have_expected_dx_ = false;  // guided matching: a predicted x_current - x_destination
+  double expected_dx_ = 0.0;
   int switch_votes_ = 0;
   int frames_since_detect_ = 0;
   bool waiting_ = false;
