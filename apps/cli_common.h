@@ -40,5 +40,8 @@ void AddBenchCommand(CLI::App* app);
 void AddShiftCommand(CLI::App* app);
 void AddEvalCommand(CLI::App* app);
 void AddTeachRepeatCommands(CLI::App* app);
+void AddFlowCommand(CLI::App* app);
+// Reads an image or throws InputError naming the file.
+cv::Mat ReadImageOrThrow(const std::string& path, int flags);
 
 }  // namespace mapless::app

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   mapless::app::AddSimCommands(&app);
   mapless::app::AddTeachRepeatCommands(&app);
   mapless::app::AddShiftCommand(&app);
+  mapless::app::AddFlowCommand(&app);
   mapless::app::AddEvalCommand(&app);
   mapless::app::AddBenchCommand(&app);
   try {

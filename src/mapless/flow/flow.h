@@ -1,0 +1,61 @@
+// Dense optical flow behind one interface (Ohnishi & Imiya, Section 3.2 and Appendix A): OpenCV DIS
+// (default, fast or medium preset), Farneback, and the paper's dense pyramidal Lucas-Kanade.
+//
+// A flow field is CV_32FC2, one (u, v) per pixel of the first image: the point at (x, y) in the
+// first image is at (x + u, y + v) in the second.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+namespace mapless::flow {
+
+enum class FlowMethod { kDisFast, kDisMedium, kFarneback, kDenseLk };
+
+// "dis" (DIS fast), "dis_medium", "farneback", "lk"; throws InputError on an unknown name.
+FlowMethod ParseFlowMethod(const std::string& name);
+const char* FlowMethodName(FlowMethod method);
+
+// The paper's dense Lucas-Kanade (Appendix A): a 5x5 window, pyramid levels 0-4 built with the 3x3
+// kernel 1/4 (centre), 1/8 (edges), 1/16 (corners), coarse-to-fine with warping. Every pixel is
+// solved at once: the structure tensor and the mismatch vector are box-filtered images, and the
+// 2x2 systems are solved element-wise.
+struct DenseLkOptions {
+  int window = 5;           // side of the square window (odd)
+  int levels = 5;           // pyramid levels 0..levels-1
+  int iterations = 3;       // warping iterations per level
+  double min_eigen = 0.5;  // smaller eigenvalue of the window-averaged tensor (grey^2/px^2)
+                          // below this: a flat window, no update
+  // A 3x3 median of each level's result before it is expanded to the next level. Not in the paper:
+  // a 5x5 window leaves isolated wild vectors that the coarse-to-fine expansion spreads.
+  bool median = true;
+  void Validate() const;
+};
+
+struct FlowOptions {
+  FlowMethod method = FlowMethod::kDisFast;
+  DenseLkOptions lk;
+  void Validate() const;
+};
+
+// Flow from `first` to `second` (8-bit grey or colour, same size).
+cv::Mat ComputeFlow(const cv::Mat& first, const cv::Mat& second, const FlowOptions& options);
+
+// The paper's pyramid: level 0 is the image (CV_32F), level l+1 is level l smoothed with the 3x3
+// kernel above and subsampled by 2.
+std::vector<cv::Mat> BuildPyramid(const cv::Mat& grey, int levels);
+
+cv::Mat DenseLucasKanade(const cv::Mat& first, const cv::Mat& second,
+                         const DenseLkOptions& options);
+
+// End-point error against ground truth; pixels where `valid` is zero (or the truth is unknown,
+// |value| > 1e9 as in Middlebury files) are skipped.
+struct FlowError {
+  double mean_epe_px = 0.0;
+  double median_epe_px = 0.0;
+  long count = 0;
+};
+FlowError EndPointError(const cv::Mat& flow, const cv::Mat& truth, const cv::Mat& valid = {});
+
+}  // namespace mapless::flow
