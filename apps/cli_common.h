@@ -41,6 +41,7 @@ void AddShiftCommand(CLI::App* app);
 void AddEvalCommand(CLI::App* app);
 void AddTeachRepeatCommands(CLI::App* app);
 void AddFlowCommand(CLI::App* app);
+void AddGroundCommand(CLI::App* app);
 // Reads an image or throws InputError naming the file.
 cv::Mat ReadImageOrThrow(const std::string& path, int flags);
 

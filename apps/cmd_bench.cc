@@ -11,6 +11,7 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "cli_common.h"
+#include "mapless/flow/flow.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/sim/driver.h"
 
@@ -208,6 +209,27 @@ void AddBenchCommand(CLI::App* app) {
     });
     j["sim_render_over_dis_fast"] =
         j["sim_render_320x240_ms"].get<double>() / j["opencv_dis_fast_320x240_ms"].get<double>();
+    // Issue 4: the paper's dense pyramidal LK (5x5, levels 0-4) against OpenCV's sparse
+    // calcOpticalFlowPyrLK asked for every pixel with the same window and levels.
+    j["dense_lk_320x240_ms"] = MedianMs(args->repeats, 2, [&](int i) {
+      const auto k = static_cast<std::size_t>(i) % pair_a.size();
+      flow = flow::DenseLucasKanade(pair_a[k], pair_b[k], flow::DenseLkOptions{});
+    });
+    {
+      std::vector<cv::Point2f> every;
+      for (int y = 0; y < pair_a[0].rows; ++y)
+        for (int x = 0; x < pair_a[0].cols; ++x) every.emplace_back(x, y);
+      std::vector<cv::Point2f> next;
+      std::vector<uchar> status;
+      std::vector<float> error;
+      j["opencv_pyrlk_every_pixel_320x240_ms"] = MedianMs(5, 1, [&](int i) {
+        const auto k = static_cast<std::size_t>(i) % pair_a.size();
+        cv::calcOpticalFlowPyrLK(pair_a[k], pair_b[k], every, next, status, error, cv::Size(5, 5),
+                                 4);
+      });
+    }
+    j["pyrlk_every_pixel_over_dense_lk"] = j["opencv_pyrlk_every_pixel_320x240_ms"].get<double>() /
+                                           j["dense_lk_320x240_ms"].get<double>();
     BenchTeachRepeat(&j);
     if (args->json) {
       std::cout << j.dump() << "\n";
@@ -217,7 +239,8 @@ void AddBenchCommand(CLI::App* app) {
     for (const char* key :
          {"sim_render_320x240_ms", "opencv_dis_fast_320x240_ms", "teach_step_ms", "repeat_step_ms",
           "repeat_step_1km_ms", "repeat_step_fresh_ms", "repeat_step_fresh_1km_ms",
-          "segment_start_ms", "opencv_orb500_320x240_ms"}) {
+          "segment_start_ms", "opencv_orb500_320x240_ms", "dense_lk_320x240_ms",
+          "opencv_pyrlk_every_pixel_320x240_ms"}) {
       std::printf("%-34s %10.3f\n", key, j[key].get<double>());
     }
     std::printf("%-34s %10.2f  (issue 2: <= 2.0)\n", "sim_render / dis_fast",
@@ -226,6 +249,8 @@ void AddBenchCommand(CLI::App* app) {
                 j["repeat_step_over_orb"].get<double>());
     std::printf("%-34s %10.2f  (issue 3: <= 6.0)\n", "segment_start / orb500",
                 j["segment_start_over_orb"].get<double>());
+    std::printf("%-34s %10.2f  (issue 4: >= 10)\n", "pyrlk_every_pixel / dense_lk",
+                j["pyrlk_every_pixel_over_dense_lk"].get<double>());
   });
 }
 

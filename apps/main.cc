@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   mapless::app::AddTeachRepeatCommands(&app);
   mapless::app::AddShiftCommand(&app);
   mapless::app::AddFlowCommand(&app);
+  mapless::app::AddGroundCommand(&app);
   mapless::app::AddEvalCommand(&app);
   mapless::app::AddBenchCommand(&app);
   try {
