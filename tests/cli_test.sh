@@ -27,7 +27,7 @@ expect_exit() {
 }
 
 # Every subcommand answers --help with exit 0 and a usage text.
-for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench" "shift" "teach" "repeat" "route" "route info" "eval"; do
+for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench" "shift" "teach" "repeat" "route" "route info" "eval" "flow" "ground"; do
   # shellcheck disable=SC2086
   expect_exit "help: mapless $sub --help" 0 "$MAPLESS" $sub --help
   grep -qi "usage" "$TMP/out"; check "help text: mapless $sub" $?
@@ -89,6 +89,22 @@ dx=$(sed 's/.*"dx_px":\([-0-9.e]*\).*/\1/' "$TMP/out")
 awk -v d="$dx" 'BEGIN { exit !(d > 40.5 - 17.5 && d < 40.5 + 17.5) }'; check "shift of Stromovka place 1, session 12 vs 01 is 40.5 +- 17.5 px (got $dx)" $?
 expect_exit "shift of a missing image exits 2" 2 "$MAPLESS" shift "$S/0101.png" "$TMP/none.png"
 grep -q "none.png: cannot read image" "$TMP/err"; check "shift names the missing image" $?
+
+# Optical flow and the dominant plane on two simulator frames of the downward-looking corridor.
+expect_exit "render f0" 0 "$MAPLESS" sim render --scenario corridor_straight_3p5m --pose 0,0,0 --out "$TMP/f0.png"
+expect_exit "render f1" 0 "$MAPLESS" sim render --scenario corridor_straight_3p5m --pose 0.05,0,0 --out "$TMP/f1.png"
+expect_exit "flow --out" 0 "$MAPLESS" flow "$TMP/f0.png" "$TMP/f1.png" --out "$TMP/f.flo" --method lk
+expect_exit "flow against its own output" 0 "$MAPLESS" flow "$TMP/f0.png" "$TMP/f1.png" --method lk --gt "$TMP/f.flo"
+grep -q '"epe_px":0' "$TMP/out"; check "flow EPE against its own output is 0" $?
+head -c 100 "$TMP/f.flo" > "$TMP/short.flo"
+expect_exit "truncated .flo exits 2" 2 "$MAPLESS" flow "$TMP/f0.png" "$TMP/f1.png" --gt "$TMP/short.flo"
+grep -q "short.flo: truncated" "$TMP/err"; check "flow names the truncated .flo" $?
+expect_exit "unknown flow method exits 2" 2 "$MAPLESS" flow "$TMP/f0.png" "$TMP/f1.png" --out "$TMP/g.flo" --method magic
+grep -q "unknown flow method 'magic'" "$TMP/err"; check "flow names the unknown method" $?
+expect_exit "ground --out" 0 "$MAPLESS" ground "$TMP/f0.png" "$TMP/f1.png" --out "$TMP/ground.png" --roi-top 0
+[ -s "$TMP/ground.png" ]; check "ground wrote a mask" $?
+expect_exit "ground of a missing frame exits 2" 2 "$MAPLESS" ground "$TMP/f0.png" "$TMP/none.png" --out "$TMP/g.png"
+grep -q "none.png: cannot read image" "$TMP/err"; check "ground names the missing frame" $?
 
 # Teach from a recorded image folder, inspect, repeat open loop: one JSON line per frame.
 expect_exit "teach from an image folder" 0 "$MAPLESS" teach --source "$TMP/d1/frames" --out "$TMP/route"

@@ -105,8 +105,8 @@ std::vector<cv::Mat> BuildPyramid(const cv::Mat& grey, int levels) {
   return pyramid;
 }
 
-cv::Mat DenseLucasKanade(const cv::Mat& first, const cv::Mat& second,
-                         const DenseLkOptions& options) {
+cv::Mat DenseLucasKanade(const cv::Mat& first, const cv::Mat& second, const DenseLkOptions& options,
+                         std::vector<cv::Mat>* level_flows) {
   options.Validate();
   const cv::Mat a = ToGrey(first);
   const cv::Mat b = ToGrey(second);
@@ -115,6 +115,7 @@ cv::Mat DenseLucasKanade(const cv::Mat& first, const cv::Mat& second,
                                           << b.rows);
   const std::vector<cv::Mat> pa = BuildPyramid(a, options.levels);
   const std::vector<cv::Mat> pb = BuildPyramid(b, options.levels);
+  if (level_flows != nullptr) level_flows->clear();
   const cv::Size win(options.window, options.window);
   cv::Mat flow;
   for (int l = static_cast<int>(pa.size()) - 1; l >= 0; --l) {
@@ -156,6 +157,7 @@ cv::Mat DenseLucasKanade(const cv::Mat& first, const cv::Mat& second,
       for (cv::Mat& c : uv) cv::medianBlur(c, c, 3);
       cv::merge(uv, flow);
     }
+    if (level_flows != nullptr) level_flows->insert(level_flows->begin(), flow.clone());
   }
   return flow;
 }

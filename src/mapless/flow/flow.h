@@ -46,8 +46,10 @@ cv::Mat ComputeFlow(const cv::Mat& first, const cv::Mat& second, const FlowOptio
 // kernel above and subsampled by 2.
 std::vector<cv::Mat> BuildPyramid(const cv::Mat& grey, int levels);
 
-cv::Mat DenseLucasKanade(const cv::Mat& first, const cv::Mat& second,
-                         const DenseLkOptions& options);
+// `level_flows`, when given, receives each layer's flow u^l (finest first) in that layer's pixels:
+// the layer optical flow fields of Section 3.6, for hierarchical dominant planes.
+cv::Mat DenseLucasKanade(const cv::Mat& first, const cv::Mat& second, const DenseLkOptions& options,
+                         std::vector<cv::Mat>* level_flows = nullptr);
 
 // End-point error against ground truth; pixels where `valid` is zero (or the truth is unknown,
 // |value| > 1e9 as in Middlebury files) are skipped.

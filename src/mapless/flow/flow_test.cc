@@ -74,6 +74,18 @@ TEST(DenseLucasKanade, RecoversALargeMotionThroughThePyramid) {
   EXPECT_GT(InteriorError(DenseLucasKanade(a, b, one_level), -12.0, 6.0), 3.0);
 }
 
+TEST(DenseLucasKanade, ReturnsEachLayersFlowInItsOwnPixels) {
+  const cv::Mat a = Texture(320, 240, 9);
+  const cv::Mat b = Translate(a, 8.0, 0.0);
+  std::vector<cv::Mat> layers;
+  DenseLucasKanade(a, b, DenseLkOptions{}, &layers);
+  ASSERT_EQ(layers.size(), 5u);
+  EXPECT_EQ(layers[0].size(), cv::Size(320, 240));
+  EXPECT_EQ(layers[1].size(), cv::Size(160, 120));
+  const cv::Vec2f centre = layers[1].at<cv::Vec2f>(60, 80);
+  EXPECT_NEAR(centre[0], 4.0, 0.5);  // 8 px at full resolution is 4 px at layer 1
+}
+
 TEST(BuildPyramid, UsesThePapersKernelAndHalvesEachLevel) {
   cv::Mat impulse = cv::Mat::zeros(16, 16, CV_8U);
   impulse.at<uchar>(8, 8) = 160;
