@@ -61,6 +61,8 @@ void RepeatOptions::Validate() const {
                 "RepeatOptions.abort_after_s = " << abort_after_s << "; must be > 0");
   MAPLESS_CHECK(switch_confirm_frames >= 1, "RepeatOptions.switch_confirm_frames = "
                                                 << switch_confirm_frames << "; must be >= 1");
+  MAPLESS_CHECK(final_confirm_frames >= 1, "RepeatOptions.final_confirm_frames = "
+                                               << final_confirm_frames << "; must be >= 1");
   MAPLESS_CHECK(min_switch_features >= 2,
                 "RepeatOptions.min_switch_features = " << min_switch_features << "; must be >= 2");
   MAPLESS_CHECK(ransac_threshold_px >= 0.0,
@@ -227,8 +229,10 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
   step.switching = control::CheckSwitch(pairs, options_.switch_rule);
   const bool enough = static_cast<int>(pairs.size()) >= options_.min_switch_features;
   switch_votes_ = (step.switching.switch_now && enough) ? switch_votes_ + 1 : 0;
+  const bool last = destination_ + 1 >= static_cast<int>(route_->keyframes.size());
+  const int confirm = last ? options_.final_confirm_frames : options_.switch_confirm_frames;
   const bool switch_now = options_.switching == Switching::kStdRatio
-                              ? switch_votes_ >= options_.switch_confirm_frames
+                              ? switch_votes_ >= confirm
                               : (mse_.Update(pairs) && enough);
   if (switch_now) {
     step.switched = true;

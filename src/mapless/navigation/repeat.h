@@ -41,6 +41,9 @@ struct RepeatOptions {
   control::SwitchOptions switch_rule;
   int mse_rising_frames = 2;
   int switch_confirm_frames = 3;     // the StdRatio/ED condition must hold this many frames
+  // ... and this many for the last keyframe, whose switch ends the route: an early end cannot be
+  // caught up by a later segment.
+  int final_confirm_frames = 3;
   int min_switch_features = 20;      // no switching on fewer features (their spread is noise)
   double ransac_threshold_px = 3.0;  // outlier rejection of matches by a fundamental matrix
                                      // (RANSAC, needs no calibration); 0 disables it
