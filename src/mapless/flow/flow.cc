@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
@@ -17,6 +18,15 @@ cv::Mat ToGrey(const cv::Mat& image) {
   if (image.channels() == 4) cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
   MAPLESS_CHECK(grey.type() == CV_8UC1, "ComputeFlow: expected an 8-bit image");
   return grey;
+}
+
+// Both images as 8-bit grey, checked to be the same size.
+std::pair<cv::Mat, cv::Mat> GreyPair(const cv::Mat& first, const cv::Mat& second, const char* who) {
+  cv::Mat a = ToGrey(first);
+  cv::Mat b = ToGrey(second);
+  MAPLESS_CHECK(a.size() == b.size(), who << ": images of different sizes " << a.cols << "x"
+                                          << a.rows << " and " << b.cols << "x" << b.rows);
+  return {a, b};
 }
 
 // Solves the per-pixel 2x2 systems [a11 a12; a12 a22] d = -[b1; b2] and adds d to `flow`.
@@ -108,11 +118,7 @@ std::vector<cv::Mat> BuildPyramid(const cv::Mat& grey, int levels) {
 cv::Mat DenseLucasKanade(const cv::Mat& first, const cv::Mat& second, const DenseLkOptions& options,
                          std::vector<cv::Mat>* level_flows) {
   options.Validate();
-  const cv::Mat a = ToGrey(first);
-  const cv::Mat b = ToGrey(second);
-  MAPLESS_CHECK(a.size() == b.size(), "DenseLucasKanade: images of different sizes "
-                                          << a.cols << "x" << a.rows << " and " << b.cols << "x"
-                                          << b.rows);
+  const auto [a, b] = GreyPair(first, second, "DenseLucasKanade");
   const std::vector<cv::Mat> pa = BuildPyramid(a, options.levels);
   const std::vector<cv::Mat> pb = BuildPyramid(b, options.levels);
   if (level_flows != nullptr) level_flows->clear();
@@ -164,11 +170,7 @@ cv::Mat DenseLucasKanade(const cv::Mat& first, const cv::Mat& second, const Dens
 
 cv::Mat ComputeFlow(const cv::Mat& first, const cv::Mat& second, const FlowOptions& options) {
   options.Validate();
-  const cv::Mat a = ToGrey(first);
-  const cv::Mat b = ToGrey(second);
-  MAPLESS_CHECK(a.size() == b.size(), "ComputeFlow: images of different sizes "
-                                          << a.cols << "x" << a.rows << " and " << b.cols << "x"
-                                          << b.rows);
+  const auto [a, b] = GreyPair(first, second, "ComputeFlow");
   cv::Mat flow;
   switch (options.method) {
     case FlowMethod::kDisFast:
