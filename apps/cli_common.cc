@@ -1,5 +1,6 @@
 #include "cli_common.h"
 
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <vector>
 
@@ -64,6 +65,25 @@ sim::DriveOptions LoadDriveOptions(const std::string& config_path) {
     throw InputError(config_path + ": " + e.what());
   }
   return options;
+}
+
+cv::Mat ReadImageOrThrow(const std::string& path, int flags) {
+  cv::Mat img;
+  try {
+    img = cv::imread(path, flags);
+  } catch (const cv::Exception&) {
+    img.release();
+  }
+  if (img.empty()) throw InputError(path + ": cannot read image (missing, or not an image file)");
+  return img;
+}
+
+void RequireSameSize(const cv::Mat& image, const std::string& path, const cv::Mat& reference,
+                     const std::string& reference_path) {
+  if (image.size() == reference.size()) return;
+  throw InputError(path + ": size " + std::to_string(image.cols) + "x" +
+                   std::to_string(image.rows) + " differs from " + reference_path + " (" +
+                   std::to_string(reference.cols) + "x" + std::to_string(reference.rows) + ")");
 }
 
 }  // namespace mapless::app

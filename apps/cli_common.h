@@ -44,5 +44,8 @@ void AddFlowCommand(CLI::App* app);
 void AddGroundCommand(CLI::App* app);
 // Reads an image or throws InputError naming the file.
 cv::Mat ReadImageOrThrow(const std::string& path, int flags);
+// Throws InputError naming `path` and both sizes unless `image` has `reference`'s size.
+void RequireSameSize(const cv::Mat& image, const std::string& path, const cv::Mat& reference,
+                     const std::string& reference_path);
 
 }  // namespace mapless::app

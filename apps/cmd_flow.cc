@@ -14,17 +14,6 @@
 
 namespace mapless::app {
 
-cv::Mat ReadImageOrThrow(const std::string& path, int flags) {
-  cv::Mat img;
-  try {
-    img = cv::imread(path, flags);
-  } catch (const cv::Exception&) {
-    img.release();
-  }
-  if (img.empty()) throw InputError(path + ": cannot read image (missing, or not an image file)");
-  return img;
-}
-
 void AddFlowCommand(CLI::App* app) {
   struct Args {
     std::string first;
@@ -47,11 +36,7 @@ void AddFlowCommand(CLI::App* app) {
     options.method = flow::ParseFlowMethod(args->method);
     const cv::Mat a = ReadImageOrThrow(args->first, cv::IMREAD_GRAYSCALE);
     const cv::Mat b = ReadImageOrThrow(args->second, cv::IMREAD_GRAYSCALE);
-    if (a.size() != b.size()) {
-      throw InputError(args->second + ": size " + std::to_string(b.cols) + "x" +
-                       std::to_string(b.rows) + " differs from " + args->first + " (" +
-                       std::to_string(a.cols) + "x" + std::to_string(a.rows) + ")");
-    }
+    RequireSameSize(b, args->second, a, args->first);
     const cv::Mat field = flow::ComputeFlow(a, b, options);
     if (!args->out.empty()) {
       io::WriteFlo(args->out, field);
@@ -60,8 +45,7 @@ void AddFlowCommand(CLI::App* app) {
     if (!args->truth.empty()) {
       cv::Mat valid;
       const cv::Mat truth = io::ReadFlowFile(args->truth, &valid);
-      if (truth.size() != field.size())
-        throw InputError(args->truth + ": ground truth size differs from the images");
+      RequireSameSize(truth, args->truth, a, args->first);
       const flow::FlowError e = flow::EndPointError(field, truth, valid);
       nlohmann::json j;
       j["method"] = args->method;

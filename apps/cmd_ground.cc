@@ -60,8 +60,7 @@ void AddGroundCommand(CLI::App* app) {
     options.Validate();
     const cv::Mat a = ReadImageOrThrow(args->first, cv::IMREAD_GRAYSCALE);
     const cv::Mat b = ReadImageOrThrow(args->second, cv::IMREAD_GRAYSCALE);
-    if (a.size() != b.size())
-      throw InputError(args->second + ": size differs from " + args->first);
+    RequireSameSize(b, args->second, a, args->first);
     const cv::Mat field = flow::ComputeFlow(a, b, flow_options);
     const ground::DominantPlane plane = ground::DetectDominantPlane(field, options);
     if (!plane.found) {
@@ -71,8 +70,7 @@ void AddGroundCommand(CLI::App* app) {
     if (!args->out.empty()) io::WriteImageAtomic(args->out, plane.mask);
     if (!args->truth.empty()) {
       const cv::Mat truth = ReadImageOrThrow(args->truth, cv::IMREAD_GRAYSCALE);
-      if (truth.size() != a.size())
-        throw InputError(args->truth + ": size differs from " + args->first);
+      RequireSameSize(truth, args->truth, a, args->first);
       const cv::Mat gt = truth > 127;
       const int top = static_cast<int>(args->iou_top * a.rows);
       nlohmann::json j;

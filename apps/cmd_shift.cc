@@ -10,20 +10,6 @@
 #include "mapless/features/shift.h"
 
 namespace mapless::app {
-namespace {
-
-cv::Mat ReadGrey(const std::string& path) {
-  cv::Mat img;
-  try {
-    img = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  } catch (const cv::Exception&) {
-    img.release();
-  }
-  if (img.empty()) throw InputError(path + ": cannot read image (missing, or not an image file)");
-  return img;
-}
-
-}  // namespace
 
 void AddShiftCommand(CLI::App* app) {
   struct Args {
@@ -50,7 +36,7 @@ void AddShiftCommand(CLI::App* app) {
     options.matching.ratio = args->ratio;
     options.Validate();
     const features::ShiftEstimate e =
-        features::EstimateShift(ReadGrey(args->reference), ReadGrey(args->current), options);
+        features::EstimateShift(ReadImageOrThrow(args->reference, cv::IMREAD_GRAYSCALE), ReadImageOrThrow(args->current, cv::IMREAD_GRAYSCALE), options);
     if (args->json) {
       nlohmann::json j;
       j["dx_px"] = e.dx_px;

@@ -1,6 +1,7 @@
 #include "mapless/navigation/repeat.h"
 
 #include <algorithm>
+#include <utility>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -14,10 +15,7 @@ double MedianDx(const std::vector<cv::Point2f>& a, const std::vector<cv::Point2f
   std::vector<double> d;
   d.reserve(a.size());
   for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) d.push_back(b[i].x - a[i].x);
-  if (d.empty()) return 0.0;
-  const auto mid = d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2);
-  std::nth_element(d.begin(), mid, d.end());
-  return *mid;
+  return control::Median(std::move(d));
 }
 
 }  // namespace
