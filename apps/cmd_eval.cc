@@ -11,9 +11,80 @@
 
 #include "cli_common.h"
 #include "mapless/core/check.h"
+#include "mapless/eval/potential.h"
 #include "mapless/eval/suite.h"
 
 namespace mapless::app {
+
+namespace {
+
+// `mapless eval potential`: Ohnishi & Imiya, Section 5 (see eval/potential.h).
+void RunPotentialSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
+                       const std::string& only) {
+  std::vector<eval::PotentialEntry> entries;
+  for (const auto& e : eval::PotentialSuiteEntries())
+    if (only.empty() || e.scenario == only) entries.push_back(e);
+  if (entries.empty()) throw InputError("--only '" + only + "': not a scenario of suite potential");
+  const navigation::PotentialNavOptions nav;
+  std::vector<eval::PotentialEntryResult> results(entries.size());
+  std::size_t next = 0;
+  while (next < entries.size()) {
+    std::vector<std::future<void>> batch;
+    for (int j = 0; j < jobs && next < entries.size(); ++j, ++next) {
+      const std::size_t k = next;
+      batch.push_back(std::async(std::launch::async, [&, k] {
+        results[k] = eval::RunPotentialEntry(entries[k], runs, seed, nav);
+        spdlog::info("eval: {} {}: {}/{} successes", entries[k].scenario, entries[k].experiment,
+                     results[k].successes, results[k].runs);
+      }));
+    }
+    for (auto& f : batch) f.get();
+  }
+  std::vector<eval::InclusionResult> inclusion;
+  for (const char* name : {"corridor_straight_3p5m", "obstacle_field"})
+    if (only.empty() || only == name)
+      inclusion.push_back(eval::InclusionOnSimulator(sim::LoadScenario(name), nav.plane));
+
+  nlohmann::json j;
+  j["suite"] = "potential";
+  j["runs"] = runs;
+  j["seed"] = seed;
+  j["results"] = nlohmann::json::array();
+  FILE* table = json_out ? stderr : stdout;
+  std::fprintf(table, "%-24s %-14s %9s %5s %10s %10s %10s\n", "scenario", "experiment", "success",
+               "coll", "final rms", "dev std", "dev max");
+  for (const auto& r : results) {
+    j["results"].push_back({{"scenario", r.scenario},
+                            {"controller", "potential"},
+                            {"experiment", r.experiment},
+                            {"runs", r.runs},
+                            {"successes", r.successes},
+                            {"final_error_m_rms", r.final_error_m_rms},
+                            {"final_error_m_std", r.final_error_m_std},
+                            {"lateral_rms_m", r.lateral_rms_m},
+                            {"collisions", r.collisions},
+                            {"deviation_std_m", r.deviation_std_m},
+                            {"deviation_std_m_max", r.deviation_std_m_max},
+                            {"failures", r.failures}});
+    std::fprintf(table, "%-24s %-14s %4d/%-4d %5d %9.3fm %9.4fm %9.4fm\n", r.scenario.c_str(),
+                 r.experiment.c_str(), r.successes, r.runs, r.collisions, r.final_error_m_rms,
+                 r.deviation_std_m, r.deviation_std_m_max);
+  }
+  j["inclusion"] = nlohmann::json::array();
+  for (const auto& in : inclusion) {
+    j["inclusion"].push_back({{"scenario", in.scenario},
+                              {"frames", in.frames},
+                              {"p_d0_in_d1", in.inclusion[0]},
+                              {"p_d1_in_d2", in.inclusion[1]},
+                              {"p_d2_in_d3", in.inclusion[2]}});
+    std::fprintf(table, "inclusion %-24s frames %3d  P(D0<D1) %.3f  P(D1<D2) %.3f  P(D2<D3) %.3f\n",
+                 in.scenario.c_str(), in.frames, in.inclusion[0], in.inclusion[1],
+                 in.inclusion[2]);
+  }
+  if (json_out) std::cout << j.dump() << "\n";
+}
+
+}  // namespace
 
 void AddEvalCommand(CLI::App* app) {
   struct Args {
@@ -26,8 +97,8 @@ void AddEvalCommand(CLI::App* app) {
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app->add_subcommand(
-      "eval", "Run an evaluation suite on the simulator (table1, funnel-scenarios)");
-  cmd->add_option("SUITE", args->suite, "table1 or funnel-scenarios")->required();
+      "eval", "Run an evaluation suite on the simulator (table1, funnel-scenarios, potential)");
+  cmd->add_option("SUITE", args->suite, "table1, funnel-scenarios or potential")->required();
   cmd->add_option("--runs", args->runs, "Repeats per scenario and controller")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
@@ -38,6 +109,10 @@ void AddEvalCommand(CLI::App* app) {
       ->check(CLI::Range(1, 64));
   cmd->add_option("--only", args->only, "Evaluate only this scenario of the suite");
   cmd->callback([args] {
+    if (args->suite == "potential") {
+      RunPotentialSuite(args->runs, args->seed, args->json, args->jobs, args->only);
+      return;
+    }
     std::vector<eval::SuiteEntry> entries = eval::SuiteEntries(args->suite);
     if (!args->only.empty()) {
       std::vector<eval::SuiteEntry> kept;

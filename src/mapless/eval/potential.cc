@@ -1,0 +1,296 @@
+#include "mapless/eval/potential.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "mapless/core/check.h"
+#include "mapless/core/rng.h"
+#include "mapless/flow/flow.h"
+#include "mapless/sim/simulation.h"
+
+namespace mapless::eval {
+namespace {
+
+// The scenario's taught path as points (start first).
+std::vector<Eigen::Vector2d> PathPoints(const sim::Scenario& s) {
+  std::vector<Eigen::Vector2d> pts{{s.teach_start.x_m, s.teach_start.y_m}};
+  for (const auto& step : s.teach_path)
+    if (step.kind == sim::PathStep::Kind::kGoTo) pts.push_back(step.target);
+  return pts;
+}
+
+double Rms(const std::vector<double>& v) {
+  double s = 0.0;
+  for (double x : v) s += x * x;
+  return v.empty() ? 0.0 : std::sqrt(s / static_cast<double>(v.size()));
+}
+
+double Std(const std::vector<double>& v) {
+  if (v.empty()) return 0.0;
+  double mean = 0.0;
+  for (double x : v) mean += x;
+  mean /= static_cast<double>(v.size());
+  double var = 0.0;
+  for (double x : v) var += (x - mean) * (x - mean);
+  return std::sqrt(var / static_cast<double>(v.size()));
+}
+
+}  // namespace
+
+navigation::PlanarFlowCalibration CalibrateOnSimulator(const sim::Scenario& scenario,
+                                                       const navigation::PotentialNavOptions& nav,
+                                                       int frames) {
+  MAPLESS_CHECK(frames >= 2, "calibration frames = " << frames << "; must be >= 2");
+  navigation::PlanarFlowCalibration c;
+  c.width = scenario.camera.model.width;
+  c.height = scenario.camera.model.height;
+  c.period_s = 1.0 / scenario.camera.rate_hz;
+  c.speed_mps = nav.potential.max_translation_mps;
+  c.omega_radps = nav.potential.max_rotation_radps;
+  sim::CameraSpec camera = scenario.camera;
+  camera.effects = {};
+  sim::RobotOptions robot = scenario.robot;
+  robot.motion_noise_v_frac = robot.motion_noise_omega_frac = 0.0;
+  auto drive = [&](const Twist2& twist) {
+    sim::Simulation sim(scenario.world, camera, {}, scenario.seed);
+    const int r = sim.AddRobot(scenario.teach_start, robot);
+    // Reach the constant velocity first (the robot accelerates within its limits).
+    sim.SetCommand(r, twist);
+    sim.Advance(1.0);
+    std::vector<cv::Mat> images;
+    for (int i = 0; i < frames; ++i) {
+      images.push_back(sim.Render(r));
+      sim.Advance(c.period_s);
+    }
+    return navigation::CalibratePlanarModel(images, nav.flow, nav.plane);
+  };
+  c.translational = drive({c.speed_mps, 0.0});
+  c.rotational = drive({0.0, c.omega_radps});
+  return c;
+}
+
+void PotentialRunOptions::Validate() const {
+  nav.Validate();
+  MAPLESS_CHECK(motion_noise_frac >= 0.0 && motion_noise_frac < 1.0,
+                "motion_noise_frac = " << motion_noise_frac << "; must be in [0, 1)");
+  MAPLESS_CHECK(invert_fraction >= 0.0 && invert_fraction <= 1.0,
+                "invert_fraction = " << invert_fraction << "; must be in [0, 1]");
+  MAPLESS_CHECK(timeout_factor > 0.0 && success_radius_m > 0.0,
+                "timeout_factor and success_radius_m must be > 0");
+}
+
+PotentialRun RunPotential(const sim::Scenario& scenario,
+                          const navigation::PlanarFlowCalibration& calibration,
+                          const PotentialRunOptions& options, const PotentialObserver& observer) {
+  options.Validate();
+  Rng rng(options.seed);
+  sim::CameraSpec camera = scenario.camera;
+  camera.effects.invert_fraction = std::max(camera.effects.invert_fraction,
+                                            options.invert_fraction);
+  camera.effects.noise_sigma = std::max(camera.effects.noise_sigma, options.image_noise_sigma);
+  sim::RobotOptions robot = scenario.robot;
+  robot.motion_noise_v_frac = options.motion_noise_frac;
+  robot.motion_noise_omega_frac = options.motion_noise_frac;
+  const Pose2 start = scenario.teach_start * Pose2{0.0, options.start_lateral_m, 0.0};
+  sim::Simulation sim(scenario.world, camera, {}, rng.NextU64());
+  const int r = sim.AddRobot(start, robot);
+
+  navigation::PotentialNavOptions nav = options.nav;
+  nav.homing = options.homing;
+  navigation::PotentialNavigator navigator(calibration, nav);
+  const std::vector<Eigen::Vector2d> taught = PathPoints(scenario);
+  double length = 0.0;
+  for (std::size_t i = 1; i < taught.size(); ++i) length += (taught[i] - taught[i - 1]).norm();
+  Eigen::Vector2d goal(start.x_m, start.y_m);
+  if (options.destination) {
+    navigator.SetDestination(*options.destination);
+    length = (*options.destination - goal).norm() * (options.homing ? 2.0 : 1.0);
+    if (!options.homing) goal = *options.destination;
+  }
+  MAPLESS_CHECK(taught.size() >= 2 || options.destination,
+                "scenario '" << scenario.name << "' has no taught path for corridor centring");
+  const Eigen::Vector2d end = taught.back();
+  const Eigen::Vector2d end_dir = (taught.back() - taught[taught.size() - 2]).normalized();
+  const double period = 1.0 / scenario.camera.rate_hz;
+  const double timeout =
+      options.timeout_factor * length / nav.potential.max_translation_mps + 20.0;
+
+  PotentialRun run;
+  while (true) {
+    const Pose2 pose = sim.robot(r).pose();
+    run.path.push_back(pose);
+    const cv::Mat image = sim.Render(r);
+    const navigation::PotentialStep step = navigator.Update(image, sim.robot(r).odometry());
+    if (observer) observer(pose, image, step);
+    if (step.status == navigation::PotentialStatus::kSearching && !step.plane_mask.empty())
+      ++run.no_plane_frames;
+    if (!options.destination &&
+        (Eigen::Vector2d(pose.x_m, pose.y_m) - end).dot(end_dir) >= 0.0) {
+      run.reached = true;
+      run.status = "passed the end of the corridor";
+      break;
+    }
+    if (navigator.finished()) {
+      run.reached = step.status == navigation::PotentialStatus::kArrived;
+      run.status = step.reason;
+      break;
+    }
+    if (sim.collided(r)) {
+      run.collided = true;
+      run.status = "collision with " + sim.collisions().front().with;
+      break;
+    }
+    if (ToSeconds(sim.now_ns()) > timeout) {
+      run.status = "timeout after " + std::to_string(static_cast<int>(timeout)) + " s";
+      break;
+    }
+    sim.SetCommand(r, step.command);
+    sim.Advance(period);
+  }
+  run.duration_s = ToSeconds(sim.now_ns());
+  const Pose2& last = run.path.back();
+  run.final_error_m =
+      options.destination ? (Eigen::Vector2d(last.x_m, last.y_m) - goal).norm() : 0.0;
+  run.success = run.reached && !run.collided && run.final_error_m <= options.success_radius_m;
+  return run;
+}
+
+double SignedDistanceToPath(const std::vector<Pose2>& path, double x_m, double y_m) {
+  MAPLESS_CHECK(!path.empty(), "SignedDistanceToPath: empty path");
+  if (path.size() == 1) return std::hypot(x_m - path[0].x_m, y_m - path[0].y_m);
+  double best = std::numeric_limits<double>::infinity();
+  double best_signed = 0.0;
+  const Eigen::Vector2d p(x_m, y_m);
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    const Eigen::Vector2d a(path[i - 1].x_m, path[i - 1].y_m);
+    const Eigen::Vector2d b(path[i].x_m, path[i].y_m);
+    const Eigen::Vector2d ab = b - a;
+    const double len2 = ab.squaredNorm();
+    if (len2 < 1e-12) continue;
+    const double t = std::clamp((p - a).dot(ab) / len2, 0.0, 1.0);
+    const Eigen::Vector2d q = a + t * ab;
+    const double d = (p - q).norm();
+    if (d < best) {
+      best = d;
+      const double cross = ab.x() * (p - a).y() - ab.y() * (p - a).x();
+      best_signed = cross >= 0.0 ? d : -d;
+    }
+  }
+  return std::isfinite(best) ? best_signed : std::hypot(x_m - path[0].x_m, y_m - path[0].y_m);
+}
+
+double TrajectoryDeviationStd(const std::vector<Pose2>& clean, const std::vector<Pose2>& noisy) {
+  const std::size_t n = std::min(clean.size(), noisy.size());
+  std::vector<double> diff;
+  diff.reserve(n);
+  for (std::size_t i = 0; i < n; ++i)
+    diff.push_back(SignedDistanceToPath(clean, noisy[i].x_m, noisy[i].y_m));
+  return Std(diff);
+}
+
+InclusionResult InclusionOnSimulator(const sim::Scenario& scenario,
+                                     const ground::DominantPlaneOptions& plane, int max_frames) {
+  InclusionResult result;
+  result.scenario = scenario.name;
+  result.inclusion.assign(3, 0.0);
+  flow::DenseLkOptions lk;
+  lk.levels = 4;  // layers 0-3, as in Table 1
+  cv::Mat previous;
+  int frames = 0;
+  sim::DriveOptions drive;
+  sim::DriveTaughtPath(scenario, drive, [&](const sim::DriveFrame& f) {
+    if (frames >= max_frames) return;
+    if (!previous.empty()) {
+      std::vector<cv::Mat> layer_flows;
+      flow::DenseLucasKanade(previous, f.image, lk, &layer_flows);
+      const ground::HierarchicalPlanes h = ground::DetectHierarchicalPlanes(layer_flows, plane);
+      bool all = true;
+      for (const auto& l : h.layers) all = all && l.found;
+      if (all && h.inclusion.size() >= 3) {
+        for (int l = 0; l < 3; ++l) result.inclusion[l] += h.inclusion[l];
+        ++frames;
+      }
+    }
+    previous = f.image;
+  });
+  result.frames = frames;
+  for (double& v : result.inclusion) v = frames > 0 ? v / frames : 0.0;
+  return result;
+}
+
+std::vector<PotentialEntry> PotentialSuiteEntries() {
+  return {{"corridor_straight_3p5m", "image-noise"}, {"corridor_straight_3p5m", "motion-noise"},
+          {"corridor_s_shaped", "image-noise"},      {"corridor_s_shaped", "motion-noise"},
+          {"obstacle_field", "destination-0"},       {"obstacle_field", "destination-1"},
+          {"obstacle_field", "destination-2"},       {"obstacle_field", "homing"}};
+}
+
+PotentialEntryResult RunPotentialEntry(const PotentialEntry& entry, int runs, std::uint64_t seed,
+                                       const navigation::PotentialNavOptions& nav) {
+  MAPLESS_CHECK(runs >= 1, "runs = " << runs << "; must be >= 1");
+  const sim::Scenario scenario = sim::LoadScenario(entry.scenario);
+  const navigation::PlanarFlowCalibration calibration = CalibrateOnSimulator(scenario, nav);
+  PotentialEntryResult r;
+  r.scenario = entry.scenario;
+  r.experiment = entry.experiment;
+  r.runs = runs;
+  PotentialRunOptions base;
+  base.nav = nav;
+  const bool corridor = entry.experiment == "image-noise" || entry.experiment == "motion-noise";
+  std::vector<Pose2> clean;
+  if (corridor) {
+    // The straight corridor starts off-centre so that centring is exercised; the S-shaped one on
+    // its centre line.
+    base.start_lateral_m = entry.scenario == "corridor_straight_3p5m" ? 0.4 : 0.0;
+    const PotentialRun ref = RunPotential(scenario, calibration, base);
+    MAPLESS_CHECK(ref.success, "the clean corridor run of " << entry.scenario
+                                                            << " failed: " << ref.status);
+    clean = ref.path;
+    // The paper's perturbations (Section 5.2.1): 20% of the pixels, 20% of T and R.
+    if (entry.experiment == "image-noise") base.invert_fraction = 0.2;
+    if (entry.experiment == "motion-noise") base.motion_noise_frac = 0.2;
+  } else {
+    // Navigation and homing: 10% motion noise and sensor noise, as in the other suites.
+    base.motion_noise_frac = 0.1;
+    base.image_noise_sigma = 2.0;
+    const std::size_t d = entry.experiment == "homing"
+                              ? 0
+                              : static_cast<std::size_t>(std::stoi(entry.experiment.substr(12)));
+    MAPLESS_CHECK(d < scenario.destinations.size(),
+                  entry.experiment << ": scenario " << entry.scenario << " has "
+                                   << scenario.destinations.size() << " destinations");
+    base.destination = scenario.destinations[d];
+    base.homing = entry.experiment == "homing";
+  }
+  std::vector<double> finals, deviations, lateral;
+  for (int i = 0; i < runs; ++i) {
+    PotentialRunOptions o = base;
+    o.seed = seed + static_cast<std::uint64_t>(i);
+    const PotentialRun run = RunPotential(scenario, calibration, o);
+    finals.push_back(run.final_error_m);
+    if (corridor) {
+      deviations.push_back(TrajectoryDeviationStd(clean, run.path));
+      for (const Pose2& p : run.path) lateral.push_back(SignedDistanceToPath(clean, p.x_m, p.y_m));
+    }
+    if (run.success) {
+      ++r.successes;
+    } else {
+      r.failures.push_back("run " + std::to_string(i) + " (seed " + std::to_string(o.seed) +
+                           "): " + run.status + ", " + std::to_string(run.final_error_m).substr(0, 4) +
+                           " m from the goal");
+    }
+    if (run.collided) ++r.collisions;
+  }
+  r.final_error_m_rms = Rms(finals);
+  r.final_error_m_std = Std(finals);
+  r.lateral_rms_m = Rms(lateral);
+  if (!deviations.empty()) {
+    double sum = 0.0;
+    for (double d : deviations) sum += d;
+    r.deviation_std_m = sum / static_cast<double>(deviations.size());
+    r.deviation_std_m_max = *std::max_element(deviations.begin(), deviations.end());
+  }
+  return r;
+}
+
+}  // namespace mapless::eval

@@ -1,0 +1,103 @@
+// The visual-potential experiments of Ohnishi & Imiya (Section 5) on the simulator: corridor
+// centring under image noise and motion noise (Fig. 20-26), navigation to destinations through an
+// obstacle field (Fig. 32), homing (Fig. 38-40) and the inclusion measures of Table 1.
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mapless/navigation/potential.h"
+#include "mapless/sim/scenario.h"
+
+namespace mapless::eval {
+
+// Calibrates the pure planar flows on the simulator as the paper does on the robot: from the
+// scenario's teach start, drive straight at T_m for `frames` frames, then turn in place at R_m
+// (clean images, no motion noise).
+navigation::PlanarFlowCalibration CalibrateOnSimulator(const sim::Scenario& scenario,
+                                                       const navigation::PotentialNavOptions& nav,
+                                                       int frames = 6);
+
+struct PotentialRunOptions {
+  navigation::PotentialNavOptions nav;
+  double motion_noise_frac = 0.0;  // of T and R, per command (the paper: 0.2)
+  double invert_fraction = 0.0;    // image noise: fraction of pixels inverted (the paper: 0.2)
+  double image_noise_sigma = 0.0;  // Gaussian image noise, grey levels
+  double start_lateral_m = 0.0;    // start this far left of the scenario's teach start
+  // A destination in world coordinates (the robot is told it relative to its start, and its
+  // odometry starts there). Without one, corridor centring: the run ends when the robot passes
+  // the end of the scenario's taught path.
+  std::optional<Eigen::Vector2d> destination;
+  bool homing = false;              // return to the start after the destination
+  double timeout_factor = 3.0;      // of the path length at T_m (destination and back for homing)
+  double success_radius_m = 0.3;    // final distance to the goal (the issue: 0.3 m)
+  std::uint64_t seed = 1;
+  void Validate() const;
+};
+
+struct PotentialRun {
+  bool success = false;  // reached (or passed the corridor's end), no collision, within radius
+  bool reached = false;
+  bool collided = false;
+  double final_error_m = 0.0;  // to the goal (the start when homing); 0 in corridor mode
+  double duration_s = 0.0;
+  int no_plane_frames = 0;     // frames on which the dominant plane was lost
+  std::string status;
+  std::vector<Pose2> path;  // ground truth, one per frame
+};
+
+using PotentialObserver =
+    std::function<void(const Pose2&, const cv::Mat&, const navigation::PotentialStep&)>;
+
+PotentialRun RunPotential(const sim::Scenario& scenario,
+                          const navigation::PlanarFlowCalibration& calibration,
+                          const PotentialRunOptions& options, const PotentialObserver& observer = {});
+
+// Signed distance from a point to a polyline (positive to the left of its direction).
+double SignedDistanceToPath(const std::vector<Pose2>& path, double x_m, double y_m);
+
+// The paper's corridor-centring figure: the standard deviation, along the time axis, of the
+// difference between a noisy and the clean trajectory (the noisy pose's signed distance to the
+// clean path, over the frames both runs have).
+double TrajectoryDeviationStd(const std::vector<Pose2>& clean, const std::vector<Pose2>& noisy);
+
+// Table 1: the mean inclusion measures P(D_l ⊂ D_l+1), l = 0..2, of the hierarchical dominant
+// planes (dense pyramidal LK layer flows) along the scenario's taught drive.
+struct InclusionResult {
+  std::string scenario;
+  int frames = 0;                 // frame pairs with a plane in every layer
+  std::vector<double> inclusion;  // mean P(D_l ⊂ D_l+1)
+};
+InclusionResult InclusionOnSimulator(const sim::Scenario& scenario,
+                                     const ground::DominantPlaneOptions& plane, int max_frames = 60);
+
+// One line of the potential suite.
+struct PotentialEntry {
+  std::string scenario;
+  std::string experiment;  // image-noise, motion-noise, destination-N, homing
+};
+std::vector<PotentialEntry> PotentialSuiteEntries();
+
+struct PotentialEntryResult {
+  std::string scenario;
+  std::string experiment;
+  int runs = 0;
+  int successes = 0;
+  int collisions = 0;
+  double final_error_m_rms = 0.0;
+  double final_error_m_std = 0.0;
+  double lateral_rms_m = 0.0;      // RMS distance to the clean run's path (corridor) or 0
+  double deviation_std_m = 0.0;    // corridor: mean over runs of TrajectoryDeviationStd
+  double deviation_std_m_max = 0.0;
+  std::vector<std::string> failures;
+};
+
+// Runs `runs` noisy runs of an entry with seeds seed, seed + 1, ... (and, for the corridor, one
+// clean run to compare with).
+PotentialEntryResult RunPotentialEntry(const PotentialEntry& entry, int runs, std::uint64_t seed,
+                                       const navigation::PotentialNavOptions& nav);
+
+}  // namespace mapless::eval

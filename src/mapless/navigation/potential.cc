@@ -1,0 +1,311 @@
+#include "mapless/navigation/potential.h"
+
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "mapless/core/check.h"
+#include "mapless/io/yaml_reader.h"
+
+namespace mapless::navigation {
+namespace {
+
+cv::Mat Grey(const cv::Mat& image) {
+  MAPLESS_CHECK(!image.empty() && image.depth() == CV_8U &&
+                    (image.channels() == 1 || image.channels() == 3),
+                "PotentialNavigator: expected a non-empty 8-bit grey or BGR image");
+  if (image.channels() == 1) return image.clone();
+  cv::Mat grey;
+  cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  return grey;
+}
+
+double MeanMagnitude(const cv::Mat& field) {
+  std::vector<cv::Mat> c;
+  cv::split(field, c);
+  cv::Mat mag;
+  cv::magnitude(c[0], c[1], mag);
+  return cv::mean(mag)[0];
+}
+
+void CheckModel(const cv::Mat& m, const char* field) {
+  MAPLESS_CHECK(m.rows == 3 && m.cols == 3 && m.type() == CV_64F && cv::checkRange(m),
+                "PlanarFlowCalibration." << field << ": expected a finite 3x3 matrix");
+}
+
+}  // namespace
+
+void PlanarFlowCalibration::Validate() const {
+  MAPLESS_CHECK(width > 0 && height > 0, "PlanarFlowCalibration: width and height must be > 0");
+  MAPLESS_CHECK(period_s > 0.0, "PlanarFlowCalibration.period_s = " << period_s
+                                                                    << "; must be > 0");
+  MAPLESS_CHECK(speed_mps > 0.0, "PlanarFlowCalibration.speed_mps = " << speed_mps
+                                                                      << "; must be > 0");
+  MAPLESS_CHECK(omega_radps > 0.0, "PlanarFlowCalibration.omega_radps = " << omega_radps
+                                                                          << "; must be > 0");
+  CheckModel(translational, "translational");
+  CheckModel(rotational, "rotational");
+}
+
+cv::Mat CalibratePlanarModel(const std::vector<cv::Mat>& frames, const flow::FlowOptions& flow,
+                             const ground::DominantPlaneOptions& plane) {
+  MAPLESS_CHECK(frames.size() >= 2, "planar-flow calibration needs at least two frames, got "
+                                        << frames.size());
+  cv::Mat sum = cv::Mat::zeros(3, 3, CV_64F);
+  int count = 0;
+  for (std::size_t i = 1; i < frames.size(); ++i) {
+    const ground::DominantPlane p = ground::DetectDominantPlane(
+        flow::ComputeFlow(Grey(frames[i - 1]), Grey(frames[i]), flow), plane);
+    if (!p.found || std::abs(p.model.at<double>(2, 2)) < 1e-12) continue;
+    sum += p.model / p.model.at<double>(2, 2);
+    ++count;
+  }
+  MAPLESS_CHECK(count > 0, "planar-flow calibration: no dominant plane in any of the "
+                               << frames.size() - 1 << " frame pairs (is the ground in view?)");
+  return sum / count;
+}
+
+std::string CalibrationToYaml(const PlanarFlowCalibration& c) {
+  c.Validate();
+  std::ostringstream out;
+  out.precision(17);
+  auto row = [&](const char* key, const cv::Mat& m) {
+    out << key << ": [";
+    for (int i = 0; i < 9; ++i) out << (i ? ", " : "") << m.at<double>(i / 3, i % 3);
+    out << "]\n";
+  };
+  out << "# mapless planar-flow calibration (visual potential, Section 4.3): ground homographies\n"
+      << "# of one frame period, row-major, driving straight ahead and turning counter-clockwise.\n"
+      << "format: mapless-planar-flow-calibration\nversion: 1\n"
+      << "width: " << c.width << "\nheight: " << c.height << "\nperiod_s: " << c.period_s
+      << "\nspeed_mps: " << c.speed_mps << "\nomega_radps: " << c.omega_radps << "\n";
+  row("translational", c.translational);
+  row("rotational", c.rotational);
+  return out.str();
+}
+
+PlanarFlowCalibration CalibrationFromYaml(const std::string& text, const std::string& source) {
+  const io::YamlMap y = io::YamlMap::LoadString(text, source);
+  y.CheckKnownKeys({"format", "version", "width", "height", "period_s", "speed_mps",
+                    "omega_radps", "translational", "rotational"});
+  if (y.GetString("format") != "mapless-planar-flow-calibration")
+    y.Fail("format", "expected 'mapless-planar-flow-calibration'");
+  if (y.GetInt("version") != 1) y.Fail("version", "unsupported version (this build reads 1)");
+  PlanarFlowCalibration c;
+  c.width = y.GetInt("width");
+  c.height = y.GetInt("height");
+  c.period_s = y.GetDouble("period_s");
+  c.speed_mps = y.GetDouble("speed_mps");
+  c.omega_radps = y.GetDouble("omega_radps");
+  auto model = [&](const char* key) {
+    const std::vector<double> v = y.GetDoubles(key, 9);
+    cv::Mat m(3, 3, CV_64F);
+    for (int i = 0; i < 9; ++i) m.at<double>(i / 3, i % 3) = v[static_cast<std::size_t>(i)];
+    return m;
+  };
+  c.translational = model("translational");
+  c.rotational = model("rotational");
+  try {
+    c.Validate();
+  } catch (const InputError& e) {
+    throw InputError(source + ": " + e.what());
+  }
+  return c;
+}
+
+void PotentialNavOptions::Validate() const {
+  flow.Validate();
+  plane.Validate();
+  potential.Validate();
+  MAPLESS_CHECK(arrive_radius_m > 0.0, "PotentialNavOptions.arrive_radius_m must be > 0");
+  MAPLESS_CHECK(creep_fraction > 0.0 && creep_fraction <= 1.0,
+                "PotentialNavOptions.creep_fraction = " << creep_fraction << "; must be in (0, 1]");
+  MAPLESS_CHECK(min_motion_m >= 0.0, "PotentialNavOptions.min_motion_m must be >= 0");
+  MAPLESS_CHECK(search_step_rad > 0.0 && search_step_rad <= kPi,
+                "PotentialNavOptions.search_step_rad = " << search_step_rad
+                                                         << "; must be in (0, pi]");
+  MAPLESS_CHECK(search_rate_fraction > 0.0 && search_rate_fraction <= 1.0,
+                "PotentialNavOptions.search_rate_fraction must be in (0, 1]");
+  MAPLESS_CHECK(max_search_steps >= 1, "PotentialNavOptions.max_search_steps must be >= 1");
+  MAPLESS_CHECK(force_filter > 0.0 && force_filter <= 1.0,
+                "PotentialNavOptions.force_filter = " << force_filter << "; must be in (0, 1]");
+  MAPLESS_CHECK(misses_before_search >= 1,
+                "PotentialNavOptions.misses_before_search must be >= 1");
+}
+
+const char* PotentialStatusName(PotentialStatus s) {
+  switch (s) {
+    case PotentialStatus::kDriving: return "driving";
+    case PotentialStatus::kLooking: return "looking";
+    case PotentialStatus::kSearching: return "searching";
+    case PotentialStatus::kTurningAround: return "turning_around";
+    case PotentialStatus::kArrived: return "arrived";
+    case PotentialStatus::kAborted: return "aborted";
+  }
+  return "?";
+}
+
+PotentialNavigator::PotentialNavigator(PlanarFlowCalibration calibration,
+                                       PotentialNavOptions options)
+    : calibration_(std::move(calibration)), options_(std::move(options)) {
+  calibration_.Validate();
+  options_.Validate();
+  const cv::Size size(calibration_.width, calibration_.height);
+  translational_flow_ = ground::PlanarFlow(calibration_.translational, size);
+  rotational_flow_ = ground::PlanarFlow(calibration_.rotational, size);
+  flow_scale_ = MeanMagnitude(translational_flow_);
+  MAPLESS_CHECK(flow_scale_ > 1e-3, "PlanarFlowCalibration.translational: the calibrated "
+                                    "forward flow is zero (did the robot move?)");
+  translational_flow_ /= flow_scale_;
+  // The rotational field keeps its size relative to the translational one per unit of speed:
+  // Eq. 13 mixes them as unit motions, so normalise it to the same mean magnitude.
+  rotational_flow_ /= MeanMagnitude(rotational_flow_);
+}
+
+void PotentialNavigator::SetDestination(const Eigen::Vector2d& destination) {
+  destination_ = destination;
+}
+
+PotentialStep PotentialNavigator::Search(PotentialStep step, const Pose2& odometry,
+                                         const std::string& why) {
+  if (status_ != PotentialStatus::kSearching) {
+    ++search_steps_;
+    if (search_steps_ > options_.max_search_steps) {
+      status_ = PotentialStatus::kAborted;
+      step.status = status_;
+      step.reason = why + "; no free ground after " + std::to_string(options_.max_search_steps) +
+                    " turns: stopped";
+      step.command = {};
+      return step;
+    }
+    status_ = PotentialStatus::kSearching;
+    // Turn towards the side where the ground was last seen (the last force's side).
+    turn_direction_ = last_theta_rad_ < 0.0 ? -1.0 : 1.0;
+    turn_target_rad_ = odometry.theta_rad + turn_direction_ * options_.search_step_rad;
+  }
+  step.status = status_;
+  step.reason = why + ": stopped, turning in place to look for free ground";
+  step.command = {0.0, turn_direction_ * options_.search_rate_fraction *
+                           options_.potential.max_rotation_radps};
+  return step;
+}
+
+PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odometry) {
+  MAPLESS_CHECK(image.cols == calibration_.width && image.rows == calibration_.height,
+                "PotentialNavigator: image is " << image.cols << "x" << image.rows
+                                                << ", the calibration is for " << calibration_.width
+                                                << "x" << calibration_.height);
+  PotentialStep step;
+  step.leg = leg_;
+  const cv::Mat grey = Grey(image);
+  if (!start_) start_ = Eigen::Vector2d(odometry.x_m, odometry.y_m);
+  const double vmax = options_.potential.max_translation_mps;
+  const double turn_rate = options_.search_rate_fraction * options_.potential.max_rotation_radps;
+
+  if (destination_) {
+    const Eigen::Vector2d to = *destination_ - Eigen::Vector2d(odometry.x_m, odometry.y_m);
+    step.theta_d_rad = WrapAngle(std::atan2(to.y(), to.x()) - odometry.theta_rad);
+    if (status_ != PotentialStatus::kTurningAround && to.norm() <= options_.arrive_radius_m) {
+      if (options_.homing && leg_ == 0) {
+        // Section 5.4: turn 180 degrees, swap start and destination, navigate back.
+        leg_ = 1;
+        std::swap(*destination_, *start_);
+        status_ = PotentialStatus::kTurningAround;
+        turn_direction_ = 1.0;
+        turn_target_rad_ = odometry.theta_rad + kPi;
+      } else {
+        status_ = PotentialStatus::kArrived;
+      }
+    }
+  }
+  if (finished()) {
+    step.status = status_;
+    step.reason = status_ == PotentialStatus::kArrived ? "destination reached" : "aborted";
+    previous_ = grey;
+    previous_odometry_ = odometry;
+    return step;
+  }
+  step.leg = leg_;
+
+  // Turning in place (searching, or turning round at the destination) until the target heading.
+  if (status_ == PotentialStatus::kSearching || status_ == PotentialStatus::kTurningAround) {
+    const double left = turn_direction_ * WrapAngle(turn_target_rad_ - odometry.theta_rad);
+    if (left > 0.02) {
+      step.status = status_;
+      step.reason = status_ == PotentialStatus::kSearching
+                        ? "no ground plane: turning in place to look for free ground"
+                        : "destination reached: turning round to go home";
+      // Slow down near the target so the turn does not overshoot by a frame.
+      const double period = std::max(calibration_.period_s, 1e-3);
+      const double rate = std::min(turn_rate, left / period);
+      step.command = {0.0, turn_direction_ * rate};
+      previous_ = grey;
+      previous_odometry_ = odometry;
+      return step;
+    }
+    if (status_ == PotentialStatus::kTurningAround) search_steps_ = 0;
+    misses_ = 0;
+    status_ = PotentialStatus::kLooking;
+  }
+
+  // The plane is observable only when the camera translated between the two frames.
+  const double moved = std::hypot(odometry.x_m - previous_odometry_.x_m,
+                                  odometry.y_m - previous_odometry_.y_m);
+  if (previous_.empty() || moved < options_.min_motion_m) {
+    status_ = PotentialStatus::kLooking;
+    step.status = status_;
+    step.reason = "creeping forward one frame to see the ground move";
+    step.command = {options_.creep_fraction * vmax, 0.0};
+    previous_ = grey;
+    previous_odometry_ = odometry;
+    return step;
+  }
+
+  const cv::Mat flow = flow::ComputeFlow(previous_, grey, options_.flow);
+  previous_ = grey;
+  previous_odometry_ = odometry;
+  const ground::DominantPlane plane = ground::DetectDominantPlane(flow, options_.plane);
+  step.plane_found = plane.found;
+  step.plane_fraction = plane.roi_fraction;
+  step.plane_mask = plane.mask;
+  if (!plane.found) {
+    std::ostringstream why;
+    why << "no ground plane (" << static_cast<int>(std::lround(100.0 * plane.roi_fraction))
+        << "% of the view)";
+    if (++misses_ >= options_.misses_before_search) return Search(step, odometry, why.str());
+    // Stop and look again (the next frame, standing, cannot see: it creeps one frame).
+    status_ = PotentialStatus::kLooking;
+    step.status = status_;
+    step.reason = why.str() + ": stopped to look again";
+    step.command = {};
+    return step;
+  }
+  search_steps_ = 0;
+  misses_ = 0;
+
+  // Attraction: the desired flow towards the destination (Eq. 13; theta_d = 0 without one), or
+  // the measured planar flow (Eq. 11) when asked; in units of the calibrated forward flow.
+  const cv::Mat attraction =
+      !destination_ && options_.follow_planar_flow
+          ? cv::Mat(ground::PlanarFlow(plane.model, grey.size()) / flow_scale_)
+          : control::DesiredFlow(translational_flow_, rotational_flow_, step.theta_d_rad);
+  const cv::Mat repulsion = control::RepulsionField(plane.mask, options_.potential);
+  const cv::Mat potential =
+      control::PotentialField(plane.mask, repulsion, attraction, options_.potential);
+  const cv::Vec2d force = control::ControlForce(potential);
+  filtered_force_ = have_force_ ? options_.force_filter * force +
+                                      (1.0 - options_.force_filter) * filtered_force_
+                                : force;
+  have_force_ = true;
+  step.force = filtered_force_;
+  const control::PotentialCommand c = control::CommandFromForce(step.force, options_.potential);
+  step.theta_rad = c.theta_rad;
+  last_theta_rad_ = c.theta_rad;
+  step.command = c.twist;
+  if (!options_.allow_reverse) step.command.v_mps = std::max(0.0, step.command.v_mps);
+  status_ = PotentialStatus::kDriving;
+  step.status = status_;
+  return step;
+}
+
+}  // namespace mapless::navigation

@@ -1,0 +1,144 @@
+// Navigation by the visual potential (Ohnishi & Imiya, Sections 4-5): from consecutive camera
+// images, dense optical flow -> dominant plane (free ground) -> potential field -> (T, R).
+//
+// Three uses, one loop (Fig. 14):
+//   - corridor centring: no destination; the attraction is the calibrated forward flow (Eq. 13 with
+//     theta_d = 0), or, as an option, the measured planar flow of Eq. 11 (see
+//     PotentialNavOptions::follow_planar_flow for why that is not the default);
+//   - navigation to a destination: the attraction is the desired flow mixed from the calibrated
+//     pure translational and rotational planar flows by the destination angle theta_d (Eq. 13-14),
+//     theta_d from the robot's odometry (Section 5.3.2, Eq. 27);
+//   - homing (Section 5.4): at the destination, turn 180 degrees, swap start and destination, and
+//     navigate back.
+//
+// Safety: the plane is only observable while the robot translates (a standing or purely rotating
+// camera moves every scene point by the same homography). When the dominant plane is lost (a wall
+// fills the view), the robot stops, turns in place by a fixed step, creeps forward one frame to
+// look again, and reports why; it never drives on into what it cannot see.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "mapless/control/visual_potential.h"
+#include "mapless/core/pose.h"
+#include "mapless/flow/flow.h"
+#include "mapless/ground/dominant_plane.h"
+
+namespace mapless::navigation {
+
+// The pure translational and rotational planar flows of Section 4.3, calibrated by driving at a
+// constant velocity (as the paper does) and stored as the two fitted ground homographies: the flow
+// at any pixel is model(x) - x (ground::PlanarFlow). Both are for one frame period.
+struct PlanarFlowCalibration {
+  int width = 0;
+  int height = 0;
+  double period_s = 0.0;     // frame period of the calibration drive
+  double speed_mps = 0.0;    // translation during the translational drive
+  double omega_radps = 0.0;  // rotation (counter-clockwise) during the rotational drive
+  cv::Mat translational;     // 3x3 CV_64F homography, forward motion
+  cv::Mat rotational;        // 3x3 CV_64F homography, counter-clockwise rotation
+  void Validate() const;     // throws InputError naming the field
+};
+
+// The mean ground homography over consecutive pairs of `frames` (taken while driving at constant
+// velocity): each pair's flow is fitted by RANSAC and the models (normalised to h33 = 1) averaged.
+// Throws InputError when fewer than two frames are given or no pair shows a plane.
+cv::Mat CalibratePlanarModel(const std::vector<cv::Mat>& frames, const flow::FlowOptions& flow,
+                             const ground::DominantPlaneOptions& plane);
+
+// The calibration as a small YAML document (versioned), and back. Parse errors name `source`.
+std::string CalibrationToYaml(const PlanarFlowCalibration& calibration);
+PlanarFlowCalibration CalibrationFromYaml(const std::string& text, const std::string& source);
+
+struct PotentialNavOptions {
+  flow::FlowOptions flow;  // DIS fast by default
+  ground::DominantPlaneOptions plane;
+  control::VisualPotentialOptions potential;
+  // The attraction is divided by the mean magnitude of the calibrated translational flow, so the
+  // repulsion gain does not depend on the camera, its mount or the speed.
+  double arrive_radius_m = 0.1;   // the destination is reached (by odometry) within this
+  double creep_fraction = 0.25;   // of T_m: the one-frame step taken to see the ground move
+  double min_motion_m = 0.004;    // less translation between frames: the plane is unobservable
+  double search_step_rad = 0.6;   // no plane: turn in place by this much, then look again
+  double search_rate_fraction = 0.8;  // of R_m, while searching and turning round
+  int misses_before_search = 3;   // frames in a row without a plane before turning to search
+                                  // (before that the robot only stops and looks again)
+  int max_search_steps = 12;      // searched this often in a row without finding ground: give up
+  // Not in the paper: a first-order low-pass on the control force, f <- a f_new + (1 - a) f
+  // (a = 1: none). A single frame's mask noise then cannot jerk the robot.
+  double force_filter = 1.0;
+  bool allow_reverse = false;     // Eq. 17 gives T < 0 for a force pointing backwards; clamp to 0
+  bool homing = false;            // after the destination, turn round and return to the start
+  // Without a destination, attract along the measured planar flow (Eq. 11-12) instead of the
+  // calibrated forward flow. Off by default: the measured flow contains the robot's own rotation,
+  // and -u_hat of a left turn points left, so the turn feeds itself (on the simulator the robot
+  // spins on the spot in the straight corridor).
+  bool follow_planar_flow = false;
+  void Validate() const;
+};
+
+enum class PotentialStatus {
+  kDriving,        // following the potential
+  kLooking,        // creeping one frame to see the ground move (start, after a turn)
+  kSearching,      // no dominant plane: stopped, turning in place
+  kTurningAround,  // homing: turning 180 degrees at the destination
+  kArrived,        // the (last) destination is reached: stopped
+  kAborted,        // no ground found after max_search_steps: stopped
+};
+const char* PotentialStatusName(PotentialStatus s);
+
+struct PotentialStep {
+  PotentialStatus status = PotentialStatus::kDriving;
+  std::string reason;
+  bool plane_found = false;
+  double plane_fraction = 0.0;  // of the region of interest
+  double theta_d_rad = 0.0;     // destination direction relative to the heading (0 without one)
+  double theta_rad = 0.0;       // direction of the control force (Eq. 16), positive to the left
+  cv::Vec2d force{0.0, 0.0};    // Eq. 15
+  int leg = 0;                  // 0: to the destination, 1: homing
+  Twist2 command;
+  cv::Mat plane_mask;  // d(x, y, t) of this frame (empty when no flow was computed)
+};
+
+class PotentialNavigator {
+ public:
+  PotentialNavigator(PlanarFlowCalibration calibration, PotentialNavOptions options);
+
+  // The destination in the odometry frame; without one, the robot drives ahead and centres itself
+  // in free space (corridor centring). Call before the first Update.
+  void SetDestination(const Eigen::Vector2d& destination);
+
+  // One control period: the camera image and the robot's odometry pose at the same time.
+  PotentialStep Update(const cv::Mat& image, const Pose2& odometry);
+  bool finished() const {
+    return status_ == PotentialStatus::kArrived || status_ == PotentialStatus::kAborted;
+  }
+
+ private:
+  PotentialStep Search(PotentialStep step, const Pose2& odometry, const std::string& why);
+
+  PlanarFlowCalibration calibration_;
+  PotentialNavOptions options_;
+  cv::Mat translational_flow_;  // unit-mean-magnitude fields at the image size
+  cv::Mat rotational_flow_;
+  double flow_scale_ = 1.0;  // mean |u_t| of the calibration, pixels per frame
+  std::optional<Eigen::Vector2d> destination_;
+  std::optional<Eigen::Vector2d> start_;
+  int leg_ = 0;
+  PotentialStatus status_ = PotentialStatus::kLooking;
+  cv::Mat previous_;
+  Pose2 previous_odometry_;
+  double turn_target_rad_ = 0.0;  // searching / turning around: heading to reach
+  double turn_direction_ = 1.0;
+  int search_steps_ = 0;
+  int misses_ = 0;
+  double last_theta_rad_ = 0.0;
+  cv::Vec2d filtered_force_{0.0, 0.0};
+  bool have_force_ = false;  // direction of the last force: the side where the ground was
+};
+
+}  // namespace mapless::navigation
