@@ -246,8 +246,12 @@ PotentialEntryResult RunPotentialEntry(const PotentialEntry& entry, int runs, st
     MAPLESS_CHECK(ref.success, "the clean corridor run of " << entry.scenario
                                                             << " failed: " << ref.status);
     clean = ref.path;
-    // The paper's perturbations (Section 5.2.1): 20% of the pixels, 20% of T and R.
-    if (entry.experiment == "image-noise") base.invert_fraction = 0.2;
+    // The paper's perturbations (Section 5.2): 20% of the dominant-plane map's pixels inverted
+    // (on top of sensor noise), or 20% errors on T and R.
+    if (entry.experiment == "image-noise") {
+      base.nav.plane_noise_fraction = 0.2;
+      base.image_noise_sigma = 2.0;
+    }
     if (entry.experiment == "motion-noise") base.motion_noise_frac = 0.2;
   } else {
     // Navigation and homing: 10% motion noise and sensor noise, as in the other suites.
@@ -266,6 +270,7 @@ PotentialEntryResult RunPotentialEntry(const PotentialEntry& entry, int runs, st
   for (int i = 0; i < runs; ++i) {
     PotentialRunOptions o = base;
     o.seed = seed + static_cast<std::uint64_t>(i);
+    o.nav.noise_seed = o.seed;
     const PotentialRun run = RunPotential(scenario, calibration, o);
     finals.push_back(run.final_error_m);
     if (corridor) {

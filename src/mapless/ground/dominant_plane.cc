@@ -55,6 +55,9 @@ void DominantPlaneOptions::Validate() const {
                                                          << "; must be in [1, 64]");
   MAPLESS_CHECK(confidence > 0.0 && confidence < 1.0,
                 "DominantPlaneOptions.confidence = " << confidence << "; must be in (0, 1)");
+  MAPLESS_CHECK(fit_bottom_fraction > 0.0 && fit_bottom_fraction <= 1.0,
+                "DominantPlaneOptions.fit_bottom_fraction = " << fit_bottom_fraction
+                                                              << "; must be in (0, 1]");
   MAPLESS_CHECK(roi_top_fraction >= 0.0 && roi_top_fraction < 1.0,
                 "DominantPlaneOptions.roi_top_fraction = " << roi_top_fraction
                                                            << "; must be in [0, 1)");
@@ -90,7 +93,9 @@ DominantPlane DetectDominantPlane(const cv::Mat& flow, const DominantPlaneOption
   result.mask = cv::Mat::zeros(flow.size(), CV_8UC1);
   const cv::Rect roi = RoiOf(flow.size(), options.roi_top_fraction);
   std::vector<cv::Point2f> from, to;
-  for (int y = roi.y + options.sample_step_px / 2; y < roi.y + roi.height;
+  const int fit_top =
+      roi.y + static_cast<int>(std::floor(roi.height * (1.0 - options.fit_bottom_fraction)));
+  for (int y = fit_top + options.sample_step_px / 2; y < roi.y + roi.height;
        y += options.sample_step_px) {
     const auto* f = flow.ptr<cv::Vec2f>(y);
     for (int x = options.sample_step_px / 2; x < flow.cols; x += options.sample_step_px) {
@@ -126,18 +131,22 @@ DominantPlane DetectDominantPlane(const cv::Mat& flow, const DominantPlaneOption
                : std::min(max_iterations,
                           static_cast<int>(std::ceil(std::log(1.0 - options.confidence) /
                                                      std::log(1.0 - std::pow(w, minimal)))));
-  // Eq. 5 on every pixel: on the plane when the flow agrees with the planar flow.
-  const cv::Mat planar = PlanarFlow(model, flow.size());
+  // Eq. 5 on every pixel: on the plane when the flow agrees with the planar flow (computed
+  // inline, as PlanarFlow does, without materialising the field).
+  const auto* m = model.ptr<double>();
   const auto eps = static_cast<float>(options.epsilon_px);
   const auto rel = static_cast<float>(options.epsilon_relative);
   for (int y = 0; y < flow.rows; ++y) {
     const auto* f = flow.ptr<cv::Vec2f>(y);
-    const auto* p = planar.ptr<cv::Vec2f>(y);
     uchar* d = result.mask.ptr<uchar>(y);
     for (int x = 0; x < flow.cols; ++x) {
-      const float du = f[x][0] - p[x][0];
-      const float dv = f[x][1] - p[x][1];
-      const float tol = eps + rel * std::sqrt(p[x][0] * p[x][0] + p[x][1] * p[x][1]);
+      const double h = m[6] * x + m[7] * y + m[8];
+      const double s = std::abs(h) > 1e-12 ? 1.0 / h : 0.0;
+      const auto px = static_cast<float>((m[0] * x + m[1] * y + m[2]) * s - x);
+      const auto py = static_cast<float>((m[3] * x + m[4] * y + m[5]) * s - y);
+      const float du = f[x][0] - px;
+      const float dv = f[x][1] - py;
+      const float tol = eps + rel * std::sqrt(px * px + py * py);
       d[x] = du * du + dv * dv < tol * tol ? 255 : 0;
     }
   }

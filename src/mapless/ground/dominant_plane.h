@@ -32,6 +32,11 @@ struct DominantPlaneOptions {
   // Region of interest: the rows below this fraction of the image height (0: the whole image, as
   // in the paper; 0.5: the bottom half, for a forward-looking car camera).
   double roi_top_fraction = 0.0;
+  // Not in the paper: RANSAC draws only from the bottom `fit_bottom_fraction` of the ROI (1: the
+  // whole ROI, the paper). A robot stands on the ground, so the rows just ahead of it are ground
+  // unless it is already touching something; fitting there keeps a large, close obstacle (whose
+  // own flow is planar too) from winning the consensus. Inliers are still taken everywhere.
+  double fit_bottom_fraction = 1.0;
   double min_plane_fraction = 0.5;  // the plane must cover more than this of the ROI
   // Property 1 of the paper: the ground touches the bottom of the image. Keep only the plane
   // regions connected to the bottom row (after a small morphological opening).

@@ -113,11 +113,27 @@ PlanarFlowCalibration CalibrationFromYaml(const std::string& text, const std::st
   return c;
 }
 
+ground::DominantPlaneOptions DefaultPlaneOptions() {
+  ground::DominantPlaneOptions o;
+  o.epsilon_px = 0.5;
+  o.epsilon_relative = 0.15;
+  o.fit_bottom_fraction = 0.5;
+  o.sample_step_px = 8;
+  return o;
+}
+
+control::VisualPotentialOptions DefaultPotentialOptions() {
+  control::VisualPotentialOptions o;
+  o.repulsion_gain = 6.0;
+  return o;
+}
+
 void PotentialNavOptions::Validate() const {
   flow.Validate();
   plane.Validate();
   potential.Validate();
   MAPLESS_CHECK(arrive_radius_m > 0.0, "PotentialNavOptions.arrive_radius_m must be > 0");
+  MAPLESS_CHECK(approach_radius_m >= 0.0, "PotentialNavOptions.approach_radius_m must be >= 0");
   MAPLESS_CHECK(creep_fraction > 0.0 && creep_fraction <= 1.0,
                 "PotentialNavOptions.creep_fraction = " << creep_fraction << "; must be in (0, 1]");
   MAPLESS_CHECK(min_motion_m >= 0.0, "PotentialNavOptions.min_motion_m must be >= 0");
@@ -127,6 +143,11 @@ void PotentialNavOptions::Validate() const {
   MAPLESS_CHECK(search_rate_fraction > 0.0 && search_rate_fraction <= 1.0,
                 "PotentialNavOptions.search_rate_fraction must be in (0, 1]");
   MAPLESS_CHECK(max_search_steps >= 1, "PotentialNavOptions.max_search_steps must be >= 1");
+  MAPLESS_CHECK(potential_width_px >= 16,
+                "PotentialNavOptions.potential_width_px = " << potential_width_px
+                                                            << "; must be >= 16");
+  MAPLESS_CHECK(plane_noise_fraction >= 0.0 && plane_noise_fraction <= 1.0,
+                "PotentialNavOptions.plane_noise_fraction must be in [0, 1]");
   MAPLESS_CHECK(force_filter > 0.0 && force_filter <= 1.0,
                 "PotentialNavOptions.force_filter = " << force_filter << "; must be in (0, 1]");
   MAPLESS_CHECK(misses_before_search >= 1,
@@ -147,7 +168,9 @@ const char* PotentialStatusName(PotentialStatus s) {
 
 PotentialNavigator::PotentialNavigator(PlanarFlowCalibration calibration,
                                        PotentialNavOptions options)
-    : calibration_(std::move(calibration)), options_(std::move(options)) {
+    : calibration_(std::move(calibration)),
+      options_(std::move(options)),
+      noise_(options_.noise_seed) {
   calibration_.Validate();
   options_.Validate();
   const cv::Size size(calibration_.width, calibration_.height);
@@ -160,6 +183,12 @@ PotentialNavigator::PotentialNavigator(PlanarFlowCalibration calibration,
   // The rotational field keeps its size relative to the translational one per unit of speed:
   // Eq. 13 mixes them as unit motions, so normalise it to the same mean magnitude.
   rotational_flow_ /= MeanMagnitude(rotational_flow_);
+  const int w = std::min(options_.potential_width_px, calibration_.width);
+  work_size_ = cv::Size(w, std::max(1, static_cast<int>(std::lround(
+                                           static_cast<double>(calibration_.height) * w /
+                                           calibration_.width))));
+  cv::resize(translational_flow_, translational_flow_, work_size_, 0, 0, cv::INTER_AREA);
+  cv::resize(rotational_flow_, rotational_flow_, work_size_, 0, 0, cv::INTER_AREA);
 }
 
 void PotentialNavigator::SetDestination(const Eigen::Vector2d& destination) {
@@ -205,6 +234,7 @@ PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odom
   if (destination_) {
     const Eigen::Vector2d to = *destination_ - Eigen::Vector2d(odometry.x_m, odometry.y_m);
     step.theta_d_rad = WrapAngle(std::atan2(to.y(), to.x()) - odometry.theta_rad);
+    goal_distance_m_ = to.norm();
     if (status_ != PotentialStatus::kTurningAround && to.norm() <= options_.arrive_radius_m) {
       if (options_.homing && leg_ == 0) {
         // Section 5.4: turn 180 degrees, swap start and destination, navigate back.
@@ -264,7 +294,7 @@ PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odom
   const cv::Mat flow = flow::ComputeFlow(previous_, grey, options_.flow);
   previous_ = grey;
   previous_odometry_ = odometry;
-  const ground::DominantPlane plane = ground::DetectDominantPlane(flow, options_.plane);
+  ground::DominantPlane plane = ground::DetectDominantPlane(flow, options_.plane);
   step.plane_found = plane.found;
   step.plane_fraction = plane.roi_fraction;
   step.plane_mask = plane.mask;
@@ -283,15 +313,33 @@ PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odom
   search_steps_ = 0;
   misses_ = 0;
 
+  if (options_.plane_noise_fraction > 0.0) {
+    for (int y = 0; y < plane.mask.rows; ++y) {
+      uchar* d = plane.mask.ptr<uchar>(y);
+      for (int x = 0; x < plane.mask.cols; ++x)
+        if (noise_.Uniform() < options_.plane_noise_fraction) d[x] = 255 - d[x];
+    }
+  }
+  // The potential is averaged over the image (Eq. 15), so it is computed on a coarse grid of
+  // potential_width_px columns: the same mean, a sixteenth of the work at 320x240.
+  cv::Mat d;
+  cv::resize(plane.mask, d, work_size_, 0, 0, cv::INTER_NEAREST);
   // Attraction: the desired flow towards the destination (Eq. 13; theta_d = 0 without one), or
   // the measured planar flow (Eq. 11) when asked; in units of the calibrated forward flow.
-  const cv::Mat attraction =
-      !destination_ && options_.follow_planar_flow
-          ? cv::Mat(ground::PlanarFlow(plane.model, grey.size()) / flow_scale_)
-          : control::DesiredFlow(translational_flow_, rotational_flow_, step.theta_d_rad);
-  const cv::Mat repulsion = control::RepulsionField(plane.mask, options_.potential);
+  cv::Mat attraction;
+  if (!destination_ && options_.follow_planar_flow) {
+    cv::resize(ground::PlanarFlow(plane.model, grey.size()) / flow_scale_, attraction, work_size_,
+               0, 0, cv::INTER_AREA);
+  } else {
+    attraction = control::DesiredFlow(translational_flow_, rotational_flow_, step.theta_d_rad);
+  }
+  control::VisualPotentialOptions potential_options = options_.potential;
+  potential_options.work_width_px = d.cols;
+  // g per pixel of the full image (the gain is tuned in those units).
+  const cv::Mat repulsion = control::RepulsionField(d, potential_options) *
+                            (static_cast<double>(d.cols) / grey.cols);
   const cv::Mat potential =
-      control::PotentialField(plane.mask, repulsion, attraction, options_.potential);
+      control::PotentialField(d, repulsion, attraction, options_.potential);
   const cv::Vec2d force = control::ControlForce(potential);
   filtered_force_ = have_force_ ? options_.force_filter * force +
                                       (1.0 - options_.force_filter) * filtered_force_
@@ -302,7 +350,18 @@ PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odom
   step.theta_rad = c.theta_rad;
   last_theta_rad_ = c.theta_rad;
   step.command = c.twist;
-  if (!options_.allow_reverse) step.command.v_mps = std::max(0.0, step.command.v_mps);
+  if (!options_.allow_reverse && step.command.v_mps < 0.0) {
+    // A force pointing backwards: a robot that does not reverse turns in place towards it at the
+    // full rate (Eq. 17 would give R -> 0 as the force points straight back).
+    step.command.v_mps = 0.0;
+    step.command.omega_radps =
+        (c.theta_rad >= 0.0 ? 1.0 : -1.0) * options_.potential.max_rotation_radps;
+  }
+  if (goal_distance_m_ >= 0.0 && goal_distance_m_ < options_.approach_radius_m) {
+    const double cap = std::max(options_.creep_fraction * vmax,
+                                vmax * goal_distance_m_ / options_.approach_radius_m);
+    step.command.v_mps = std::min(step.command.v_mps, cap);
+  }
   status_ = PotentialStatus::kDriving;
   step.status = status_;
   return step;

@@ -25,6 +25,7 @@
 
 #include "mapless/control/visual_potential.h"
 #include "mapless/core/pose.h"
+#include "mapless/core/rng.h"
 #include "mapless/flow/flow.h"
 #include "mapless/ground/dominant_plane.h"
 
@@ -54,13 +55,24 @@ cv::Mat CalibratePlanarModel(const std::vector<cv::Mat>& frames, const flow::Flo
 std::string CalibrationToYaml(const PlanarFlowCalibration& calibration);
 PlanarFlowCalibration CalibrationFromYaml(const std::string& text, const std::string& source);
 
+ground::DominantPlaneOptions DefaultPlaneOptions();
+control::VisualPotentialOptions DefaultPotentialOptions();
+
 struct PotentialNavOptions {
   flow::FlowOptions flow;  // DIS fast by default
-  ground::DominantPlaneOptions plane;
-  control::VisualPotentialOptions potential;
+  // Tuned on the simulator (docs/flow_and_ground.md): a tolerance of 0.5 px + 15% of the planar
+  // flow, RANSAC fitted on the bottom half of the image.
+  ground::DominantPlaneOptions plane = DefaultPlaneOptions();
+  // Repulsion gain 6 (the paper's Eq. 11 has 1: our attraction is in units of the calibrated
+  // forward flow, so the balance is ours to set).
+  control::VisualPotentialOptions potential = DefaultPotentialOptions();
   // The attraction is divided by the mean magnitude of the calibrated translational flow, so the
   // repulsion gain does not depend on the camera, its mount or the speed.
+  int potential_width_px = 80;    // the potential field's grid (its mean is what drives)
   double arrive_radius_m = 0.1;   // the destination is reached (by odometry) within this
+  // Closer than this to the destination the speed falls in proportion to the distance (down to
+  // the creep speed), so the turning circle shrinks and the robot cannot orbit the goal.
+  double approach_radius_m = 0.6;
   double creep_fraction = 0.25;   // of T_m: the one-frame step taken to see the ground move
   double min_motion_m = 0.004;    // less translation between frames: the plane is unobservable
   double search_step_rad = 0.6;   // no plane: turn in place by this much, then look again
@@ -70,8 +82,12 @@ struct PotentialNavOptions {
   int max_search_steps = 12;      // searched this often in a row without finding ground: give up
   // Not in the paper: a first-order low-pass on the control force, f <- a f_new + (1 - a) f
   // (a = 1: none). A single frame's mask noise then cannot jerk the robot.
-  double force_filter = 1.0;
+  double force_filter = 0.5;
   bool allow_reverse = false;     // Eq. 17 gives T < 0 for a force pointing backwards; clamp to 0
+  // Robustness experiments of Section 5.2 only: invert this fraction of the dominant-plane map's
+  // pixels each frame ("an error of 20% to the detected dominant plane"), drawn from noise_seed.
+  double plane_noise_fraction = 0.0;
+  std::uint64_t noise_seed = 1;
   bool homing = false;            // after the destination, turn round and return to the start
   // Without a destination, attract along the measured planar flow (Eq. 11-12) instead of the
   // calibrated forward flow. Off by default: the measured flow contains the robot's own rotation,
@@ -123,7 +139,8 @@ class PotentialNavigator {
 
   PlanarFlowCalibration calibration_;
   PotentialNavOptions options_;
-  cv::Mat translational_flow_;  // unit-mean-magnitude fields at the image size
+  cv::Size work_size_;           // the potential's grid
+  cv::Mat translational_flow_;  // unit-mean-magnitude fields on that grid
   cv::Mat rotational_flow_;
   double flow_scale_ = 1.0;  // mean |u_t| of the calibration, pixels per frame
   std::optional<Eigen::Vector2d> destination_;
@@ -137,6 +154,8 @@ class PotentialNavigator {
   int search_steps_ = 0;
   int misses_ = 0;
   double last_theta_rad_ = 0.0;
+  double goal_distance_m_ = -1.0;  // odometry distance to the destination (< 0: none)
+  Rng noise_;
   cv::Vec2d filtered_force_{0.0, 0.0};
   bool have_force_ = false;  // direction of the last force: the side where the ground was
 };
