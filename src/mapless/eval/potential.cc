@@ -6,6 +6,7 @@
 #include "mapless/core/check.h"
 #include "mapless/core/rng.h"
 #include "mapless/flow/flow.h"
+#include "mapless/sim/renderer.h"
 #include "mapless/sim/simulation.h"
 
 namespace mapless::eval {
@@ -189,7 +190,12 @@ double TrajectoryDeviationStd(const std::vector<Pose2>& clean, const std::vector
 }
 
 InclusionResult InclusionOnSimulator(const sim::Scenario& scenario,
-                                     const ground::DominantPlaneOptions& plane, int max_frames) {
+                                     const ground::DominantPlaneOptions& plane, int max_pairs,
+                                     double speed_mps) {
+  MAPLESS_CHECK(speed_mps > 0.0, "inclusion drive speed = " << speed_mps << "; must be > 0");
+  sim::Scenario slow = scenario;
+  slow.teach_speed_mps = speed_mps;
+  for (auto& step : slow.teach_path) step.speed_mps = 0.0;
   InclusionResult result;
   result.scenario = scenario.name;
   result.inclusion.assign(3, 0.0);
@@ -198,20 +204,28 @@ InclusionResult InclusionOnSimulator(const sim::Scenario& scenario,
   cv::Mat previous;
   int frames = 0;
   sim::DriveOptions drive;
-  sim::DriveTaughtPath(scenario, drive, [&](const sim::DriveFrame& f) {
-    if (frames >= max_frames) return;
-    if (!previous.empty()) {
-      std::vector<cv::Mat> layer_flows;
-      flow::DenseLucasKanade(previous, f.image, lk, &layer_flows);
-      const ground::HierarchicalPlanes h = ground::DetectHierarchicalPlanes(layer_flows, plane);
-      bool all = true;
-      for (const auto& l : h.layers) all = all && l.found;
-      if (all && h.inclusion.size() >= 3) {
-        for (int l = 0; l < 3; ++l) result.inclusion[l] += h.inclusion[l];
-        ++frames;
-      }
+  drive.render_frames = false;  // rendered here, only for the pairs used
+  const sim::Renderer renderer(scenario.world, sim::RenderOptions{});
+  // One pair (frames k, k + 1) every kStride frames, spread along the path.
+  constexpr int kStride = 10;
+  sim::DriveTaughtPath(slow, drive, [&](const sim::DriveFrame& f) {
+    if (result.pairs >= max_pairs || f.index % kStride > 1) return;
+    const cv::Mat image = renderer.Render(scenario.camera.model,
+                                          sim::WorldFromCamera(f.truth, scenario.camera.mount));
+    if (f.index % kStride == 0) {
+      previous = image;
+      return;
     }
-    previous = f.image;
+    ++result.pairs;
+    std::vector<cv::Mat> layer_flows;
+    flow::DenseLucasKanade(previous, image, lk, &layer_flows);
+    const ground::HierarchicalPlanes h = ground::DetectHierarchicalPlanes(layer_flows, plane);
+    bool all = true;
+    for (const auto& l : h.layers) all = all && l.found;
+    if (all && h.inclusion.size() >= 3) {
+      for (std::size_t l = 0; l < 3; ++l) result.inclusion[l] += h.inclusion[l];
+      ++frames;
+    }
   });
   result.frames = frames;
   for (double& v : result.inclusion) v = frames > 0 ? v / frames : 0.0;

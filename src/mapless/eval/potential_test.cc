@@ -124,6 +124,19 @@ TEST(PotentialNavigation, ReachesADestinationPastTheObstacles) {
   EXPECT_LE(run.final_error_m, 0.3);
 }
 
+TEST(Inclusion, CoarserLayersMostlyContainTheFinerPlane) {
+  // Table 1's measure on a slow drive down the corridor with the paper's detector options.
+  const InclusionResult r = InclusionOnSimulator(sim::LoadScenario("corridor_straight_3p5m"),
+                                                 ground::DominantPlaneOptions{}, 6);
+  EXPECT_EQ(r.pairs, 6);
+  EXPECT_GE(r.frames, 4);
+  ASSERT_EQ(r.inclusion.size(), 3U);
+  for (double p : r.inclusion) {
+    EXPECT_GT(p, 0.6);
+    EXPECT_LE(p, 1.0);
+  }
+}
+
 TEST(TrajectoryDeviation, IsTheSpreadOfTheSignedOffsetFromTheCleanPath) {
   std::vector<Pose2> clean, noisy;
   for (int i = 0; i <= 100; ++i) {
