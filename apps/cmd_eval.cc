@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
+#include <functional>
 #include <future>
 #include <iostream>
 #include <map>
@@ -18,6 +19,27 @@ namespace mapless::app {
 
 namespace {
 
+// Calls fn(0) ... fn(n - 1), `jobs` at a time (each entry is independent and seeded, so the
+// results do not depend on `jobs`).
+void RunInBatches(std::size_t n, int jobs, const std::function<void(std::size_t)>& fn) {
+  std::size_t next = 0;
+  while (next < n) {
+    std::vector<std::future<void>> batch;
+    for (int j = 0; j < jobs && next < n; ++j, ++next)
+      batch.push_back(std::async(std::launch::async, fn, next));
+    for (auto& f : batch) f.get();
+  }
+}
+
+nlohmann::json SuiteJson(const std::string& suite, int runs, std::uint64_t seed) {
+  nlohmann::json j;
+  j["suite"] = suite;
+  j["runs"] = runs;
+  j["seed"] = seed;
+  j["results"] = nlohmann::json::array();
+  return j;
+}
+
 // `mapless eval potential`: Ohnishi & Imiya, Section 5 (see eval/potential.h).
 void RunPotentialSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
                        const std::string& only) {
@@ -27,19 +49,11 @@ void RunPotentialSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
   if (entries.empty()) throw InputError("--only '" + only + "': not a scenario of suite potential");
   const navigation::PotentialNavOptions nav;
   std::vector<eval::PotentialEntryResult> results(entries.size());
-  std::size_t next = 0;
-  while (next < entries.size()) {
-    std::vector<std::future<void>> batch;
-    for (int j = 0; j < jobs && next < entries.size(); ++j, ++next) {
-      const std::size_t k = next;
-      batch.push_back(std::async(std::launch::async, [&, k] {
-        results[k] = eval::RunPotentialEntry(entries[k], runs, seed, nav);
-        spdlog::info("eval: {} {}: {}/{} successes", entries[k].scenario, entries[k].experiment,
-                     results[k].successes, results[k].runs);
-      }));
-    }
-    for (auto& f : batch) f.get();
-  }
+  RunInBatches(entries.size(), jobs, [&](std::size_t k) {
+    results[k] = eval::RunPotentialEntry(entries[k], runs, seed, nav);
+    spdlog::info("eval: {} {}: {}/{} successes", entries[k].scenario, entries[k].experiment,
+                 results[k].successes, results[k].runs);
+  });
   std::vector<eval::InclusionResult> inclusion;
   for (const char* name : {"corridor_straight_3p5m", "obstacle_field"})
     if (only.empty() || only == name)
@@ -48,11 +62,7 @@ void RunPotentialSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
       inclusion.push_back(
           eval::InclusionOnSimulator(sim::LoadScenario(name), ground::DominantPlaneOptions{}));
 
-  nlohmann::json j;
-  j["suite"] = "potential";
-  j["runs"] = runs;
-  j["seed"] = seed;
-  j["results"] = nlohmann::json::array();
+  nlohmann::json j = SuiteJson("potential", runs, seed);
   FILE* table = json_out ? stderr : stdout;
   std::fprintf(table, "%-24s %-14s %9s %5s %10s %10s %10s\n", "scenario", "experiment", "success",
                "coll", "final rms", "dev std", "dev max");
@@ -139,26 +149,14 @@ void AddEvalCommand(CLI::App* app) {
                      std::make_pair(s, eval::TeachOnSimulator(s, navigation::TeachOptions{})));
     }
     std::vector<eval::EntryResult> results(entries.size());
-    std::size_t next = 0;
-    while (next < entries.size()) {
-      std::vector<std::future<void>> batch;
-      for (int j = 0; j < args->jobs && next < entries.size(); ++j, ++next) {
-        const std::size_t k = next;
-        batch.push_back(std::async(std::launch::async, [&, k] {
-          const auto& [scenario, route] = taught.at(entries[k].scenario);
-          results[k] = eval::RunEntry(scenario, route, entries[k].controller, args->runs,
-                                      args->seed, eval::RepeatRunOptions{});
-          spdlog::info("eval: {} {}: {}/{} successes", entries[k].scenario, results[k].controller,
-                       results[k].successes, results[k].runs);
-        }));
-      }
-      for (auto& f : batch) f.get();
-    }
-    nlohmann::json j;
-    j["suite"] = args->suite;
-    j["runs"] = args->runs;
-    j["seed"] = args->seed;
-    j["results"] = nlohmann::json::array();
+    RunInBatches(entries.size(), args->jobs, [&](std::size_t k) {
+      const auto& [scenario, route] = taught.at(entries[k].scenario);
+      results[k] = eval::RunEntry(scenario, route, entries[k].controller, args->runs, args->seed,
+                                  eval::RepeatRunOptions{});
+      spdlog::info("eval: {} {}: {}/{} successes", entries[k].scenario, results[k].controller,
+                   results[k].successes, results[k].runs);
+    });
+    nlohmann::json j = SuiteJson(args->suite, args->runs, args->seed);
     FILE* table = args->json ? stderr : stdout;
     std::fprintf(table, "%-30s %-9s %9s %10s %10s %10s %5s\n", "scenario", "control", "success",
                  "final rms", "final std", "lateral", "coll");

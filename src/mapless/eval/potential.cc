@@ -5,6 +5,7 @@
 
 #include "mapless/core/check.h"
 #include "mapless/core/rng.h"
+#include "mapless/eval/teach_repeat.h"
 #include "mapless/flow/flow.h"
 #include "mapless/sim/renderer.h"
 #include "mapless/sim/simulation.h"
@@ -136,13 +137,9 @@ PotentialRun RunPotential(const sim::Scenario& scenario,
       run.status = step.reason;
       break;
     }
-    if (sim.collided(r)) {
-      run.collided = true;
-      run.status = "collision with " + sim.collisions().front().with;
-      break;
-    }
-    if (ToSeconds(sim.now_ns()) > timeout) {
-      run.status = "timeout after " + std::to_string(static_cast<int>(timeout)) + " s";
+    if (std::string stop = SimulationStop(sim, r, timeout); !stop.empty()) {
+      run.collided = sim.collided(r);
+      run.status = std::move(stop);
       break;
     }
     sim.SetCommand(r, step.command);

@@ -40,6 +40,16 @@ double DistanceToPath(const std::vector<Pose2>& path, double x_m, double y_m) {
   return best;
 }
 
+std::string SimulationStop(const sim::Simulation& sim, int robot, double timeout_s) {
+  if (sim.collided(robot)) {
+    for (const sim::Collision& c : sim.collisions())
+      if (c.robot == robot) return "collision with " + c.with;
+  }
+  const double t = ToSeconds(sim.now_ns());
+  if (t > timeout_s) return "timeout after " + std::to_string(static_cast<int>(t)) + " s";
+  return {};
+}
+
 TaughtRoute TeachOnSimulator(const sim::Scenario& scenario, const navigation::TeachOptions& options,
                              const std::function<void(const route::Keyframe&)>& on_keyframe) {
   TaughtRoute taught;
@@ -100,14 +110,9 @@ RepeatRun RepeatOnSimulator(const sim::Scenario& scenario, const TaughtRoute& ta
       run.status = step.reason;
       break;
     }
-    if (sim.collided(r)) {
-      run.collided = true;
-      run.status = "collision with " + sim.collisions().front().with;
-      break;
-    }
-    if (ToSeconds(sim.now_ns()) > timeout) {
-      run.status =
-          "timeout after " + std::to_string(static_cast<int>(ToSeconds(sim.now_ns()))) + " s";
+    if (std::string stop = SimulationStop(sim, r, timeout); !stop.empty()) {
+      run.collided = sim.collided(r);
+      run.status = std::move(stop);
       break;
     }
     sim.SetCommand(r, step.command);
