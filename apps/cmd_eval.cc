@@ -40,6 +40,18 @@ nlohmann::json SuiteJson(const std::string& suite, int runs, std::uint64_t seed)
   return j;
 }
 
+nlohmann::json EntryJson(const eval::EntryResult& r) {
+  return {{"scenario", r.scenario},
+          {"controller", r.controller},
+          {"runs", r.runs},
+          {"successes", r.successes},
+          {"final_error_m_rms", r.final_error_m_rms},
+          {"final_error_m_std", r.final_error_m_std},
+          {"lateral_rms_m", r.lateral_rms_m},
+          {"collisions", r.collisions},
+          {"failures", r.failures}};
+}
+
 // `mapless eval potential`: Ohnishi & Imiya, Section 5 (see eval/potential.h).
 void RunPotentialSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
                        const std::string& only) {
@@ -67,18 +79,11 @@ void RunPotentialSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
   std::fprintf(table, "%-24s %-14s %9s %5s %10s %10s %10s\n", "scenario", "experiment", "success",
                "coll", "final rms", "dev std", "dev max");
   for (const auto& r : results) {
-    j["results"].push_back({{"scenario", r.scenario},
-                            {"controller", "potential"},
-                            {"experiment", r.experiment},
-                            {"runs", r.runs},
-                            {"successes", r.successes},
-                            {"final_error_m_rms", r.final_error_m_rms},
-                            {"final_error_m_std", r.final_error_m_std},
-                            {"lateral_rms_m", r.lateral_rms_m},
-                            {"collisions", r.collisions},
-                            {"deviation_std_m", r.deviation_std_m},
-                            {"deviation_std_m_max", r.deviation_std_m_max},
-                            {"failures", r.failures}});
+    nlohmann::json e = EntryJson(r);
+    e["experiment"] = r.experiment;
+    e["deviation_std_m"] = r.deviation_std_m;
+    e["deviation_std_m_max"] = r.deviation_std_m_max;
+    j["results"].push_back(e);
     std::fprintf(table, "%-24s %-14s %4d/%-4d %5d %9.3fm %9.4fm %9.4fm\n", r.scenario.c_str(),
                  r.experiment.c_str(), r.successes, r.runs, r.collisions, r.final_error_m_rms,
                  r.deviation_std_m, r.deviation_std_m_max);
@@ -161,15 +166,7 @@ void AddEvalCommand(CLI::App* app) {
     std::fprintf(table, "%-30s %-9s %9s %10s %10s %10s %5s\n", "scenario", "control", "success",
                  "final rms", "final std", "lateral", "coll");
     for (const auto& r : results) {
-      j["results"].push_back({{"scenario", r.scenario},
-                              {"controller", r.controller},
-                              {"runs", r.runs},
-                              {"successes", r.successes},
-                              {"final_error_m_rms", r.final_error_m_rms},
-                              {"final_error_m_std", r.final_error_m_std},
-                              {"lateral_rms_m", r.lateral_rms_m},
-                              {"collisions", r.collisions},
-                              {"failures", r.failures}});
+      j["results"].push_back(EntryJson(r));
       std::fprintf(table, "%-30s %-9s %4d/%-4d %9.2fm %9.2fm %9.2fm %5d\n", r.scenario.c_str(),
                    r.controller.c_str(), r.successes, r.runs, r.final_error_m_rms,
                    r.final_error_m_std, r.lateral_rms_m, r.collisions);

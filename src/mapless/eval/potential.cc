@@ -243,6 +243,7 @@ PotentialEntryResult RunPotentialEntry(const PotentialEntry& entry, int runs, st
   const navigation::PlanarFlowCalibration calibration = CalibrateOnSimulator(scenario, nav);
   PotentialEntryResult r;
   r.scenario = entry.scenario;
+  r.controller = "potential";
   r.experiment = entry.experiment;
   r.runs = runs;
   PotentialRunOptions base;

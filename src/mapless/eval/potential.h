@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "mapless/eval/suite.h"
 #include "mapless/navigation/potential.h"
 #include "mapless/sim/scenario.h"
 
@@ -85,18 +86,12 @@ struct PotentialEntry {
 };
 std::vector<PotentialEntry> PotentialSuiteEntries();
 
-struct PotentialEntryResult {
-  std::string scenario;
+// The suites' common fields (controller "potential"; final error to the goal, 0 in the corridor;
+// lateral_rms_m: RMS distance to the clean run's path in the corridor, else 0), and:
+struct PotentialEntryResult : EntryResult {
   std::string experiment;
-  int runs = 0;
-  int successes = 0;
-  int collisions = 0;
-  double final_error_m_rms = 0.0;
-  double final_error_m_std = 0.0;
-  double lateral_rms_m = 0.0;      // RMS distance to the clean run's path (corridor) or 0
-  double deviation_std_m = 0.0;    // corridor: mean over runs of TrajectoryDeviationStd
+  double deviation_std_m = 0.0;  // corridor: mean over runs of TrajectoryDeviationStd
   double deviation_std_m_max = 0.0;
-  std::vector<std::string> failures;
 };
 
 // Runs `runs` noisy runs of an entry with seeds seed, seed + 1, ... (and, for the corridor, one
