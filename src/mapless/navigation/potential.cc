@@ -1,5 +1,6 @@
 #include "mapless/navigation/potential.h"
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -124,7 +125,7 @@ ground::DominantPlaneOptions DefaultPlaneOptions() {
 
 control::VisualPotentialOptions DefaultPotentialOptions() {
   control::VisualPotentialOptions o;
-  o.repulsion_gain = 6.0;
+  o.repulsion_gain = 2.0;
   return o;
 }
 
@@ -275,12 +276,23 @@ PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odom
     }
     if (status_ == PotentialStatus::kTurningAround) search_steps_ = 0;
     misses_ = 0;
+    last_plane_fraction_ = 1.0;  // a new view: one creep to look at it
+    last_plane_found_ = true;
     status_ = PotentialStatus::kLooking;
   }
 
   // The plane is observable only when the camera translated between the two frames.
   const double moved = std::hypot(odometry.x_m - previous_odometry_.x_m,
                                   odometry.y_m - previous_odometry_.y_m);
+  if (!previous_.empty() && moved < options_.min_motion_m &&
+      last_plane_fraction_ < options_.full_speed_plane_fraction) {
+    // Stopped with an obstacle in view (a force pointing back, a potential minimum): creeping on
+    // would drive blind towards it, so turn away first.
+    previous_ = grey;
+    previous_odometry_ = odometry;
+    return Search(step, odometry,
+                  last_plane_found_ ? "stopped with an obstacle ahead" : "no ground plane");
+  }
   if (previous_.empty() || moved < options_.min_motion_m) {
     status_ = PotentialStatus::kLooking;
     step.status = status_;
@@ -297,6 +309,8 @@ PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odom
   ground::DominantPlane plane = ground::DetectDominantPlane(flow, options_.plane);
   step.plane_found = plane.found;
   step.plane_fraction = plane.roi_fraction;
+  last_plane_fraction_ = plane.roi_fraction;
+  last_plane_found_ = plane.found;
   step.plane_mask = plane.mask;
   if (!plane.found) {
     std::ostringstream why;
@@ -356,6 +370,12 @@ PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odom
     step.command.v_mps = 0.0;
     step.command.omega_radps =
         (c.theta_rad >= 0.0 ? 1.0 : -1.0) * options_.potential.max_rotation_radps;
+  }
+  if (options_.full_speed_plane_fraction > options_.plane.min_plane_fraction) {
+    const double lo = options_.plane.min_plane_fraction;
+    step.command.v_mps *= std::clamp((plane.roi_fraction - lo) /
+                                         (options_.full_speed_plane_fraction - lo),
+                                     0.0, 1.0);
   }
   if (goal_distance_m_ >= 0.0 && goal_distance_m_ < options_.approach_radius_m) {
     const double cap = std::max(options_.creep_fraction * vmax,

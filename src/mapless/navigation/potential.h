@@ -63,11 +63,16 @@ struct PotentialNavOptions {
   // Tuned on the simulator (docs/flow_and_ground.md): a tolerance of 0.5 px + 15% of the planar
   // flow, RANSAC fitted on the bottom half of the image.
   ground::DominantPlaneOptions plane = DefaultPlaneOptions();
-  // Repulsion gain 6 (the paper's Eq. 11 has 1: our attraction is in units of the calibrated
+  // Repulsion gain 2 (the paper's Eq. 11 has 1: our attraction is in units of the calibrated
   // forward flow, so the balance is ours to set).
   control::VisualPotentialOptions potential = DefaultPotentialOptions();
   // The attraction is divided by the mean magnitude of the calibrated translational flow, so the
   // repulsion gain does not depend on the camera, its mount or the speed.
+  // Not in the paper: the speed falls with the free ground in view, from T_m when at least this
+  // fraction of the region of interest is ground to 0 at the "no plane" threshold
+  // (plane.min_plane_fraction), so the robot slows as obstacles fill the view and turns tighter.
+  // 0 disables it.
+  double full_speed_plane_fraction = 0.8;
   int potential_width_px = 80;    // the potential field's grid (its mean is what drives)
   double arrive_radius_m = 0.1;   // the destination is reached (by odometry) within this
   // Closer than this to the destination the speed falls in proportion to the distance (down to
@@ -82,7 +87,7 @@ struct PotentialNavOptions {
   int max_search_steps = 12;      // searched this often in a row without finding ground: give up
   // Not in the paper: a first-order low-pass on the control force, f <- a f_new + (1 - a) f
   // (a = 1: none). A single frame's mask noise then cannot jerk the robot.
-  double force_filter = 0.5;
+  double force_filter = 0.2;
   bool allow_reverse = false;     // Eq. 17 gives T < 0 for a force pointing backwards; clamp to 0
   // Robustness experiments of Section 5.2 only: invert this fraction of the dominant-plane map's
   // pixels each frame ("an error of 20% to the detected dominant plane"), drawn from noise_seed.
@@ -154,6 +159,8 @@ class PotentialNavigator {
   int search_steps_ = 0;
   int misses_ = 0;
   double last_theta_rad_ = 0.0;
+  double last_plane_fraction_ = 1.0;  // of the last frame with flow
+  bool last_plane_found_ = true;
   double goal_distance_m_ = -1.0;  // odometry distance to the destination (< 0: none)
   Rng noise_;
   cv::Vec2d filtered_force_{0.0, 0.0};
