@@ -58,6 +58,8 @@ void DominantPlaneOptions::Validate() const {
   MAPLESS_CHECK(fit_bottom_fraction > 0.0 && fit_bottom_fraction <= 1.0,
                 "DominantPlaneOptions.fit_bottom_fraction = " << fit_bottom_fraction
                                                               << "; must be in (0, 1]");
+  MAPLESS_CHECK(max_iterations >= 0, "DominantPlaneOptions.max_iterations = "
+                                         << max_iterations << "; must be >= 0 (0: the paper's)");
   MAPLESS_CHECK(roi_top_fraction >= 0.0 && roi_top_fraction < 1.0,
                 "DominantPlaneOptions.roi_top_fraction = " << roi_top_fraction
                                                            << "; must be in [0, 1)");
@@ -107,7 +109,9 @@ DominantPlane DetectDominantPlane(const cv::Mat& flow, const DominantPlaneOption
   const int minimal = options.model == PlaneModel::kAffine ? 3 : 4;
   if (static_cast<int>(from.size()) < 2 * minimal) return result;
   // The paper iterates at most width * height / 2 times; the adaptive count stops far earlier.
-  const int max_iterations = std::max(100, flow.cols * flow.rows / 2);
+  const int max_iterations = options.max_iterations > 0
+                                 ? options.max_iterations
+                                 : std::max(100, flow.cols * flow.rows / 2);
   std::vector<uchar> inliers;
   cv::Mat model;
   if (options.model == PlaneModel::kAffine) {
@@ -139,11 +143,20 @@ DominantPlane DetectDominantPlane(const cv::Mat& flow, const DominantPlaneOption
   for (int y = 0; y < flow.rows; ++y) {
     const auto* f = flow.ptr<cv::Vec2f>(y);
     uchar* d = result.mask.ptr<uchar>(y);
+    // Per row, the homography's numerators and denominator are affine in x: float steps.
+    const auto a0 = static_cast<float>(m[1] * y + m[2]);
+    const auto b0 = static_cast<float>(m[4] * y + m[5]);
+    const auto w0 = static_cast<float>(m[7] * y + m[8]);
+    const auto a1 = static_cast<float>(m[0]);
+    const auto b1 = static_cast<float>(m[3]);
+    const auto w1 = static_cast<float>(m[6]);
+    const auto fy = static_cast<float>(y);
     for (int x = 0; x < flow.cols; ++x) {
-      const double h = m[6] * x + m[7] * y + m[8];
-      const double s = std::abs(h) > 1e-12 ? 1.0 / h : 0.0;
-      const auto px = static_cast<float>((m[0] * x + m[1] * y + m[2]) * s - x);
-      const auto py = static_cast<float>((m[3] * x + m[4] * y + m[5]) * s - y);
+      const auto fx = static_cast<float>(x);
+      const float h = w1 * fx + w0;
+      const float s = std::abs(h) > 1e-12F ? 1.0F / h : 0.0F;
+      const float px = (a1 * fx + a0) * s - fx;
+      const float py = (b1 * fx + b0) * s - fy;
       const float du = f[x][0] - px;
       const float dv = f[x][1] - py;
       const float tol = eps + rel * std::sqrt(px * px + py * py);

@@ -119,13 +119,15 @@ ground::DominantPlaneOptions DefaultPlaneOptions() {
   o.epsilon_px = 0.5;
   o.epsilon_relative = 0.15;
   o.fit_bottom_fraction = 0.5;
-  o.sample_step_px = 8;
+  o.sample_step_px = 12;
+  o.max_iterations = 1000;
   return o;
 }
 
 control::VisualPotentialOptions DefaultPotentialOptions() {
   control::VisualPotentialOptions o;
   o.repulsion_gain = 2.0;
+  o.work_width_px = 40;  // the blur (sigma: half the image) on a 40-column map
   return o;
 }
 
@@ -144,6 +146,8 @@ void PotentialNavOptions::Validate() const {
   MAPLESS_CHECK(search_rate_fraction > 0.0 && search_rate_fraction <= 1.0,
                 "PotentialNavOptions.search_rate_fraction must be in (0, 1]");
   MAPLESS_CHECK(max_search_steps >= 1, "PotentialNavOptions.max_search_steps must be >= 1");
+  MAPLESS_CHECK(plane_scale > 0.0 && plane_scale <= 1.0,
+                "PotentialNavOptions.plane_scale = " << plane_scale << "; must be in (0, 1]");
   MAPLESS_CHECK(potential_width_px >= 16,
                 "PotentialNavOptions.potential_width_px = " << potential_width_px
                                                             << "; must be >= 16");
@@ -303,10 +307,21 @@ PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odom
     return step;
   }
 
-  const cv::Mat flow = flow::ComputeFlow(previous_, grey, options_.flow);
+  cv::Mat flow = flow::ComputeFlow(previous_, grey, options_.flow);
   previous_ = grey;
   previous_odometry_ = odometry;
-  ground::DominantPlane plane = ground::DetectDominantPlane(flow, options_.plane);
+  ground::DominantPlaneOptions plane_options = options_.plane;
+  if (options_.plane_scale < 1.0) {
+    // The plane on a coarser flow field: the field is averaged down and its vectors (and the
+    // tolerance, and the RANSAC grid) are scaled to the coarse pixels.
+    cv::resize(flow, flow, cv::Size(), options_.plane_scale, options_.plane_scale,
+               cv::INTER_AREA);
+    flow *= options_.plane_scale;
+    plane_options.epsilon_px *= options_.plane_scale;
+    plane_options.sample_step_px = std::max(
+        1, static_cast<int>(std::lround(plane_options.sample_step_px * options_.plane_scale)));
+  }
+  ground::DominantPlane plane = ground::DetectDominantPlane(flow, plane_options);
   step.plane_found = plane.found;
   step.plane_fraction = plane.roi_fraction;
   last_plane_fraction_ = plane.roi_fraction;
@@ -342,13 +357,14 @@ PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odom
   // the measured planar flow (Eq. 11) when asked; in units of the calibrated forward flow.
   cv::Mat attraction;
   if (!destination_ && options_.follow_planar_flow) {
-    cv::resize(ground::PlanarFlow(plane.model, grey.size()) / flow_scale_, attraction, work_size_,
-               0, 0, cv::INTER_AREA);
+    // The model is in the plane's (scaled) pixels; back to image pixels per frame.
+    cv::resize(ground::PlanarFlow(plane.model, flow.size()) / (flow_scale_ * options_.plane_scale),
+               attraction, work_size_, 0, 0, cv::INTER_AREA);
   } else {
     attraction = control::DesiredFlow(translational_flow_, rotational_flow_, step.theta_d_rad);
   }
   control::VisualPotentialOptions potential_options = options_.potential;
-  potential_options.work_width_px = d.cols;
+  potential_options.work_width_px = std::min(d.cols, options_.potential.work_width_px);
   // g per pixel of the full image (the gain is tuned in those units).
   const cv::Mat repulsion = control::RepulsionField(d, potential_options) *
                             (static_cast<double>(d.cols) / grey.cols);

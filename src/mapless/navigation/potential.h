@@ -73,6 +73,10 @@ struct PotentialNavOptions {
   // (plane.min_plane_fraction), so the robot slows as obstacles fill the view and turns tighter.
   // 0 disables it.
   double full_speed_plane_fraction = 0.8;
+  // The dominant plane is detected on the flow field scaled by this (0.5: 160x120 for a 320x240
+  // camera): the potential only needs the map at potential_width_px columns. PotentialStep's
+  // plane_mask is at this scale.
+  double plane_scale = 0.5;
   int potential_width_px = 80;    // the potential field's grid (its mean is what drives)
   double arrive_radius_m = 0.1;   // the destination is reached (by odometry) within this
   // Closer than this to the destination the speed falls in proportion to the distance (down to
@@ -122,7 +126,7 @@ struct PotentialStep {
   cv::Vec2d force{0.0, 0.0};    // Eq. 15
   int leg = 0;                  // 0: to the destination, 1: homing
   Twist2 command;
-  cv::Mat plane_mask;  // d(x, y, t) of this frame (empty when no flow was computed)
+  cv::Mat plane_mask;  // d(x, y, t) of this frame at plane_scale (empty when no flow was computed)
 };
 
 class PotentialNavigator {
