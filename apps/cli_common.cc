@@ -1,5 +1,7 @@
 #include "cli_common.h"
 
+#include <cmath>
+#include <iostream>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <vector>
@@ -9,7 +11,10 @@
 
 namespace mapless::app {
 
-Pose2 ParsePoseDeg(const std::string& text, const std::string& option) {
+std::vector<double> ParseNumbers(const std::string& text, const std::string& option, int n,
+                                 const std::string& form) {
+  const std::string error =
+      option + " '" + text + "': expected " + form + " (" + std::to_string(n) + " numbers)";
   std::vector<double> v;
   std::stringstream in(text);
   std::string item;
@@ -17,14 +22,30 @@ Pose2 ParsePoseDeg(const std::string& text, const std::string& option) {
     try {
       std::size_t used = 0;
       v.push_back(std::stod(item, &used));
-      if (used != item.size()) throw std::invalid_argument(item);
+      if (used != item.size() || !std::isfinite(v.back())) throw std::invalid_argument(item);
     } catch (const std::exception&) {
-      throw InputError(option + " '" + text + "': expected X,Y,THETA_DEG (three numbers)");
+      throw InputError(error);
     }
   }
-  if (v.size() != 3)
-    throw InputError(option + " '" + text + "': expected X,Y,THETA_DEG (three numbers)");
+  if (static_cast<int>(v.size()) != n) throw InputError(error);
+  return v;
+}
+
+Pose2 ParsePoseDeg(const std::string& text, const std::string& option) {
+  const std::vector<double> v = ParseNumbers(text, option, 3, "X,Y,THETA_DEG");
   return Pose2{v[0], v[1], WrapAngle(DegToRad(v[2]))};
+}
+
+JsonLines::JsonLines(const std::string& path) {
+  if (path.empty() || path == "-") return;
+  file_.open(path, std::ios::out | std::ios::trunc);
+  if (!file_) throw InputError(path + ": cannot write");
+}
+
+void JsonLines::Write(const nlohmann::json& j) {
+  std::ostream& out = file_.is_open() ? static_cast<std::ostream&>(file_) : std::cout;
+  out << j.dump() << "\n";
+  out.flush();
 }
 
 sim::DriveOptions LoadDriveOptions(const std::string& config_path) {

@@ -3,6 +3,8 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
 
@@ -21,8 +23,26 @@ class RunFailed : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Parses `n` comma-separated numbers ("X,Y" for n = 2); throws InputError naming the option and
+// `form` (what was expected, e.g. "X,Y").
+std::vector<double> ParseNumbers(const std::string& text, const std::string& option, int n,
+                                 const std::string& form);
 // Parses "X,Y,THETA_DEG"; throws InputError naming the option.
 Pose2 ParsePoseDeg(const std::string& text, const std::string& option);
+
+// A journal of JSON lines: each line is flushed as it is written, so an interrupted run keeps every
+// complete line.
+class JsonLines {
+ public:
+  // "" or "-": standard output.
+  explicit JsonLines(const std::string& path);
+  void Write(const nlohmann::json& j);
+
+ private:
+  std::ofstream file_;
+};
+
+
 
 // Options of a simulated run, read from --config FILE (see config/default.yaml).
 sim::DriveOptions LoadDriveOptions(const std::string& config_path);
@@ -42,6 +62,7 @@ void AddEvalCommand(CLI::App* app);
 void AddTeachRepeatCommands(CLI::App* app);
 void AddFlowCommand(CLI::App* app);
 void AddGroundCommand(CLI::App* app);
+void AddNavigateCommand(CLI::App* app);
 // Reads an image or throws InputError naming the file.
 cv::Mat ReadImageOrThrow(const std::string& path, int flags);
 // Throws InputError naming `path` and both sizes unless `image` has `reference`'s size.

@@ -37,25 +37,6 @@ nlohmann::json StepJson(int frame, Timestamp t_ns, const navigation::RepeatStep&
   return j;
 }
 
-// Journal of JSON lines: each line is flushed as it is written, so an interrupted run keeps every
-// complete line.
-class JsonLines {
- public:
-  explicit JsonLines(const std::string& path) {
-    if (path.empty() || path == "-") return;
-    file_.open(path, std::ios::out | std::ios::trunc);
-    if (!file_) throw InputError(path + ": cannot write");
-  }
-  void Write(const nlohmann::json& j) {
-    std::ostream& out = file_.is_open() ? static_cast<std::ostream&>(file_) : std::cout;
-    out << j.dump() << "\n";
-    out.flush();
-  }
-
- private:
-  std::ofstream file_;
-};
-
 }  // namespace
 
 void AddTeachRepeatCommands(CLI::App* app) {

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   mapless::app::AddShiftCommand(&app);
   mapless::app::AddFlowCommand(&app);
   mapless::app::AddGroundCommand(&app);
+  mapless::app::AddNavigateCommand(&app);
   mapless::app::AddEvalCommand(&app);
   mapless::app::AddBenchCommand(&app);
   try {

@@ -27,7 +27,7 @@ expect_exit() {
 }
 
 # Every subcommand answers --help with exit 0 and a usage text.
-for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench" "shift" "teach" "repeat" "route" "route info" "eval" "flow" "ground"; do
+for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench" "shift" "teach" "repeat" "route" "route info" "eval" "flow" "ground" "navigate"; do
   # shellcheck disable=SC2086
   expect_exit "help: mapless $sub --help" 0 "$MAPLESS" $sub --help
   grep -qi "usage" "$TMP/out"; check "help text: mapless $sub" $?
@@ -106,6 +106,20 @@ expect_exit "ground --out" 0 "$MAPLESS" ground "$TMP/f0.png" "$TMP/f1.png" --out
 expect_exit "ground of a missing frame exits 2" 2 "$MAPLESS" ground "$TMP/f0.png" "$TMP/none.png" --out "$TMP/g.png"
 grep -q "none.png: cannot read image" "$TMP/err"; check "ground names the missing frame" $?
 
+# Visual-potential navigation: reach a destination, keep the calibration, log every frame.
+expect_exit "navigate to a destination" 0 "$MAPLESS" navigate --scenario obstacle_field --destination-index 1 --save-calibration "$TMP/cal.yaml" --log "$TMP/nav.jsonl"
+grep -q "mapless-planar-flow-calibration" "$TMP/cal.yaml"; check "navigate saved the calibration" $?
+tail -1 "$TMP/nav.jsonl" | grep -q '"status":"arrived"'; check "navigate log ends arrived" $?
+expect_exit "navigate with a bad destination exits 2" 2 "$MAPLESS" navigate --scenario obstacle_field --destination 1,x
+grep -q "destination '1,x': expected X,Y" "$TMP/err"; check "navigate names the bad destination" $?
+expect_exit "navigate --homing without a destination exits 2" 2 "$MAPLESS" navigate --scenario obstacle_field --homing
+sed 's/^width: 320/width: 64/' "$TMP/cal.yaml" > "$TMP/cal64.yaml"
+expect_exit "navigate with a calibration for another camera exits 2" 2 "$MAPLESS" navigate --scenario obstacle_field --calibration "$TMP/cal64.yaml"
+grep -q "cal64.yaml: calibrated for 64x240" "$TMP/err"; check "navigate names the mismatched calibration" $?
+head -c 120 "$TMP/cal.yaml" > "$TMP/calcut.yaml"
+expect_exit "navigate with a truncated calibration exits 2" 2 "$MAPLESS" navigate --scenario obstacle_field --calibration "$TMP/calcut.yaml"
+grep -q "calcut.yaml" "$TMP/err"; check "navigate names the truncated calibration" $?
+
 # Teach from a recorded image folder, inspect, repeat open loop: one JSON line per frame.
 expect_exit "teach from an image folder" 0 "$MAPLESS" teach --source "$TMP/d1/frames" --out "$TMP/route"
 expect_exit "route info --json" 0 "$MAPLESS" route info "$TMP/route" --json
@@ -149,6 +163,7 @@ grep -q '"success": true' "$TMP/demo/summary.json"; check "demo repeat succeeded
 # Bench: one JSON object with the render stage and its reference.
 expect_exit "bench --json" 0 "$MAPLESS" bench --json --repeats 5
 grep -q '"sim_render_320x240_ms":[0-9.]*' "$TMP/out" && grep -q '"opencv_dis_fast_320x240_ms"' "$TMP/out"; check "bench JSON has the render stage and DIS reference" $?
+grep -q '"dominant_plane_step_ms":[0-9.]*' "$TMP/out" && grep -q '"opencv_dis_fast_ground_320x240_ms"' "$TMP/out"; check "bench JSON has the potential step and its DIS reference" $?
 [ "$(wc -l <"$TMP/out")" -eq 1 ]; check "bench JSON is one line" $?
 
 echo "$passed passed, $failed failed"

@@ -1,0 +1,124 @@
+// `mapless navigate`: visual-potential navigation (Ohnishi & Imiya) on the simulator — corridor
+// centring, a destination, or a destination and home — with the per-frame decisions as JSON lines.
+#include <spdlog/spdlog.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_common.h"
+#include "mapless/core/check.h"
+#include "mapless/eval/potential.h"
+#include "mapless/io/atomic_file.h"
+
+namespace mapless::app {
+
+void AddNavigateCommand(CLI::App* app) {
+  struct Args {
+    std::string scenario;
+    std::string destination;
+    int destination_index = -1;
+    bool homing = false;
+    std::string start;
+    std::string calibration;
+    std::string save_calibration;
+    std::string log;
+    std::uint64_t seed = 1;
+    double motion_noise = 0.1;
+    double image_noise = 2.0;
+  };
+  auto a = std::make_shared<Args>();
+  CLI::App* cmd = app->add_subcommand(
+      "navigate",
+      "Visual-potential navigation on the simulator: free ground from optical flow, obstacles "
+      "avoided, a destination reached (and home again with --homing)");
+  cmd->add_option("--scenario", a->scenario, "Built-in scenario name or scenario YAML file")
+      ->required();
+  cmd->add_option("--destination", a->destination,
+                  "X,Y in the world (metres); without one the robot drives ahead and keeps to "
+                  "the middle of free space until it passes the end of the taught path");
+  cmd->add_option("--destination-index", a->destination_index,
+                  "Use the scenario's destination number N (0-based)");
+  cmd->add_flag("--homing", a->homing, "At the destination turn round and come back");
+  cmd->add_option("--start", a->start, "X,Y,THETA_DEG (default: the scenario's teach start)");
+  cmd->add_option("--calibration", a->calibration,
+                  "Planar-flow calibration file to use (default: calibrate by driving first)");
+  cmd->add_option("--save-calibration", a->save_calibration,
+                  "Write the calibration used to this file (YAML)");
+  cmd->add_option("--log", a->log, "Per-frame decisions as JSON lines (- for stdout)");
+  cmd->add_option("--seed", a->seed, "Noise seed")->capture_default_str();
+  cmd->add_option("--motion-noise", a->motion_noise, "Fraction of T and R")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.9));
+  cmd->add_option("--image-noise", a->image_noise, "Gaussian image noise, grey levels")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0));
+  cmd->callback([a] {
+    sim::Scenario scenario = sim::LoadScenario(a->scenario);
+    if (!a->start.empty()) scenario.teach_start = ParsePoseDeg(a->start, "--start");
+    eval::PotentialRunOptions o;
+    o.seed = a->seed;
+    o.motion_noise_frac = a->motion_noise;
+    o.image_noise_sigma = a->image_noise;
+    o.homing = a->homing;
+    if (!a->destination.empty() && a->destination_index >= 0)
+      throw InputError("--destination and --destination-index: give one of them");
+    if (!a->destination.empty()) {
+      const std::vector<double> d = ParseNumbers(a->destination, "--destination", 2, "X,Y");
+      o.destination = Eigen::Vector2d(d[0], d[1]);
+    } else if (a->destination_index >= 0) {
+      if (a->destination_index >= static_cast<int>(scenario.destinations.size()))
+        throw InputError("--destination-index " + std::to_string(a->destination_index) +
+                         ": scenario " + scenario.name + " has " +
+                         std::to_string(scenario.destinations.size()) + " destinations");
+      o.destination = scenario.destinations[static_cast<std::size_t>(a->destination_index)];
+    }
+    if (o.homing && !o.destination) throw InputError("--homing needs a destination");
+
+    navigation::PlanarFlowCalibration calibration;
+    if (!a->calibration.empty()) {
+      calibration = navigation::CalibrationFromYaml(io::ReadFile(a->calibration), a->calibration);
+      if (calibration.width != scenario.camera.model.width ||
+          calibration.height != scenario.camera.model.height)
+        throw InputError(a->calibration + ": calibrated for " +
+                         std::to_string(calibration.width) + "x" +
+                         std::to_string(calibration.height) + ", the camera is " +
+                         std::to_string(scenario.camera.model.width) + "x" +
+                         std::to_string(scenario.camera.model.height));
+    } else {
+      spdlog::info("navigate: calibrating the planar flows (straight at T_m, then turning)");
+      calibration = eval::CalibrateOnSimulator(scenario, o.nav);
+    }
+    if (!a->save_calibration.empty())
+      io::WriteFileAtomic(a->save_calibration, navigation::CalibrationToYaml(calibration));
+
+    JsonLines log(a->log.empty() ? std::string() : a->log);
+    const bool logging = !a->log.empty();
+    int frame = 0;
+    const eval::PotentialRun run = eval::RunPotential(
+        scenario, calibration, o,
+        [&](const Pose2& truth, const cv::Mat&, const navigation::PotentialStep& s) {
+          if (logging) {
+            nlohmann::json j;
+            j["frame"] = frame;
+            j["x_m"] = truth.x_m;
+            j["y_m"] = truth.y_m;
+            j["theta_deg"] = RadToDeg(truth.theta_rad);
+            j["status"] = navigation::PotentialStatusName(s.status);
+            j["leg"] = s.leg;
+            j["plane_fraction"] = s.plane_fraction;
+            j["theta_d_deg"] = RadToDeg(s.theta_d_rad);
+            j["force_theta_deg"] = RadToDeg(s.theta_rad);
+            j["v_mps"] = s.command.v_mps;
+            j["omega_radps"] = s.command.omega_radps;
+            if (!s.reason.empty()) j["reason"] = s.reason;
+            log.Write(j);
+          }
+          ++frame;
+        });
+    spdlog::info("navigate: {} after {:.1f} s ({} frames){}", run.status, run.duration_s,
+                 run.path.size(),
+                 o.destination ? fmt::format(", {:.2f} m from the goal", run.final_error_m) : "");
+    if (!run.success) throw RunFailed("navigate: " + run.status);
+  });
+}
+
+}  // namespace mapless::app
