@@ -25,6 +25,7 @@ void AddGroundCommand(CLI::App* app) {
     double epsilon_px = 0.5;
     double epsilon_relative = 0.3;
     double roi_top = 0.5;
+    double fit_bottom = 1.0;
     double iou_top = 0.5;
   };
   auto args = std::make_shared<Args>();
@@ -45,6 +46,9 @@ void AddGroundCommand(CLI::App* app) {
   cmd->add_option("--roi-top", args->roi_top,
                   "Region of interest: rows below this fraction of the height (0: whole image)")
       ->capture_default_str();
+  cmd->add_option("--fit-bottom", args->fit_bottom,
+                  "RANSAC draws from the bottom fraction of the region of interest only (1: all)")
+      ->capture_default_str();
   cmd->add_option("--gt", args->truth, "Labelled ground mask (255 = ground): print IoU as JSON");
   cmd->add_option("--iou-top", args->iou_top,
                   "IoU over the rows below this fraction of the height")
@@ -57,6 +61,7 @@ void AddGroundCommand(CLI::App* app) {
     options.epsilon_px = args->epsilon_px;
     options.epsilon_relative = args->epsilon_relative;
     options.roi_top_fraction = args->roi_top;
+    options.fit_bottom_fraction = args->fit_bottom;
     options.Validate();
     const cv::Mat a = ReadImageOrThrow(args->first, cv::IMREAD_GRAYSCALE);
     const cv::Mat b = ReadImageOrThrow(args->second, cv::IMREAD_GRAYSCALE);

@@ -126,7 +126,7 @@ ground::DominantPlaneOptions DefaultPlaneOptions() {
 
 control::VisualPotentialOptions DefaultPotentialOptions() {
   control::VisualPotentialOptions o;
-  o.repulsion_gain = 2.0;
+  o.repulsion_gain = 2.5;
   o.work_width_px = 40;  // the blur (sigma: half the image) on a 40-column map
   return o;
 }
@@ -146,6 +146,10 @@ void PotentialNavOptions::Validate() const {
   MAPLESS_CHECK(search_rate_fraction > 0.0 && search_rate_fraction <= 1.0,
                 "PotentialNavOptions.search_rate_fraction must be in (0, 1]");
   MAPLESS_CHECK(max_search_steps >= 1, "PotentialNavOptions.max_search_steps must be >= 1");
+  MAPLESS_CHECK(min_free_ahead >= 0.0 && min_free_ahead <= 1.0,
+                "PotentialNavOptions.min_free_ahead must be in [0, 1]");
+  MAPLESS_CHECK(ahead_rows > 0.0 && ahead_rows <= 1.0 && ahead_cols > 0.0 && ahead_cols <= 1.0,
+                "PotentialNavOptions.ahead_rows and ahead_cols must be in (0, 1]");
   MAPLESS_CHECK(plane_scale > 0.0 && plane_scale <= 1.0,
                 "PotentialNavOptions.plane_scale = " << plane_scale << "; must be in (0, 1]");
   MAPLESS_CHECK(potential_width_px >= 16,
@@ -386,6 +390,22 @@ PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odom
     step.command.v_mps = 0.0;
     step.command.omega_radps =
         (c.theta_rad >= 0.0 ? 1.0 : -1.0) * options_.potential.max_rotation_radps;
+  }
+  if (options_.min_free_ahead > 0.0) {
+    // The ground just ahead of the robot (the bottom-centre window of the image) must be free:
+    // otherwise an obstacle is close in front, and the robot turns in place towards the force's
+    // side instead of driving on.
+    const cv::Mat& m = plane.mask;
+    const int h = std::max(1, static_cast<int>(std::lround(m.rows * options_.ahead_rows)));
+    const int w = std::max(1, static_cast<int>(std::lround(m.cols * options_.ahead_cols)));
+    const cv::Rect ahead((m.cols - w) / 2, m.rows - h, w, h);
+    step.free_ahead = static_cast<double>(cv::countNonZero(m(ahead))) / ahead.area();
+    if (step.free_ahead < options_.min_free_ahead) {
+      step.command.v_mps = 0.0;
+      step.command.omega_radps =
+          (c.theta_rad >= 0.0 ? 1.0 : -1.0) * options_.potential.max_rotation_radps;
+      step.reason = "obstacle just ahead: turning in place";
+    }
   }
   if (options_.full_speed_plane_fraction > options_.plane.min_plane_fraction) {
     const double lo = options_.plane.min_plane_fraction;

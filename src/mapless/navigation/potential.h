@@ -63,7 +63,7 @@ struct PotentialNavOptions {
   // Tuned on the simulator (docs/flow_and_ground.md): a tolerance of 0.5 px + 15% of the planar
   // flow, RANSAC fitted on the bottom half of the image.
   ground::DominantPlaneOptions plane = DefaultPlaneOptions();
-  // Repulsion gain 2 (the paper's Eq. 11 has 1: our attraction is in units of the calibrated
+  // Repulsion gain 2.5 (the paper's Eq. 11 has 1: our attraction is in units of the calibrated
   // forward flow, so the balance is ours to set).
   control::VisualPotentialOptions potential = DefaultPotentialOptions();
   // The attraction is divided by the mean magnitude of the calibrated translational flow, so the
@@ -72,7 +72,14 @@ struct PotentialNavOptions {
   // fraction of the region of interest is ground to 0 at the "no plane" threshold
   // (plane.min_plane_fraction), so the robot slows as obstacles fill the view and turns tighter.
   // 0 disables it.
-  double full_speed_plane_fraction = 0.8;
+  double full_speed_plane_fraction = 0.9;
+  // Not in the paper: a safety window. The bottom-centre of the image (the lowest ahead_rows of the
+  // rows, the central ahead_cols of the columns) is the ground just in front of the robot; when
+  // less than min_free_ahead of it is plane, the robot does not drive forward but turns in place
+  // towards the force's side. Image fractions, so no calibration is needed. 0 disables it.
+  double min_free_ahead = 0.9;
+  double ahead_rows = 0.35;
+  double ahead_cols = 0.5;
   // The dominant plane is detected on the flow field scaled by this (0.5: 160x120 for a 320x240
   // camera): the potential only needs the map at potential_width_px columns. PotentialStep's
   // plane_mask is at this scale.
@@ -91,7 +98,7 @@ struct PotentialNavOptions {
   int max_search_steps = 12;      // searched this often in a row without finding ground: give up
   // Not in the paper: a first-order low-pass on the control force, f <- a f_new + (1 - a) f
   // (a = 1: none). A single frame's mask noise then cannot jerk the robot.
-  double force_filter = 0.2;
+  double force_filter = 0.3;
   bool allow_reverse = false;     // Eq. 17 gives T < 0 for a force pointing backwards; clamp to 0
   // Robustness experiments of Section 5.2 only: invert this fraction of the dominant-plane map's
   // pixels each frame ("an error of 20% to the detected dominant plane"), drawn from noise_seed.
@@ -121,6 +128,7 @@ struct PotentialStep {
   std::string reason;
   bool plane_found = false;
   double plane_fraction = 0.0;  // of the region of interest
+  double free_ahead = 1.0;      // plane fraction of the window just ahead (see min_free_ahead)
   double theta_d_rad = 0.0;     // destination direction relative to the heading (0 without one)
   double theta_rad = 0.0;       // direction of the control force (Eq. 16), positive to the left
   cv::Vec2d force{0.0, 0.0};    // Eq. 15
