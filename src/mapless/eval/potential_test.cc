@@ -94,6 +94,17 @@ TEST(PotentialNavigation, DrivesDownTheCorridorWithoutTouchingAWall) {
   EXPECT_EQ(again.path.back().y_m, run.path.back().y_m);
 }
 
+TEST(PotentialNavigation, TwentyPercentOfTheGroundMapInvertedStillDrivesThrough) {
+  // The paper's image-noise experiment (Section 5.2): the safety window must judge the detected
+  // ground, not the perturbed map, or the robot never moves.
+  PotentialRunOptions o;
+  o.nav.plane_noise_fraction = 0.2;
+  o.seed = 3;
+  o.nav.noise_seed = 3;
+  const PotentialRun run = RunPotential(ShortCorridor(), CorridorCalibration(), o);
+  EXPECT_TRUE(run.success) << run.status;
+}
+
 TEST(PotentialNavigation, AWallAheadTurnsTheRobotAwayBeforeItTouches) {
   // Facing the end wall of the corridor (x = 13) from 1 m, heading straight at it.
   sim::Scenario s = sim::LoadScenario("corridor_straight_3p5m");

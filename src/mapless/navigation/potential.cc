@@ -346,6 +346,15 @@ PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odom
   search_steps_ = 0;
   misses_ = 0;
 
+  if (options_.min_free_ahead > 0.0) {
+    // The safety window: the ground just in front of the robot (the bottom-centre of the image),
+    // measured on the detected map (before any experimental noise below).
+    const cv::Mat& m = plane.mask;
+    const int h = std::max(1, static_cast<int>(std::lround(m.rows * options_.ahead_rows)));
+    const int w = std::max(1, static_cast<int>(std::lround(m.cols * options_.ahead_cols)));
+    const cv::Rect ahead((m.cols - w) / 2, m.rows - h, w, h);
+    step.free_ahead = static_cast<double>(cv::countNonZero(m(ahead))) / ahead.area();
+  }
   if (options_.plane_noise_fraction > 0.0) {
     for (int y = 0; y < plane.mask.rows; ++y) {
       uchar* d = plane.mask.ptr<uchar>(y);
@@ -391,21 +400,12 @@ PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odom
     step.command.omega_radps =
         (c.theta_rad >= 0.0 ? 1.0 : -1.0) * options_.potential.max_rotation_radps;
   }
-  if (options_.min_free_ahead > 0.0) {
-    // The ground just ahead of the robot (the bottom-centre window of the image) must be free:
-    // otherwise an obstacle is close in front, and the robot turns in place towards the force's
-    // side instead of driving on.
-    const cv::Mat& m = plane.mask;
-    const int h = std::max(1, static_cast<int>(std::lround(m.rows * options_.ahead_rows)));
-    const int w = std::max(1, static_cast<int>(std::lround(m.cols * options_.ahead_cols)));
-    const cv::Rect ahead((m.cols - w) / 2, m.rows - h, w, h);
-    step.free_ahead = static_cast<double>(cv::countNonZero(m(ahead))) / ahead.area();
-    if (step.free_ahead < options_.min_free_ahead) {
-      step.command.v_mps = 0.0;
-      step.command.omega_radps =
-          (c.theta_rad >= 0.0 ? 1.0 : -1.0) * options_.potential.max_rotation_radps;
-      step.reason = "obstacle just ahead: turning in place";
-    }
+  if (step.free_ahead < options_.min_free_ahead) {
+    // An obstacle close in front: no forward motion; turn in place towards the force's side.
+    step.command.v_mps = 0.0;
+    step.command.omega_radps =
+        (c.theta_rad >= 0.0 ? 1.0 : -1.0) * options_.potential.max_rotation_radps;
+    step.reason = "obstacle just ahead: turning in place";
   }
   if (options_.full_speed_plane_fraction > options_.plane.min_plane_fraction) {
     const double lo = options_.plane.min_plane_fraction;
