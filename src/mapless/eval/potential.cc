@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mapless/control/funnel_lane.h"
 #include "mapless/core/check.h"
 #include "mapless/core/rng.h"
 #include "mapless/eval/teach_repeat.h"
@@ -25,16 +26,6 @@ double Rms(const std::vector<double>& v) {
   double s = 0.0;
   for (double x : v) s += x * x;
   return v.empty() ? 0.0 : std::sqrt(s / static_cast<double>(v.size()));
-}
-
-double Std(const std::vector<double>& v) {
-  if (v.empty()) return 0.0;
-  double mean = 0.0;
-  for (double x : v) mean += x;
-  mean /= static_cast<double>(v.size());
-  double var = 0.0;
-  for (double x : v) var += (x - mean) * (x - mean);
-  return std::sqrt(var / static_cast<double>(v.size()));
 }
 
 }  // namespace
@@ -183,7 +174,7 @@ double TrajectoryDeviationStd(const std::vector<Pose2>& clean, const std::vector
   diff.reserve(n);
   for (std::size_t i = 0; i < n; ++i)
     diff.push_back(SignedDistanceToPath(clean, noisy[i].x_m, noisy[i].y_m));
-  return Std(diff);
+  return control::StdDev(diff);
 }
 
 InclusionResult InclusionOnSimulator(const sim::Scenario& scenario,
@@ -299,7 +290,7 @@ PotentialEntryResult RunPotentialEntry(const PotentialEntry& entry, int runs, st
     if (run.collided) ++r.collisions;
   }
   r.final_error_m_rms = Rms(finals);
-  r.final_error_m_std = Std(finals);
+  r.final_error_m_std = control::StdDev(finals);
   r.lateral_rms_m = Rms(lateral);
   if (!deviations.empty()) {
     double sum = 0.0;
