@@ -146,6 +146,7 @@ void PotentialNavOptions::Validate() const {
   MAPLESS_CHECK(search_rate_fraction > 0.0 && search_rate_fraction <= 1.0,
                 "PotentialNavOptions.search_rate_fraction must be in (0, 1]");
   MAPLESS_CHECK(max_search_steps >= 1, "PotentialNavOptions.max_search_steps must be >= 1");
+  MAPLESS_CHECK(escape_distance_m >= 0.0, "PotentialNavOptions.escape_distance_m must be >= 0");
   MAPLESS_CHECK(min_free_ahead >= 0.0 && min_free_ahead <= 1.0,
                 "PotentialNavOptions.min_free_ahead must be in [0, 1]");
   MAPLESS_CHECK(ahead_rows > 0.0 && ahead_rows <= 1.0 && ahead_cols > 0.0 && ahead_cols <= 1.0,
@@ -204,6 +205,16 @@ void PotentialNavigator::SetDestination(const Eigen::Vector2d& destination) {
   destination_ = destination;
 }
 
+double PotentialNavigator::AvoidanceDirection(const Pose2& odometry, double theta_rad) {
+  const bool recent = have_avoided_ && std::hypot(odometry.x_m - avoided_at_.x_m,
+                                                  odometry.y_m - avoided_at_.y_m) <
+                                           options_.escape_distance_m;
+  if (!recent) avoid_direction_ = theta_rad < 0.0 ? -1.0 : 1.0;
+  have_avoided_ = true;
+  avoided_at_ = odometry;
+  return avoid_direction_;
+}
+
 PotentialStep PotentialNavigator::Search(PotentialStep step, const Pose2& odometry,
                                          const std::string& why) {
   if (status_ != PotentialStatus::kSearching) {
@@ -217,8 +228,9 @@ PotentialStep PotentialNavigator::Search(PotentialStep step, const Pose2& odomet
       return step;
     }
     status_ = PotentialStatus::kSearching;
-    // Turn towards the side where the ground was last seen (the last force's side).
-    turn_direction_ = last_theta_rad_ < 0.0 ? -1.0 : 1.0;
+    // Turn towards the side where the ground was last seen (the last force's side), unless the
+    // robot turned away from something within the last escape_distance_m: then keep that side.
+    turn_direction_ = AvoidanceDirection(odometry, last_theta_rad_);
     turn_target_rad_ = odometry.theta_rad + turn_direction_ * options_.search_step_rad;
   }
   step.status = status_;
@@ -404,7 +416,7 @@ PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odom
     // An obstacle close in front: no forward motion; turn in place towards the force's side.
     step.command.v_mps = 0.0;
     step.command.omega_radps =
-        (c.theta_rad >= 0.0 ? 1.0 : -1.0) * options_.potential.max_rotation_radps;
+        AvoidanceDirection(odometry, c.theta_rad) * options_.potential.max_rotation_radps;
     step.reason = "obstacle just ahead: turning in place";
   }
   if (options_.full_speed_plane_fraction > options_.plane.min_plane_fraction) {

@@ -80,6 +80,10 @@ struct PotentialNavOptions {
   double min_free_ahead = 0.9;
   double ahead_rows = 0.35;
   double ahead_cols = 0.5;
+  // Turning away from an obstacle (the safety window, a search): within this distance of the last
+  // such turn the robot keeps turning to the same side. Choosing the side afresh each time made it
+  // dither left and right in front of a box corner, creeping closer at each look, until it touched.
+  double escape_distance_m = 0.3;
   // The dominant plane is detected on the flow field scaled by this (0.5: 160x120 for a 320x240
   // camera): the potential only needs the map at potential_width_px columns. PotentialStep's
   // plane_mask is at this scale.
@@ -153,6 +157,8 @@ class PotentialNavigator {
 
  private:
   PotentialStep Search(PotentialStep step, const Pose2& odometry, const std::string& why);
+  // +1 (left) or -1: the side of theta, or the side chosen by a turn within escape_distance_m.
+  double AvoidanceDirection(const Pose2& odometry, double theta_rad);
 
   PlanarFlowCalibration calibration_;
   PotentialNavOptions options_;
@@ -170,6 +176,9 @@ class PotentialNavigator {
   double turn_direction_ = 1.0;
   int search_steps_ = 0;
   int misses_ = 0;
+  bool have_avoided_ = false;
+  Pose2 avoided_at_;
+  double avoid_direction_ = 1.0;
   double last_theta_rad_ = 0.0;
   double last_plane_fraction_ = 1.0;  // of the last frame with flow
   bool last_plane_found_ = true;
