@@ -22,10 +22,10 @@ void AddGroundCommand(CLI::App* app) {
     std::string method = "dis_medium";
     std::string model = "homography";
     std::string truth;
-    double epsilon_px = 0.5;
-    double epsilon_relative = 0.3;
+    double epsilon_px = 0.4;
+    double epsilon_relative = 0.4;
     double roi_top = 0.5;
-    double fit_bottom = 1.0;
+    double fit_bottom = 0.5;
     double iou_top = 0.5;
   };
   auto args = std::make_shared<Args>();

@@ -94,8 +94,9 @@ TEST(MaskIoU, CountsInsideTheRoi) {
 }
 
 // Real data: CamVid, a car camera in town with hand-labelled road and pavement (shared data folder).
-// The configuration of `mapless ground`: DIS medium, homography, epsilon 0.5 px + 0.3 |u_hat|,
-// bottom-half ROI; IoU over the bottom half, mean over all 50 consecutive pairs.
+// The configuration of `mapless ground`: DIS medium, homography, epsilon 0.4 px + 0.4 |u_hat|,
+// bottom-half ROI, RANSAC on the bottom half of it; IoU over the bottom half, mean over all 50
+// consecutive pairs (measured 0.803; the issue asks for more than 0.8).
 TEST(DetectDominantPlane, CamVidGroundIoU) {
   const std::string dir = std::string(MAPLESS_SOURCE_DIR) + "/../shared/data/camvid_seq";
   if (!std::filesystem::exists(dir + "/frames")) GTEST_SKIP() << "shared data not found at " << dir;
@@ -107,9 +108,10 @@ TEST(DetectDominantPlane, CamVidGroundIoU) {
   flow::FlowOptions flow_options;
   flow_options.method = flow::FlowMethod::kDisMedium;
   DominantPlaneOptions options;
-  options.epsilon_px = 0.5;
-  options.epsilon_relative = 0.3;
+  options.epsilon_px = 0.4;
+  options.epsilon_relative = 0.4;
   options.roi_top_fraction = 0.5;
+  options.fit_bottom_fraction = 0.5;
   DominantPlaneOptions paper = options;  // the paper's fixed tolerance, for comparison
   paper.epsilon_px = 1.0;
   paper.epsilon_relative = 0.0;
@@ -127,7 +129,7 @@ TEST(DetectDominantPlane, CamVidGroundIoU) {
   const double n = static_cast<double>(names.size() - 1);
   std::printf("CamVid ground IoU (bottom half, %d pairs): %.3f; fixed epsilon 1 px: %.3f\n",
               static_cast<int>(n), sum / n, sum_paper / n);
-  EXPECT_GT(sum / n, 0.78);
+  EXPECT_GT(sum / n, 0.8);
   EXPECT_GT(sum / n, sum_paper / n + 0.1);
 }
 
