@@ -126,7 +126,7 @@ ground::DominantPlaneOptions DefaultPlaneOptions() {
 
 control::VisualPotentialOptions DefaultPotentialOptions() {
   control::VisualPotentialOptions o;
-  o.repulsion_gain = 2.5;
+  o.repulsion_gain = 2.0;
   o.work_width_px = 40;  // the blur (sigma: half the image) on a 40-column map
   return o;
 }

@@ -63,7 +63,7 @@ struct PotentialNavOptions {
   // Tuned on the simulator (docs/flow_and_ground.md): a tolerance of 0.5 px + 15% of the planar
   // flow, RANSAC fitted on the bottom half of the image.
   ground::DominantPlaneOptions plane = DefaultPlaneOptions();
-  // Repulsion gain 2.5 (the paper's Eq. 11 has 1: our attraction is in units of the calibrated
+  // Repulsion gain 2 (the paper's Eq. 11 has 1: our attraction is in units of the calibrated
   // forward flow, so the balance is ours to set).
   control::VisualPotentialOptions potential = DefaultPotentialOptions();
   // The attraction is divided by the mean magnitude of the calibrated translational flow, so the
@@ -102,7 +102,7 @@ struct PotentialNavOptions {
   int max_search_steps = 12;      // searched this often in a row without finding ground: give up
   // Not in the paper: a first-order low-pass on the control force, f <- a f_new + (1 - a) f
   // (a = 1: none). A single frame's mask noise then cannot jerk the robot.
-  double force_filter = 0.3;
+  double force_filter = 0.2;
   bool allow_reverse = false;     // Eq. 17 gives T < 0 for a force pointing backwards; clamp to 0
   // Robustness experiments of Section 5.2 only: invert this fraction of the dominant-plane map's
   // pixels each frame ("an error of 20% to the detected dominant plane"), drawn from noise_seed.
