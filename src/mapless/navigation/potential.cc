@@ -146,6 +146,8 @@ void PotentialNavOptions::Validate() const {
   MAPLESS_CHECK(search_rate_fraction > 0.0 && search_rate_fraction <= 1.0,
                 "PotentialNavOptions.search_rate_fraction must be in (0, 1]");
   MAPLESS_CHECK(max_search_steps >= 1, "PotentialNavOptions.max_search_steps must be >= 1");
+  MAPLESS_CHECK(ground_check_tolerance >= 0.0,
+                "PotentialNavOptions.ground_check_tolerance must be >= 0");
   MAPLESS_CHECK(escape_distance_m >= 0.0, "PotentialNavOptions.escape_distance_m must be >= 0");
   MAPLESS_CHECK(min_free_ahead >= 0.0 && min_free_ahead <= 1.0,
                 "PotentialNavOptions.min_free_ahead must be in [0, 1]");
@@ -203,6 +205,37 @@ PotentialNavigator::PotentialNavigator(PlanarFlowCalibration calibration,
 
 void PotentialNavigator::SetDestination(const Eigen::Vector2d& destination) {
   destination_ = destination;
+}
+
+double PotentialNavigator::GroundMismatch(const cv::Mat& model, const Pose2& motion) const {
+  // The ground's flow for this frame's motion, from the calibration: the forward and turning
+  // flows scaled by how far the robot went and turned (odometry) relative to the calibration
+  // drive. The fitted plane's flow (in plane_scale pixels) is compared with it on a coarse grid.
+  const double a = motion.x_m / (calibration_.speed_mps * calibration_.period_s);
+  const double b = motion.theta_rad / (calibration_.omega_radps * calibration_.period_s);
+  const double s = options_.plane_scale;
+  const auto* m = model.ptr<double>();
+  const auto* t = calibration_.translational.ptr<double>();
+  const auto* r = calibration_.rotational.ptr<double>();
+  auto flow_at = [](const double* h, double x, double y) {
+    const double w = h[6] * x + h[7] * y + h[8];
+    const double k = std::abs(w) > 1e-12 ? 1.0 / w : 0.0;
+    return cv::Vec2d((h[0] * x + h[1] * y + h[2]) * k - x, (h[3] * x + h[4] * y + h[5]) * k - y);
+  };
+  double diff = 0.0;
+  double norm = 0.0;
+  constexpr int kGrid = 12;
+  for (int j = 0; j < kGrid; ++j) {
+    for (int i = 0; i < kGrid; ++i) {
+      const double x = (i + 0.5) * calibration_.width / kGrid;
+      const double y = (j + 0.5) * calibration_.height / kGrid;
+      const cv::Vec2d predicted = a * flow_at(t, x, y) + b * flow_at(r, x, y);
+      const cv::Vec2d fitted = flow_at(m, x * s, y * s) / s;
+      diff += cv::norm(fitted - predicted);
+      norm += cv::norm(predicted);
+    }
+  }
+  return norm > 1e-9 ? diff / norm : 0.0;
 }
 
 double PotentialNavigator::AvoidanceDirection(const Pose2& odometry, double theta_rad) {
@@ -324,6 +357,7 @@ PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odom
   }
 
   cv::Mat flow = flow::ComputeFlow(previous_, grey, options_.flow);
+  const Pose2 motion = previous_odometry_.Inverse() * odometry;  // this frame's, by odometry
   previous_ = grey;
   previous_odometry_ = odometry;
   ground::DominantPlaneOptions plane_options = options_.plane;
@@ -338,6 +372,15 @@ PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odom
         1, static_cast<int>(std::lround(plane_options.sample_step_px * options_.plane_scale)));
   }
   ground::DominantPlane plane = ground::DetectDominantPlane(flow, plane_options);
+  bool not_ground = false;
+  if (plane.found && options_.ground_check_tolerance > 0.0) {
+    step.ground_mismatch = GroundMismatch(plane.model, motion);
+    not_ground = step.ground_mismatch > options_.ground_check_tolerance;
+    if (not_ground) {
+      plane.found = false;
+      plane.mask.setTo(0);
+    }
+  }
   step.plane_found = plane.found;
   step.plane_fraction = plane.roi_fraction;
   last_plane_fraction_ = plane.roi_fraction;
@@ -345,8 +388,13 @@ PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odom
   step.plane_mask = plane.mask;
   if (!plane.found) {
     std::ostringstream why;
-    why << "no ground plane (" << static_cast<int>(std::lround(100.0 * plane.roi_fraction))
-        << "% of the view)";
+    if (not_ground) {
+      why << "the dominant plane does not move like the ground (a wall or an obstacle fills the "
+             "view)";
+    } else {
+      why << "no ground plane (" << static_cast<int>(std::lround(100.0 * plane.roi_fraction))
+          << "% of the view)";
+    }
     if (++misses_ >= options_.misses_before_search) return Search(step, odometry, why.str());
     // Stop and look again (the next frame, standing, cannot see: it creeps one frame).
     status_ = PotentialStatus::kLooking;

@@ -80,6 +80,11 @@ struct PotentialNavOptions {
   double min_free_ahead = 0.9;
   double ahead_rows = 0.35;
   double ahead_cols = 0.5;
+  // Not in the paper: the dominant plane must move like the ground. Its flow is compared with the
+  // ground flow predicted for this frame's odometry from the calibration (mean |difference| over
+  // mean |predicted|); above this it is a wall or an obstacle filling the view, and the frame
+  // counts as "no plane". 0 disables it.
+  double ground_check_tolerance = 0.5;
   // Turning away from an obstacle (the safety window, a search): within this distance of the last
   // such turn the robot keeps turning to the same side. Choosing the side afresh each time made it
   // dither left and right in front of a box corner, creeping closer at each look, until it touched.
@@ -133,6 +138,7 @@ struct PotentialStep {
   bool plane_found = false;
   double plane_fraction = 0.0;  // of the region of interest
   double free_ahead = 1.0;      // plane fraction of the window just ahead (see min_free_ahead)
+  double ground_mismatch = 0.0;  // the plane's flow against the predicted ground flow
   double theta_d_rad = 0.0;     // destination direction relative to the heading (0 without one)
   double theta_rad = 0.0;       // direction of the control force (Eq. 16), positive to the left
   cv::Vec2d force{0.0, 0.0};    // Eq. 15
@@ -157,6 +163,7 @@ class PotentialNavigator {
 
  private:
   PotentialStep Search(PotentialStep step, const Pose2& odometry, const std::string& why);
+  double GroundMismatch(const cv::Mat& model, const Pose2& motion) const;
   // +1 (left) or -1: the side of theta, or the side chosen by a turn within escape_distance_m.
   double AvoidanceDirection(const Pose2& odometry, double theta_rad);
 
