@@ -106,6 +106,7 @@ void AddNavigateCommand(CLI::App* app) {
             j["leg"] = s.leg;
             j["plane_fraction"] = s.plane_fraction;
             j["free_ahead"] = s.free_ahead;
+            j["ground_mismatch"] = s.ground_mismatch;
             j["theta_d_deg"] = RadToDeg(s.theta_d_rad);
             j["force_theta_deg"] = RadToDeg(s.theta_rad);
             j["v_mps"] = s.command.v_mps;
