@@ -83,6 +83,7 @@ void RunPotentialSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
     e["experiment"] = r.experiment;
     e["deviation_std_m"] = r.deviation_std_m;
     e["deviation_std_m_max"] = r.deviation_std_m_max;
+    e["deviations_m"] = r.deviations_m;
     j["results"].push_back(e);
     std::fprintf(table, "%-24s %-14s %4d/%-4d %5d %9.3fm %9.4fm %9.4fm\n", r.scenario.c_str(),
                  r.experiment.c_str(), r.successes, r.runs, r.collisions, r.final_error_m_rms,

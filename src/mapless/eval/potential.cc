@@ -292,6 +292,7 @@ PotentialEntryResult RunPotentialEntry(const PotentialEntry& entry, int runs, st
   r.final_error_m_rms = Rms(finals);
   r.final_error_m_std = control::StdDev(finals);
   r.lateral_rms_m = Rms(lateral);
+  r.deviations_m = deviations;
   if (!deviations.empty()) {
     double sum = 0.0;
     for (double d : deviations) sum += d;

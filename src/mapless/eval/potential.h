@@ -92,6 +92,7 @@ struct PotentialEntryResult : EntryResult {
   std::string experiment;
   double deviation_std_m = 0.0;  // corridor: mean over runs of TrajectoryDeviationStd
   double deviation_std_m_max = 0.0;
+  std::vector<double> deviations_m;  // corridor: each run's TrajectoryDeviationStd
 };
 
 // Runs `runs` noisy runs of an entry with seeds seed, seed + 1, ... (and, for the corridor, one
