@@ -415,17 +415,21 @@ PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odom
     const cv::Rect ahead((m.cols - w) / 2, m.rows - h, w, h);
     step.free_ahead = static_cast<double>(cv::countNonZero(m(ahead))) / ahead.area();
   }
+  // The map the potential sees: the detected one, or (robustness experiments) a copy with
+  // inverted pixels, so step.plane_mask stays the detection.
+  cv::Mat map = plane.mask;
   if (options_.plane_noise_fraction > 0.0) {
-    for (int y = 0; y < plane.mask.rows; ++y) {
-      uchar* d = plane.mask.ptr<uchar>(y);
-      for (int x = 0; x < plane.mask.cols; ++x)
+    map = plane.mask.clone();
+    for (int y = 0; y < map.rows; ++y) {
+      uchar* d = map.ptr<uchar>(y);
+      for (int x = 0; x < map.cols; ++x)
         if (noise_.Uniform() < options_.plane_noise_fraction) d[x] = 255 - d[x];
     }
   }
   // The potential is averaged over the image (Eq. 15), so it is computed on a coarse grid of
   // potential_width_px columns: the same mean, a sixteenth of the work at 320x240.
   cv::Mat d;
-  cv::resize(plane.mask, d, work_size_, 0, 0, cv::INTER_NEAREST);
+  cv::resize(map, d, work_size_, 0, 0, cv::INTER_NEAREST);
   // Attraction: the desired flow towards the destination (Eq. 13; theta_d = 0 without one), or
   // the measured planar flow (Eq. 11) when asked; in units of the calibrated forward flow.
   cv::Mat attraction;
