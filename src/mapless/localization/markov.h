@@ -1,0 +1,76 @@
+// Markov localization over the route index (Section 4 of Payá et al., Eq. 5-6): a belief over the
+// route images, predicted by convolving it with a Gaussian motion model centred on the advance the
+// odometry (or the commanded speed) reports, and corrected by an observation model that is a sum
+// of Gaussian kernels on the k route images most similar to the current one, each weighted by a
+// confidence from its similarity. The position is the maximum of the belief; its probability (the
+// belief mass within ±probability_window images of it) says how sure the robot is, and a
+// probability that stays low means the robot is lost.
+//
+// Defaults follow the paper where it gives them (k = 5); the widths are in route images.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "mapless/localization/nearest.h"
+
+namespace mapless::localization {
+
+struct MarkovOptions {
+  int kernels = 5;                     // k, route images in the observation model (Eq. 6)
+  double kernel_sigma_images = 1.5;    // σ of each kernel (Eq. 6), route images
+  double motion_sigma_images = 0.7;    // motion model standard deviation per update ...
+  double motion_sigma_fraction = 0.3;  // ... plus this fraction of the predicted advance
+  // p(z|x) never falls below this, so that a wrong belief can recover from good observations.
+  double observation_floor = 0.02;
+  int probability_window = 1;     // probability = belief mass within ± this many images
+  // Lost: for lost_after_updates in a row, either the probability is below lost_probability or
+  // the observation disagrees with the prediction (the predicted belief puts less than
+  // min_agreement of the best possible weight on the places the image looks like). The second
+  // catches a confident belief that the images contradict, which the posterior alone hides.
+  double lost_probability = 0.15;
+  double min_agreement = 0.1;
+  int lost_after_updates = 10;
+  void Validate() const;
+};
+
+enum class LocalizationStatus { kUninitialized, kTracking, kLost };
+const char* LocalizationStatusName(LocalizationStatus status);
+
+struct Localization {
+  LocalizationStatus status = LocalizationStatus::kUninitialized;
+  int index = -1;            // route image at the maximum of the belief
+  double probability = 0.0;  // belief mass around it
+  double agreement = 0.0;    // Σ prior(x) p(z|x) / max p(z|x): does the image fit the prediction
+  std::vector<Neighbour> neighbours;  // the k most similar route images (observation)
+};
+
+class MarkovLocalizer {
+ public:
+  explicit MarkovLocalizer(MarkovOptions options = {});
+
+  // Belief uniform over `route_images` (nothing known).
+  void ResetUniform(int route_images);
+  // Belief a Gaussian around `index` (after initial localization).
+  void ResetAt(int route_images, double index, double sigma_images);
+
+  // One predict + update: `advance_images` is the motion since the last update in route images
+  // (odometry distance / image spacing). `projections` (K x N) may have grown since the last call
+  // (a leader still teaching): new images get the belief's floor.
+  Localization Update(const Eigen::MatrixXf& projections, const Eigen::VectorXf& query,
+                      double advance_images);
+
+  const Eigen::VectorXd& belief() const { return belief_; }
+  const MarkovOptions& options() const { return options_; }
+
+ private:
+  void Grow(int route_images);
+  void Predict(double advance_images);
+
+  MarkovOptions options_;
+  Eigen::VectorXd belief_;
+  Eigen::VectorXd scratch_;
+  int low_updates_ = 0;
+};
+
+}  // namespace mapless::localization

@@ -1,0 +1,130 @@
+#include "mapless/localization/markov.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+
+#include "mapless/core/check.h"
+#include "mapless/localization/initial.h"
+#include "mapless/localization/nearest.h"
+
+namespace mapless::localization {
+namespace {
+
+// A route of `n` places with aliasing: the appearance repeats every `period` places (identical
+// doors) up to a small per-place signature, so that a noisy image can hardly tell place i from
+// place i + period.
+Eigen::MatrixXf AliasedRoute(int n, int period, float signature = 0.0F) {
+  Eigen::MatrixXf p(3, n);
+  std::uint32_t state = 12345;
+  for (int i = 0; i < n; ++i) {
+    const double a = 2.0 * M_PI * (i % period) / period;
+    state = state * 1664525U + 1013904223U;
+    p(0, i) = static_cast<float>(std::cos(a));
+    p(1, i) = static_cast<float>(std::sin(a));
+    p(2, i) = signature * (static_cast<float>(state >> 8) / 16777216.0F - 0.5F);
+  }
+  return p;
+}
+
+TEST(NearestProjection, FindsTheClosestColumn) {
+  Eigen::MatrixXf p(1, 4);
+  p << 0.0F, 1.0F, 2.0F, 3.0F;
+  Eigen::VectorXf q(1);
+  q << 2.2F;
+  const auto nn = NearestProjections(p, q, 2);
+  ASSERT_EQ(nn.size(), 2U);
+  EXPECT_EQ(nn[0].index, 2);
+  EXPECT_EQ(nn[1].index, 3);
+  EXPECT_NEAR(nn[0].distance, 0.2F, 1e-5F);
+}
+
+TEST(MarkovLocalizer, TracksThroughVisualAliasingWhereNearestProjectionIsAmbiguous) {
+  const int n = 120;
+  const int period = 15;
+  const Eigen::MatrixXf route = AliasedRoute(n, period, 0.2F);
+  MarkovLocalizer markov;
+  markov.ResetAt(n, 0.0, 2.0);
+  int markov_correct = 0;
+  int nn_correct = 0;
+  std::uint32_t state = 777;
+  const auto noise = [&] {
+    state = state * 1664525U + 1013904223U;
+    return 0.3F * (static_cast<float>(state >> 8) / 16777216.0F - 0.5F);
+  };
+  for (int t = 1; t < n; ++t) {
+    // Observation: the true place's appearance plus noise larger than the per-place signature.
+    Eigen::VectorXf z = route.col(t);
+    for (int c = 0; c < 3; ++c) z(c) += noise();
+    const Localization loc = markov.Update(route, z, 1.0);
+    markov_correct += std::abs(loc.index - t) <= 1;
+    nn_correct += std::abs(NearestProjection(route, z).index - t) <= 1;
+    EXPECT_EQ(loc.status, LocalizationStatus::kTracking);
+  }
+  EXPECT_GE(markov_correct, n - 3);
+  EXPECT_LT(nn_correct, n / 2);
+}
+
+TEST(MarkovLocalizer, ReportsLostWhenObservationsContradictTheMotion) {
+  const int n = 100;
+  Eigen::MatrixXf route(1, n);
+  for (int i = 0; i < n; ++i) route(0, i) = static_cast<float>(i);
+  MarkovOptions options;
+  options.lost_after_updates = 3;
+  MarkovLocalizer markov(options);
+  markov.ResetAt(n, 10.0, 1.0);
+  Localization loc;
+  // The images say the robot jumps around the route at random.
+  const int jumps[] = {80, 20, 60, 5, 95, 40, 70, 30};
+  int lost = 0;
+  for (const int j : jumps) {
+    Eigen::VectorXf z(1);
+    z << static_cast<float>(j);
+    loc = markov.Update(route, z, 0.0);
+    lost += loc.status == LocalizationStatus::kLost;
+  }
+  EXPECT_GT(lost, 0);
+}
+
+TEST(MarkovLocalizer, FollowsARouteThatGrowsWhileItIsUsed) {
+  const Eigen::MatrixXf full = AliasedRoute(60, 60);
+  MarkovLocalizer markov;
+  markov.ResetAt(10, 0.0, 1.0);
+  Localization loc;
+  for (int t = 1; t < 50; ++t) {
+    const int known = std::min(60, 10 + t);  // the leader adds one image per step
+    loc = markov.Update(full.leftCols(known), full.col(t), 1.0);
+    EXPECT_LE(std::abs(loc.index - t), 1) << t;
+  }
+  EXPECT_THROW(markov.Update(full.leftCols(5), full.col(0), 0.0), InputError);
+}
+
+TEST(MarkovOptions, RejectsBadValuesNamingTheField) {
+  MarkovOptions options;
+  options.kernels = 0;
+  try {
+    options.Validate();
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("MarkovOptions.kernels = 0"), std::string::npos);
+  }
+}
+
+TEST(InitialLocalization, ChoosesTheTightestLargeCluster) {
+  // Images around place 9 localize near 9, a few aliased ones near 24 and one stray at 40.
+  const std::vector<int> localizations = {9, 10, 24, 8, 9, 25, 10, 40, 9, 23, 11, 9};
+  const InitialLocalization init = LocalizeByClustering(localizations, {});
+  ASSERT_TRUE(init.ok) << init.reason;
+  EXPECT_EQ(init.index, 9);
+  EXPECT_EQ(init.clusters.size(), 3U);
+}
+
+TEST(InitialLocalization, FailsWithoutAConsistentCluster) {
+  const InitialLocalization init = LocalizeByClustering({1, 20, 40, 60, 80}, {});
+  EXPECT_FALSE(init.ok);
+  EXPECT_FALSE(init.reason.empty());
+}
+
+}  // namespace
+}  // namespace mapless::localization
