@@ -63,6 +63,7 @@ void AddTeachRepeatCommands(CLI::App* app);
 void AddFlowCommand(CLI::App* app);
 void AddGroundCommand(CLI::App* app);
 void AddNavigateCommand(CLI::App* app);
+void AddLocalizeCommand(CLI::App* app);
 // Reads an image or throws InputError naming the file.
 cv::Mat ReadImageOrThrow(const std::string& path, int flags);
 // Throws InputError naming `path` and both sizes unless `image` has `reference`'s size.

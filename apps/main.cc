@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   mapless::app::AddFlowCommand(&app);
   mapless::app::AddGroundCommand(&app);
   mapless::app::AddNavigateCommand(&app);
+  mapless::app::AddLocalizeCommand(&app);
   mapless::app::AddEvalCommand(&app);
   mapless::app::AddBenchCommand(&app);
   try {

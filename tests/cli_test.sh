@@ -27,7 +27,7 @@ expect_exit() {
 }
 
 # Every subcommand answers --help with exit 0 and a usage text.
-for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench" "shift" "teach" "repeat" "route" "route info" "eval" "flow" "ground" "navigate"; do
+for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench" "shift" "teach" "repeat" "route" "route info" "eval" "flow" "ground" "navigate" "localize"; do
   # shellcheck disable=SC2086
   expect_exit "help: mapless $sub --help" 0 "$MAPLESS" $sub --help
   grep -qi "usage" "$TMP/out"; check "help text: mapless $sub" $?
@@ -119,6 +119,23 @@ grep -q "cal64.yaml: calibrated for 64x240" "$TMP/err"; check "navigate names th
 head -c 120 "$TMP/cal.yaml" > "$TMP/calcut.yaml"
 expect_exit "navigate with a truncated calibration exits 2" 2 "$MAPLESS" navigate --scenario obstacle_field --calibration "$TMP/calcut.yaml"
 grep -q "calcut.yaml" "$TMP/err"; check "navigate names the truncated calibration" $?
+
+# localize: Nordland winter queries on the summer route (100 places, tests/data/nordland).
+NL="$HERE/data/nordland"
+within5() { awk -F'"index":' '{split($2,a,","); d=a[1]-(NR-1); if (d<0) d=-d; if (d<=5) ok++} END {print ok+0}' "$1"; }
+expect_exit "localize markov" 0 "$MAPLESS" localize --database "$NL/summer" --query "$NL/winter" --method markov --json
+cp "$TMP/out" "$TMP/loc_markov.jsonl"
+[ "$(wc -l <"$TMP/loc_markov.jsonl")" -eq 100 ]; check "localize: one line per query" $?
+head -1 "$TMP/loc_markov.jsonl" | grep -Eq '^\{"query":"images-04010.png","index":[0-9]+,"probability":[0-9.e-]+\}$'; check "localize: query, index, probability" $?
+expect_exit "localize nn" 0 "$MAPLESS" localize --database "$NL/summer" --query "$NL/winter" --method nn --json
+cp "$TMP/out" "$TMP/loc_nn.jsonl"
+m5=$(within5 "$TMP/loc_markov.jsonl"); n5=$(within5 "$TMP/loc_nn.jsonl")
+echo "     localize within +-5 places: markov $m5/100, nn $n5/100"
+[ "$m5" -ge 90 ] && [ "$m5" -gt "$n5" ]; check "localize: markov >= 90/100 within 5 places and better than nn" $?
+expect_exit "localize with a missing folder exits 2" 2 "$MAPLESS" localize --database "$TMP/none" --query "$NL/winter"
+grep -q -- "--database $TMP/none: not a directory" "$TMP/err"; check "localize names the missing folder" $?
+expect_exit "localize with a bad method exits 2" 2 "$MAPLESS" localize --database "$NL/summer" --query "$NL/winter" --method best
+grep -q "'best' is unknown" "$TMP/err"; check "localize names the bad method" $?
 
 # Teach from a recorded image folder, inspect, repeat open loop: one JSON line per frame.
 expect_exit "teach from an image folder" 0 "$MAPLESS" teach --source "$TMP/d1/frames" --out "$TMP/route"

@@ -137,6 +137,12 @@ void IncrementalPca::Add(const Vector& image) {
 
   // Eq. (3): D = N/(N+1) [Λ 0; 0 0] + N/(N+1)² [p pᵀ, δp; δpᵀ, δ²], δ = ĥᵀ(x - m) = ‖h‖.
   const int k1 = add_dimension ? k + 1 : k;
+  if (k1 == 0) {  // the same image as the mean so far: nothing to rotate
+    mean_ = (mean_ * static_cast<float>(n) + image) / static_cast<float>(n + 1.0);
+    projections_ = Matrix::Zero(0, n_ + 1);
+    ++n_;
+    return;
+  }
   Eigen::VectorXd a(k1);
   a.head(k) = p.cast<double>();
   if (add_dimension) a(k) = h_norm;

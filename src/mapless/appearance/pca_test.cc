@@ -130,6 +130,18 @@ TEST(IncrementalPca, ProjectionOfANewImageMatchesTheModel) {
   EXPECT_LT((gram - Matrix::Identity(gram.rows(), gram.cols())).norm(), 1e-3F);
 }
 
+TEST(IncrementalPca, AcceptsRepeatedIdenticalImages) {
+  IncrementalPca pca;
+  pca.Add(Vector::Ones(16));
+  pca.Add(Vector::Ones(16));  // no residual and no eigenvector yet
+  EXPECT_EQ(pca.dimensions(), 0);
+  Vector other = Vector::Ones(16);
+  other(3) = 5.0F;
+  pca.Add(other);
+  EXPECT_EQ(pca.dimensions(), 1);
+  EXPECT_EQ(pca.Model().images(), 3);
+}
+
 TEST(IncrementalPca, RejectsAnImageOfAnotherSize) {
   IncrementalPca pca;
   pca.Add(Vector::Ones(16));

@@ -1,0 +1,100 @@
+// `mapless localize --database DIR --query DIR [--method nn|markov] --json`: appearance-based
+// localization of each query image on the route the database images form (file-name order), one
+// JSON object per query: {"query": name, "index": i, "probability": p}.
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "cli_common.h"
+#include "mapless/core/check.h"
+#include "mapless/io/frame_source.h"
+#include "mapless/localization/sequence.h"
+
+namespace mapless::app {
+namespace {
+
+struct Folder {
+  std::vector<cv::Mat> images;
+  std::vector<std::string> names;
+};
+
+Folder ReadFolder(const std::string& dir, const std::string& option) {
+  MAPLESS_CHECK(std::filesystem::is_directory(dir),
+                option << " " << dir << ": not a directory of images");
+  Folder folder;
+  const std::unique_ptr<io::FrameSource> source = io::OpenFrameSource(dir);
+  io::Frame frame;
+  while (source->Next(&frame)) {
+    folder.images.push_back(frame.image.clone());
+    folder.names.push_back(frame.name);
+  }
+  MAPLESS_CHECK(!folder.images.empty(), option << " " << dir << ": no images in it");
+  return folder;
+}
+
+}  // namespace
+
+void AddLocalizeCommand(CLI::App* app) {
+  struct Args {
+    std::string database;
+    std::string query;
+    std::string method = "markov";
+    std::string pca = "incremental";
+    bool json = false;
+    int width = 64;
+    int height = 64;
+    int dimensions = 16;
+    double advance = 1.0;
+    double advance_sigma = 0.2;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app->add_subcommand(
+      "localize", "Localize query images on the route formed by database images (incremental PCA)");
+  cmd->add_option("--database", args->database, "Folder of route images, in route (file-name) order")
+      ->required();
+  cmd->add_option("--query", args->query, "Folder of query images (a traversal of the same route)")
+      ->required();
+  cmd->add_option("--method", args->method, "nn (nearest projection) or markov")->capture_default_str();
+  cmd->add_option("--pca", args->pca, "incremental or batch")->capture_default_str();
+  cmd->add_option("--dimensions", args->dimensions, "Eigenspace dimensions K")->capture_default_str();
+  cmd->add_option("--width", args->width, "Low-resolution image width, px")->capture_default_str();
+  cmd->add_option("--height", args->height, "Low-resolution image height, px")->capture_default_str();
+  cmd->add_option("--advance", args->advance,
+                  "Markov motion model: database images per query image")
+      ->capture_default_str();
+  cmd->add_option("--advance-sigma", args->advance_sigma,
+                  "Markov motion model: its standard deviation per query, database images")
+      ->capture_default_str();
+  cmd->add_flag("--json", args->json, "One JSON object per query (the only output format)");
+  cmd->callback([args] {
+    localization::SequenceLocalizationOptions options;
+    options.method = localization::ParseSequenceMethod(args->method);
+    MAPLESS_CHECK(args->pca == "incremental" || args->pca == "batch",
+                  "--pca " << args->pca << ": use incremental or batch");
+    options.incremental_pca = args->pca == "incremental";
+    options.image.width = args->width;
+    options.image.height = args->height;
+    options.pca.max_dimensions = args->dimensions;
+    options.advance_per_query = args->advance;
+    options.advance_sigma = args->advance_sigma;
+    options.Validate();
+    const Folder database = ReadFolder(args->database, "--database");
+    const Folder query = ReadFolder(args->query, "--query");
+    const appearance::Eigenspace route = localization::BuildRouteEigenspace(database.images, options);
+    spdlog::info("localize: {} route images, eigenspace of {} dimensions ({} PCA); {} queries ({})",
+                 database.images.size(), route.dimensions(), args->pca, query.images.size(),
+                 args->method);
+    const auto results = localization::LocalizeSequence(route, query.images, options);
+    for (std::size_t i = 0; i < results.size(); ++i) {
+      nlohmann::ordered_json j;
+      j["query"] = query.names[i];
+      j["index"] = results[i].index;
+      j["probability"] = results[i].probability;
+      std::cout << j.dump() << "\n";
+    }
+  });
+}
+
+}  // namespace mapless::app
