@@ -11,7 +11,12 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "cli_common.h"
+#include "mapless/appearance/image.h"
+#include "mapless/appearance/pca.h"
+#include "mapless/appearance/subwindow.h"
+#include "mapless/control/subwindow_steering.h"
 #include "mapless/flow/flow.h"
+#include "mapless/localization/markov.h"
 #include "mapless/eval/potential.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/sim/driver.h"
@@ -184,6 +189,72 @@ void BenchTeachRepeat(nlohmann::json* j) {
   (*j)["segment_start_over_orb"] = (*j)["segment_start_ms"].get<double>() / orb_ms;
 }
 
+// Issue 5: incremental PCA, Markov localization and sub-window steering (Payá et al.), on the
+// images of a drive along outdoor_70m.
+void BenchEigenspace(int repeats, nlohmann::json* j) {
+  const sim::Scenario scenario = sim::LoadScenario("outdoor_70m");
+  const appearance::AppearanceImageOptions image_options;
+  std::vector<appearance::Vector> vectors;
+  std::vector<cv::Mat> frames;
+  sim::DriveOptions drive;
+  sim::DriveTaughtPath(scenario, drive, [&](const sim::DriveFrame& f) {
+    vectors.push_back(appearance::AppearanceVector(f.image, image_options));
+    if (f.index % 20 == 0) frames.push_back(f.image.clone());
+  });
+  // Route of 1000 images (the drive's frames, repeated with a little noise when it is shorter).
+  appearance::IncrementalPca pca;
+  cv::RNG rng(7);
+  const auto noisy = [&](std::size_t k) {
+    appearance::Vector v = vectors[k % vectors.size()];
+    for (Eigen::Index p = 0; p < v.size(); ++p) v(p) += static_cast<float>(rng.gaussian(0.05));
+    return v;
+  };
+  for (std::size_t k = 0; k < 1000; ++k) pca.Add(noisy(k));
+  std::vector<double> ms;
+  for (int r = 0; r < std::max(repeats, 10); ++r) {
+    appearance::IncrementalPca copy = pca;
+    const appearance::Vector x = noisy(static_cast<std::size_t>(r) * 7 + 3);
+    const auto t0 = std::chrono::steady_clock::now();
+    copy.Add(x);
+    const auto t1 = std::chrono::steady_clock::now();
+    ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+  }
+  (*j)["ipca_add_1000_ms"] = Median(ms);
+  (*j)["ipca_dimensions"] = pca.dimensions();
+
+  // Markov localization over a 10,000-image route (the eigenspace's projections, tiled).
+  const appearance::Eigenspace model = pca.Model();
+  Eigen::MatrixXf projections(model.projections.rows(), 10000);
+  for (Eigen::Index c = 0; c < projections.cols(); ++c) {
+    projections.col(c) = model.projections.col(c % model.projections.cols()) +
+                         Eigen::VectorXf::Constant(model.projections.rows(), 0.01F * static_cast<float>(c / model.projections.cols()));
+  }
+  localization::MarkovLocalizer markov;
+  markov.ResetAt(10000, 5000.0, 2.0);
+  (*j)["markov_update_10000_ms"] = MedianMs(repeats, 3, [&](int i) {
+    markov.Update(projections, projections.col(5000 + i % 50), 0.5);
+  });
+
+  // One steering decision: the camera image to its low resolution, the five query windows
+  // matched in the route image's sub-window eigenspace, the seven fits.
+  const appearance::SubWindowOptions windows;
+  std::vector<appearance::SubWindowEigenspace> routes;
+  for (const cv::Mat& f : frames) {
+    routes.push_back(appearance::BuildSubWindowEigenspace(appearance::LowResolution(f, image_options), windows));
+  }
+  (*j)["subwindow_control_ms"] = MedianMs(repeats, 3, [&](int i) {
+    const std::size_t k = static_cast<std::size_t>(i) % (frames.size() - 1);
+    const cv::Mat low = appearance::LowResolution(frames[k + 1], image_options);
+    std::vector<control::WindowCorrespondence> m;
+    for (const auto& w : appearance::MatchSubWindows(routes[k], low, windows)) m.push_back({w.query, w.stored});
+    control::ComputeSubWindowSteering(m, routes[k].windows(), windows.step_px, {});
+  });
+  const double dis = (*j)["opencv_dis_fast_320x240_ms"].get<double>();
+  (*j)["ipca_add_1000_over_dis_fast"] = (*j)["ipca_add_1000_ms"].get<double>() / dis;
+  (*j)["markov_update_10000_over_dis_fast"] = (*j)["markov_update_10000_ms"].get<double>() / dis;
+  (*j)["subwindow_control_over_dis_fast"] = (*j)["subwindow_control_ms"].get<double>() / dis;
+}
+
 }  // namespace
 
 void AddBenchCommand(CLI::App* app) {
@@ -280,6 +351,7 @@ void AddBenchCommand(CLI::App* app) {
                                            j["dense_lk_320x240_ms"].get<double>();
     BenchTeachRepeat(&j);
     BenchPotential(args->repeats, &j);
+    BenchEigenspace(args->repeats, &j);
     if (args->json) {
       std::cout << j.dump() << "\n";
       return;
@@ -290,7 +362,8 @@ void AddBenchCommand(CLI::App* app) {
           "repeat_step_1km_ms", "repeat_step_fresh_ms", "repeat_step_fresh_1km_ms",
           "segment_start_ms", "opencv_orb500_320x240_ms", "dense_lk_320x240_ms",
           "opencv_pyrlk_every_pixel_320x240_ms", "opencv_dis_fast_ground_320x240_ms",
-          "dominant_plane_step_ms", "dominant_plane_step_dis_medium_ms"}) {
+          "dominant_plane_step_ms", "dominant_plane_step_dis_medium_ms", "ipca_add_1000_ms",
+          "markov_update_10000_ms", "subwindow_control_ms"}) {
       std::printf("%-34s %10.3f\n", key, j[key].get<double>());
     }
     std::printf("%-34s %10.2f  (issue 2: <= 2.0)\n", "sim_render / dis_fast",
@@ -303,6 +376,10 @@ void AddBenchCommand(CLI::App* app) {
                 j["pyrlk_every_pixel_over_dense_lk"].get<double>());
     std::printf("%-34s %10.2f  (issue 4: <= 2.0)\n", "dominant_plane_step / dis_fast",
                 j["dominant_plane_step_over_dis_fast"].get<double>());
+    for (const char* key : {"ipca_add_1000", "markov_update_10000", "subwindow_control"}) {
+      std::printf("%-34s %10.2f  (issue 5: <= 1.5)\n", (std::string(key) + " / dis_fast").c_str(),
+                  j[std::string(key) + "_over_dis_fast"].get<double>());
+    }
   });
 }
 

@@ -12,6 +12,7 @@
 
 #include "cli_common.h"
 #include "mapless/core/check.h"
+#include "mapless/eval/eigenspace.h"
 #include "mapless/eval/potential.h"
 #include "mapless/eval/suite.h"
 
@@ -105,6 +106,39 @@ void RunPotentialSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
   if (json_out) std::cout << j.dump() << "\n";
 }
 
+// `mapless eval eigenspace`: Payá et al., Section 5 (see eval/eigenspace.h).
+void RunEigenspaceSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
+                        const std::string& only) {
+  std::vector<eval::EigenspaceEntry> entries;
+  for (const auto& e : eval::EigenspaceSuiteEntries())
+    if (only.empty() || e.scenario == only) entries.push_back(e);
+  if (entries.empty()) throw InputError("--only '" + only + "': not a scenario of suite eigenspace");
+  std::vector<eval::EigenspaceEntryResult> results(entries.size());
+  RunInBatches(entries.size(), jobs, [&](std::size_t k) {
+    results[k] = eval::RunEigenspaceEntry(entries[k], runs, seed);
+    spdlog::info("eval: {} {}: {}/{} successes", entries[k].scenario, entries[k].experiment,
+                 results[k].successes, results[k].runs);
+  });
+  nlohmann::json j = SuiteJson("eigenspace", runs, seed);
+  FILE* table = json_out ? stderr : stdout;
+  std::fprintf(table, "%-16s %-16s %9s %5s %10s %11s %11s %9s %9s\n", "scenario", "experiment",
+               "success", "coll", "final rms", "lateral rms", "lateral max", "loc +-1", "nn +-1");
+  for (const auto& r : results) {
+    nlohmann::json e = EntryJson(r);
+    e["experiment"] = r.experiment;
+    e["lateral_rms_m_max"] = r.lateral_rms_m_max;
+    e["localization_within_one"] = r.localization_within_one;
+    e["nearest_within_one"] = r.nearest_within_one;
+    e["stop_frames"] = r.stops;
+    j["results"].push_back(e);
+    std::fprintf(table, "%-16s %-16s %4d/%-4d %5d %9.3fm %10.3fm %10.3fm %9.3f %9.3f\n",
+                 r.scenario.c_str(), r.experiment.c_str(), r.successes, r.runs, r.collisions,
+                 r.final_error_m_rms, r.lateral_rms_m, r.lateral_rms_m_max,
+                 r.localization_within_one, r.nearest_within_one);
+  }
+  if (json_out) std::cout << j.dump() << "\n";
+}
+
 }  // namespace
 
 void AddEvalCommand(CLI::App* app) {
@@ -118,8 +152,10 @@ void AddEvalCommand(CLI::App* app) {
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app->add_subcommand(
-      "eval", "Run an evaluation suite on the simulator (table1, funnel-scenarios, potential)");
-  cmd->add_option("SUITE", args->suite, "table1, funnel-scenarios or potential")->required();
+      "eval",
+      "Run an evaluation suite on the simulator (table1, funnel-scenarios, potential, eigenspace)");
+  cmd->add_option("SUITE", args->suite, "table1, funnel-scenarios, potential or eigenspace")
+      ->required();
   cmd->add_option("--runs", args->runs, "Repeats per scenario and controller")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
@@ -132,6 +168,10 @@ void AddEvalCommand(CLI::App* app) {
   cmd->callback([args] {
     if (args->suite == "potential") {
       RunPotentialSuite(args->runs, args->seed, args->json, args->jobs, args->only);
+      return;
+    }
+    if (args->suite == "eigenspace") {
+      RunEigenspaceSuite(args->runs, args->seed, args->json, args->jobs, args->only);
       return;
     }
     std::vector<eval::SuiteEntry> entries = eval::SuiteEntries(args->suite);

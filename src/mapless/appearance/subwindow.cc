@@ -31,8 +31,8 @@ void SubWindowOptions::Validate() const {
                 "SubWindowOptions.band_top/band_bottom = " << band_top << "/" << band_bottom
                                                            << "; need 0 <= top < bottom <= 1");
   MAPLESS_CHECK(dimensions >= 1, "SubWindowOptions.dimensions = " << dimensions << "; must be >= 1");
-  MAPLESS_CHECK(correspondences >= 2,
-                "SubWindowOptions.correspondences = " << correspondences << "; must be >= 2");
+  MAPLESS_CHECK(correspondences >= 5,
+                "SubWindowOptions.correspondences = " << correspondences << "; must be >= 5");
 }
 
 int SubWindowCount(int image_width, const SubWindowOptions& options) {
@@ -98,15 +98,32 @@ std::vector<SubWindowMatch> MatchSubWindows(const SubWindowEigenspace& route,
       all.push_back({q, i, (route.space.projections.col(i) - f).norm()});
     }
   }
-  const std::size_t keep =
-      std::min(all.size(), static_cast<std::size_t>(options.correspondences));
-  std::partial_sort(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(keep), all.end(),
-                    [](const SubWindowMatch& a, const SubWindowMatch& b) {
-                      if (a.distance != b.distance) return a.distance < b.distance;
-                      if (a.query != b.query) return a.query < b.query;
-                      return a.stored < b.stored;
-                    });
-  all.resize(keep);
+  const auto nearer = [](const SubWindowMatch& a, const SubWindowMatch& b) {
+    if (a.distance != b.distance) return a.distance < b.distance;
+    if (a.query != b.query) return a.query < b.query;
+    return a.stored < b.stored;
+  };
+  // Each query window's nearest stored window first, then the nearest of the rest overall.
+  std::vector<SubWindowMatch> kept;
+  std::vector<bool> used(all.size(), false);
+  for (int q = 0; q < 5; ++q) {
+    std::size_t best = all.size();
+    for (std::size_t i = static_cast<std::size_t>(q * count); i < static_cast<std::size_t>((q + 1) * count); ++i) {
+      if (best == all.size() || nearer(all[i], all[best])) best = i;
+    }
+    kept.push_back(all[best]);
+    used[best] = true;
+  }
+  std::vector<SubWindowMatch> rest;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    if (!used[i]) rest.push_back(all[i]);
+  }
+  const std::size_t more = std::min(
+      rest.size(), static_cast<std::size_t>(std::max(0, options.correspondences - 5)));
+  std::partial_sort(rest.begin(), rest.begin() + static_cast<std::ptrdiff_t>(more), rest.end(), nearer);
+  kept.insert(kept.end(), rest.begin(), rest.begin() + static_cast<std::ptrdiff_t>(more));
+  std::sort(kept.begin(), kept.end(), nearer);
+  all.swap(kept);
   return all;
 }
 

@@ -18,10 +18,10 @@ namespace mapless::appearance {
 struct SubWindowOptions {
   int window_width_px = 16;   // sub-window width in the low-resolution image, px
   int step_px = 1;            // horizontal scan step, px; N' = (width - window_width) / step + 1
-  double band_top = 0.25;     // central band: top row as a fraction of the image height
-  double band_bottom = 0.75;  // bottom row (exclusive) as a fraction of the image height
+  double band_top = 0.1;      // central band: top row as a fraction of the image height
+  double band_bottom = 0.9;   // bottom row (exclusive) as a fraction of the image height
   int dimensions = 8;         // K', components of each image's sub-window eigenspace
-  int correspondences = 7;    // total correspondences kept for the five query windows
+  int correspondences = 7;    // total correspondences kept for the five query windows (>= 5)
   void Validate() const;
 };
 
@@ -57,8 +57,10 @@ struct SubWindowMatch {
 };
 
 // Projects the five query windows of `current` (low resolution, same size as the route image)
-// into `route` and returns the `options.correspondences` stored windows nearest to them overall:
-// the same as five spheres of a common radius around the query projections.
+// into `route` and returns `options.correspondences` stored windows near them: each query
+// window's nearest, then the nearest of the rest overall. (The paper grows five spheres of a
+// common radius until they hold seven windows; then a query window in a smooth region, whose
+// neighbours all lie close, takes every correspondence and the fit has one abscissa.)
 std::vector<SubWindowMatch> MatchSubWindows(const SubWindowEigenspace& route,
                                             const cv::Mat& current,
                                             const SubWindowOptions& options);

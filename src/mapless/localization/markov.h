@@ -19,7 +19,7 @@ namespace mapless::localization {
 struct MarkovOptions {
   int kernels = 5;                     // k, route images in the observation model (Eq. 6)
   double kernel_sigma_images = 1.5;    // σ of each kernel (Eq. 6), route images
-  double motion_sigma_images = 0.7;    // motion model standard deviation per update ...
+  double motion_sigma_images = 0.3;    // motion model standard deviation per update ...
   double motion_sigma_fraction = 0.3;  // ... plus this fraction of the predicted advance
   // p(z|x) never falls below this, so that a wrong belief can recover from good observations.
   double observation_floor = 0.02;

@@ -1,0 +1,79 @@
+// The appearance-based route following experiments of Payá et al. (Section 5, Fig. 7-9) on the
+// simulator: a leader teaches the route (incremental or batch PCA), a follower starts on the route
+// or off it and follows it to the end, with Markov localization or the nearest projection alone,
+// after the leader has finished or while it is still teaching (two robots in one world).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "mapless/eval/suite.h"
+#include "mapless/navigation/appearance.h"
+#include "mapless/sim/scenario.h"
+
+namespace mapless::eval {
+
+struct EigenspaceRunOptions {
+  std::uint64_t seed = 1;
+  // Follower start relative to the taught start, in the start's frame: x forward (negative =
+  // behind), y to the left, theta counter-clockwise.
+  Pose2 start_offset;
+  bool concurrent = false;             // follow while the leader is still teaching
+  int follower_starts_after_images = 5;  // concurrent: the leader's images before the follower starts
+  double motion_noise = 0.0;           // follower motion noise fraction (both v and omega)
+  // Metrics count after convergence: once the follower has driven convergence_m and come within
+  // converged_lateral_m of the leader's path (a follower that starts off the route localizes
+  // poorly until it is on it: Fig. 9 of the paper).
+  double convergence_m = 3.0;
+  double converged_lateral_m = 0.15;
+  double arrive_tolerance_m = 0.6;     // success: arrived within this distance of the route end
+  double timeout_factor = 3.0;         // give up after this many times the nominal duration
+  navigation::AppearanceLeaderOptions leader;
+  navigation::AppearanceFollowerOptions follower;
+};
+
+struct EigenspaceRun {
+  bool success = false;
+  bool collided = false;
+  std::string status;
+  int route_images = 0;
+  double final_error_m = 0.0;        // follower's end to the taught end
+  double lateral_rms_m = 0.0;        // after convergence, to the leader's path
+  double localization_within_one = 0.0;  // fraction of frames after convergence (±1 image)
+  double nearest_within_one = 0.0;   // the same for the nearest projection alone
+  int frames_after_convergence = 0;
+  double convergence_distance_m = -1.0;  // driven before convergence (-1: never)
+  int stops = 0;                     // frames in which the follower stood still and said why
+  std::vector<Pose2> leader_path;    // ground truth
+  std::vector<Pose2> follower_path;  // ground truth
+};
+
+// Called for every follower frame (for logs and debugging).
+using EigenspaceObserver =
+    std::function<void(const navigation::FollowerStep& step, const Pose2& truth)>;
+
+EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario, const EigenspaceRunOptions& options,
+                                  const EigenspaceObserver& observer = {});
+
+// One line of `mapless eval eigenspace`.
+struct EigenspaceEntry {
+  std::string scenario;
+  std::string experiment;  // on-route, off-route-left, off-route-right, batch-pca, no-markov,
+                           // concurrent
+};
+std::vector<EigenspaceEntry> EigenspaceSuiteEntries();
+EigenspaceRunOptions EigenspaceEntryOptions(const EigenspaceEntry& entry, std::uint64_t seed);
+
+struct EigenspaceEntryResult : EntryResult {
+  std::string experiment;
+  double localization_within_one = 0.0;  // mean over runs (Markov or nearest, as the run used)
+  double nearest_within_one = 0.0;       // mean over runs, nearest projection alone
+  double lateral_rms_m_max = 0.0;        // worst run
+  int stops = 0;                         // total stop frames over runs
+};
+
+EigenspaceEntryResult RunEigenspaceEntry(const EigenspaceEntry& entry, int runs, std::uint64_t seed);
+
+}  // namespace mapless::eval

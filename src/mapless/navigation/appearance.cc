@@ -1,0 +1,324 @@
+#include "mapless/navigation/appearance.h"
+
+#include <opencv2/core.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "mapless/core/check.h"
+#include "mapless/localization/nearest.h"
+
+namespace mapless::navigation {
+
+// ---- Leader ------------------------------------------------------------------------------------
+
+void AppearanceLeaderOptions::Validate() const {
+  MAPLESS_CHECK(image_spacing_m > 0.0,
+                "AppearanceLeaderOptions.image_spacing_m = " << image_spacing_m << "; must be > 0");
+  MAPLESS_CHECK(image_turn_rad > 0.0,
+                "AppearanceLeaderOptions.image_turn_rad = " << image_turn_rad << "; must be > 0");
+  image.Validate();
+  windows.Validate();
+  pca.Validate();
+}
+
+AppearanceLeader::AppearanceLeader(AppearanceLeaderOptions options)
+    : options_(options), pca_(options.pca) {
+  options_.Validate();
+}
+
+bool AppearanceLeader::Update(const cv::Mat& image, const Pose2& odometry) {
+  MAPLESS_CHECK(!finished_, "AppearanceLeader::Update after Finish()");
+  if (have_last_) distance_m_ += odometry.DistanceTo(last_odometry_);
+  last_odometry_ = odometry;
+  const bool first = !have_last_;
+  have_last_ = true;
+  const bool far = distance_m_ - last_stored_distance_m_ >= options_.image_spacing_m - 1e-9;
+  const bool turned =
+      std::abs(WrapAngle(odometry.theta_rad - last_stored_.theta_rad)) >= options_.image_turn_rad;
+  if (!first && !far && !turned) return false;
+
+  const cv::Mat low = appearance::LowResolution(image, options_.image);
+  const appearance::Vector vector = appearance::ToVector(low);
+  auto stored = std::make_shared<route::AppearanceRouteImage>();
+  stored->windows = appearance::BuildSubWindowEigenspace(low, options_.windows);
+  stored->distance_m = distance_m_;
+  stored->odometry = odometry;
+  if (options_.incremental) {
+    pca_.Add(vector);
+  } else {
+    vectors_.push_back(vector);
+  }
+  images_.push_back(std::move(stored));
+  last_stored_ = odometry;
+  last_stored_distance_m_ = distance_m_;
+  return true;
+}
+
+void AppearanceLeader::Finish() {
+  if (finished_) return;
+  finished_ = true;
+  if (options_.incremental || vectors_.empty()) return;
+  appearance::Matrix data(vectors_.front().size(), static_cast<Eigen::Index>(vectors_.size()));
+  for (std::size_t i = 0; i < vectors_.size(); ++i) data.col(static_cast<Eigen::Index>(i)) = vectors_[i];
+  batch_ = appearance::BatchPcaSvd(data, options_.pca.max_dimensions);
+}
+
+std::shared_ptr<const route::AppearanceRoute> AppearanceLeader::Snapshot() const {
+  if (images_.empty() || (!options_.incremental && !finished_)) return nullptr;
+  auto snapshot = std::make_shared<route::AppearanceRoute>();
+  snapshot->space = options_.incremental ? pca_.Model() : batch_;
+  snapshot->images = images_;
+  snapshot->complete = finished_;
+  return snapshot;
+}
+
+// ---- Follower ----------------------------------------------------------------------------------
+
+const char* FollowerStateName(FollowerState state) {
+  switch (state) {
+    case FollowerState::kInitializing:
+      return "initializing";
+    case FollowerState::kFollowing:
+      return "following";
+    case FollowerState::kStopped:
+      return "stopped";
+    case FollowerState::kWaitingForLeader:
+      return "waiting_for_leader";
+    case FollowerState::kArrived:
+      return "arrived";
+  }
+  return "?";
+}
+
+void AppearanceFollowerOptions::Validate() const {
+  image.Validate();
+  windows.Validate();
+  steering.Validate();
+  markov.Validate();
+  clustering.Validate();
+  MAPLESS_CHECK(init_turn_rad >= 0.0 && init_turn_rad < kPi,
+                "AppearanceFollowerOptions.init_turn_rad = " << init_turn_rad
+                                                             << "; must be in [0, pi)");
+  MAPLESS_CHECK(init_turn_rate_radps > 0.0, "AppearanceFollowerOptions.init_turn_rate_radps = "
+                                                << init_turn_rate_radps << "; must be > 0");
+  MAPLESS_CHECK(init_forward_m >= 0.0,
+                "AppearanceFollowerOptions.init_forward_m = " << init_forward_m << "; must be >= 0");
+  MAPLESS_CHECK(init_forward_speed_mps > 0.0, "AppearanceFollowerOptions.init_forward_speed_mps = "
+                                                  << init_forward_speed_mps << "; must be > 0");
+  MAPLESS_CHECK(init_sigma_images > 0.0, "AppearanceFollowerOptions.init_sigma_images = "
+                                             << init_sigma_images << "; must be > 0");
+  MAPLESS_CHECK(start_window_m >= 0.0,
+                "AppearanceFollowerOptions.start_window_m = " << start_window_m << "; must be >= 0");
+  MAPLESS_CHECK(arrive_min_probability >= 0.0 && arrive_min_probability <= 1.0,
+                "AppearanceFollowerOptions.arrive_min_probability = " << arrive_min_probability
+                                                                      << "; must be in [0, 1]");
+  MAPLESS_CHECK(min_follow_frames >= 0, "AppearanceFollowerOptions.min_follow_frames = "
+                                            << min_follow_frames << "; must be >= 0");
+  MAPLESS_CHECK(min_contrast >= 0.0,
+                "AppearanceFollowerOptions.min_contrast = " << min_contrast << "; must be >= 0");
+  MAPLESS_CHECK(relocalize_after_stopped_frames >= 1,
+                "AppearanceFollowerOptions.relocalize_after_stopped_frames = "
+                    << relocalize_after_stopped_frames << "; must be >= 1");
+  MAPLESS_CHECK(markov_update_images >= 0.0, "AppearanceFollowerOptions.markov_update_images = "
+                                                 << markov_update_images << "; must be >= 0");
+  MAPLESS_CHECK(lookahead_images >= 0, "AppearanceFollowerOptions.lookahead_images = "
+                                           << lookahead_images << "; must be >= 0");
+  MAPLESS_CHECK(arrive_within_images >= 0, "AppearanceFollowerOptions.arrive_within_images = "
+                                               << arrive_within_images << "; must be >= 0");
+  MAPLESS_CHECK(wait_within_images >= 0, "AppearanceFollowerOptions.wait_within_images = "
+                                             << wait_within_images << "; must be >= 0");
+}
+
+AppearanceFollower::AppearanceFollower(AppearanceFollowerOptions options)
+    : options_(options), markov_(options.markov) {
+  options_.Validate();
+}
+
+void AppearanceFollower::StartInitialization(const Pose2& odometry, int centre_index) {
+  initializing_ = true;
+  init_centre_ = centre_index;
+  stopped_frames_ = 0;
+  init_started_ = true;
+  init_phase_ = 0;
+  init_start_ = odometry;
+  init_localizations_.clear();
+}
+
+FollowerStep AppearanceFollower::Initialize(const appearance::Vector& projection,
+                                            const Pose2& odometry,
+                                            const route::AppearanceRoute& route) {
+  FollowerStep step;
+  step.state = FollowerState::kInitializing;
+  if (!init_started_) StartInitialization(odometry, init_centre_);
+  // Candidates: route images within start_window_m of the start (first localization) or of the
+  // position where the follower lost its footing (later ones).
+  int from = 0;
+  int to = route.size() - 1;
+  if (options_.start_window_m > 0.0 && route.SpacingM() > 0.0) {
+    const int w = static_cast<int>(std::lround(options_.start_window_m / route.SpacingM()));
+    from = std::clamp(init_centre_ < 0 ? 0 : init_centre_ - w, 0, route.size() - 1);
+    to = std::clamp(init_centre_ < 0 ? w : init_centre_ + w, from, route.size() - 1);
+  }
+  init_localizations_.push_back(
+      from + localization::NearestProjection(
+                 route.space.projections.middleCols(from, to - from + 1), projection).index);
+  step.index = init_localizations_.back();
+  const double turned = WrapAngle(odometry.theta_rad - init_start_.theta_rad);
+  const double theta = options_.init_turn_rad;
+  const double rate = options_.init_turn_rate_radps;
+  // Small turns and a short creep around the start (Section 4, Fig. 6), one phase after another.
+  if (init_phase_ == 0 && turned >= theta) init_phase_ = 1;
+  if (init_phase_ == 1 && turned <= -theta) init_phase_ = 2;
+  if (init_phase_ == 2 && turned >= 0.0) init_phase_ = 3;
+  if (init_phase_ == 3 && odometry.DistanceTo(init_start_) >= options_.init_forward_m) init_phase_ = 4;
+  switch (init_phase_) {
+    case 0:
+    case 2:
+      step.command.omega_radps = std::min(rate, 2.0 * std::abs(theta - turned) + 0.05);
+      return step;
+    case 1:
+      step.command.omega_radps = -std::min(rate, 2.0 * std::abs(-theta - turned) + 0.05);
+      return step;
+    case 3:
+      step.command.v_mps = options_.init_forward_speed_mps;
+      return step;
+    default:
+      break;
+  }
+  const localization::InitialLocalization init =
+      localization::LocalizeByClustering(init_localizations_, options_.clustering);
+  if (!init.ok) {
+    init_started_ = false;  // try again from here
+    step.reason = "initial localization failed: " + init.reason;
+    return step;
+  }
+  markov_.ResetAt(route.size(), init.index, options_.init_sigma_images);
+  have_localization_ = false;
+  pending_advance_images_ = 0.0;
+  initializing_ = false;
+  init_started_ = false;
+  step.index = init.index;
+  step.reason = "localized at route image " + std::to_string(init.index);
+  return step;
+}
+
+FollowerStep AppearanceFollower::Update(const cv::Mat& image, const Pose2& odometry,
+                                        const route::AppearanceRoute& route) {
+  double advance_m = 0.0;
+  if (have_odometry_) {
+    // Signed distance along the previous heading.
+    advance_m = (odometry.x_m - last_odometry_.x_m) * std::cos(last_odometry_.theta_rad) +
+                (odometry.y_m - last_odometry_.y_m) * std::sin(last_odometry_.theta_rad);
+  }
+  have_odometry_ = true;
+  last_odometry_ = odometry;
+
+  FollowerStep step;
+  if (arrived_) {
+    step.state = FollowerState::kArrived;
+    return step;
+  }
+  if (route.size() < 2) {
+    step.state = FollowerState::kWaitingForLeader;
+    step.reason = "the route has fewer than 2 images";
+    return step;
+  }
+  cv::Scalar mean;
+  cv::Scalar contrast;
+  cv::meanStdDev(image, mean, contrast);
+  if (contrast[0] < options_.min_contrast) {
+    // Black, over-exposed or a featureless wall: nothing to localize or steer by.
+    step.state = initializing_ ? FollowerState::kInitializing : FollowerState::kStopped;
+    step.reason = "the camera image has no contrast (standard deviation " +
+                  std::to_string(contrast[0]) + " grey levels)";
+    return step;
+  }
+  const cv::Mat low = appearance::LowResolution(image, options_.image);
+  const appearance::Vector projection = route.space.Project(appearance::ToVector(low));
+  if (initializing_) return Initialize(projection, odometry, route);
+
+  const int n = route.size();
+  if (options_.use_markov) {
+    const double spacing = std::max(route.SpacingM(), 1e-3);
+    pending_advance_images_ += advance_m / spacing;
+    // One Bayes update per markov_update_images of travel: consecutive frames see nearly the same
+    // image and their errors are not independent (updating at every frame counts the same
+    // evidence many times over).
+    if (!have_localization_ || std::abs(pending_advance_images_) >= options_.markov_update_images ||
+        route.size() != last_route_size_) {
+      last_localization_ = markov_.Update(route.space.projections, projection, pending_advance_images_);
+      pending_advance_images_ = 0.0;
+      have_localization_ = true;
+      last_route_size_ = route.size();
+    }
+    const localization::Localization& loc = last_localization_;
+    step.index = std::clamp(loc.index + static_cast<int>(std::lround(pending_advance_images_)), 0,
+                            n - 1);
+    step.probability = loc.probability;
+    if (loc.status == localization::LocalizationStatus::kLost) {
+      StartInitialization(odometry, loc.index);
+      step.state = FollowerState::kStopped;
+      step.reason = "localization lost (probability " + std::to_string(loc.probability) +
+                    "); localizing again";
+      return step;
+    }
+  } else {
+    const std::vector<localization::Neighbour> nn =
+        localization::NearestProjections(route.space.projections, projection, 2);
+    step.index = nn.front().index;
+    step.probability = nn.size() > 1 && nn[1].distance > 0.0F
+                           ? 1.0 - static_cast<double>(nn[0].distance) / nn[1].distance
+                           : 1.0;
+  }
+  ++follow_frames_;
+  if (route.complete && step.index >= n - 1 - options_.arrive_within_images &&
+      follow_frames_ >= options_.min_follow_frames &&
+      (!options_.use_markov || step.probability >= options_.arrive_min_probability)) {
+    arrived_ = true;
+    step.state = FollowerState::kArrived;
+    return step;
+  }
+  if (!route.complete && step.index >= n - 1 - options_.wait_within_images) {
+    step.state = FollowerState::kWaitingForLeader;
+    step.reason = "at route image " + std::to_string(step.index) + " of " + std::to_string(n) +
+                  " still being taught";
+    return step;
+  }
+  // Steer towards the route image lookahead_images ahead; when its sub-windows give no
+  // consistent fit, try its neighbours (the localization is good to about one image).
+  const int ahead = std::min(step.index + options_.lookahead_images, n - 1);
+  for (const int target : {ahead, ahead - 1, ahead + 1}) {
+    if (target < 0 || target >= n) continue;
+    const route::AppearanceRouteImage& image_j = *route.images[static_cast<std::size_t>(target)];
+    std::vector<control::WindowCorrespondence> matches;
+    for (const appearance::SubWindowMatch& m :
+         appearance::MatchSubWindows(image_j.windows, low, options_.windows)) {
+      matches.push_back({m.query, m.stored});
+    }
+    step.target = target;
+    step.steering = control::ComputeSubWindowSteering(matches, image_j.windows.windows(),
+                                                      options_.windows.step_px, options_.steering);
+    if (step.steering.ok) break;
+  }
+  if (!step.steering.ok) {
+    // Safety: no steering decision, so the robot stops and says why; if that lasts, it makes the
+    // small motions of the initial localization around its current position, which also change
+    // the view.
+    step.state = FollowerState::kStopped;
+    step.reason = step.steering.reason;
+    if (++stopped_frames_ >= options_.relocalize_after_stopped_frames) {
+      StartInitialization(odometry, step.index);
+      step.reason += "; localizing again around route image " + std::to_string(step.index);
+    }
+    return step;
+  }
+  stopped_frames_ = 0;
+  step.state = FollowerState::kFollowing;
+  step.command = step.steering.twist;
+  return step;
+}
+
+}  // namespace mapless::navigation

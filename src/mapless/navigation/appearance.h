@@ -1,0 +1,149 @@
+// Appearance-based route following (Payá et al., ../shared/papers/
+// incremental_pca_markov_route_following.md): a leader teaches the route by adding low-resolution
+// images to an eigenspace one at a time (incremental PCA, Section 2) and publishes each new model;
+// a follower localizes itself on the route (initial localization by clustering, Section 4; then
+// Markov localization, Section 4, or the nearest projection, Section 3) and steers from the
+// sub-window correspondences with the route image ahead (Section 3), while the leader may still be
+// teaching. No threads, files or clocks here: the caller feeds frames and odometry.
+//
+// Safety: the follower stops and says why when it has no consistent sub-window fit, when the
+// localization is lost (it then re-localizes with the same small motions as at the start), and
+// when it reaches the end of a route that is still being taught (it waits for the leader).
+#pragma once
+
+#include <memory>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "mapless/appearance/image.h"
+#include "mapless/appearance/pca.h"
+#include "mapless/appearance/subwindow.h"
+#include "mapless/control/subwindow_steering.h"
+#include "mapless/core/pose.h"
+#include "mapless/localization/initial.h"
+#include "mapless/localization/markov.h"
+#include "mapless/route/appearance_route.h"
+
+namespace mapless::navigation {
+
+struct AppearanceLeaderOptions {
+  double image_spacing_m = 0.2;  // a route image every this much odometry distance ...
+  double image_turn_rad = 0.2;   // ... or heading change (turns in place), and the first frame
+  bool incremental = true;  // false: batch PCA once the route is finished (the classical method:
+                            // nothing can follow before)
+  appearance::AppearanceImageOptions image;
+  appearance::SubWindowOptions windows;
+  appearance::IncrementalPcaOptions pca;  // batch PCA keeps pca.max_dimensions components
+  void Validate() const;
+};
+
+class AppearanceLeader {
+ public:
+  explicit AppearanceLeader(AppearanceLeaderOptions options = {});
+  // Offers a camera frame and the odometry; returns true when it became a route image.
+  bool Update(const cv::Mat& image, const Pose2& odometry);
+  // The route is complete (batch PCA is computed here when incremental is false).
+  void Finish();
+  // The current route as an immutable snapshot (null before any image, or before Finish() for
+  // batch PCA). O(M K L) for the incremental model.
+  std::shared_ptr<const route::AppearanceRoute> Snapshot() const;
+  int images() const { return static_cast<int>(images_.size()); }
+
+ private:
+  AppearanceLeaderOptions options_;
+  appearance::IncrementalPca pca_;
+  std::vector<appearance::Vector> vectors_;  // batch mode only
+  std::vector<std::shared_ptr<const route::AppearanceRouteImage>> images_;
+  appearance::Eigenspace batch_;
+  bool finished_ = false;
+  double distance_m_ = 0.0;
+  bool have_last_ = false;
+  Pose2 last_odometry_;
+  Pose2 last_stored_;
+  double last_stored_distance_m_ = 0.0;
+};
+
+struct AppearanceFollowerOptions {
+  bool use_markov = true;  // false: nearest projection every frame (Section 3 alone)
+  appearance::AppearanceImageOptions image;
+  appearance::SubWindowOptions windows;
+  control::SubWindowSteeringOptions steering;
+  localization::MarkovOptions markov;
+  localization::ClusteringOptions clustering;
+  // Initial localization: turn in place to +init_turn_rad, to -init_turn_rad and back to the start
+  // heading, then creep forward init_forward_m, localizing every frame.
+  double init_turn_rad = 0.25;
+  double init_turn_rate_radps = 0.5;
+  double init_forward_m = 0.15;
+  double init_forward_speed_mps = 0.1;
+  double init_sigma_images = 2.0;  // belief width around the chosen cluster
+  // Where the follower starts: within this distance of the route start (the usual case: it sets
+  // off where the leader did), so the initial localization only considers those route images;
+  // on a route whose places repeat (identical doors) it cannot otherwise tell the start from its
+  // twins. 0: the whole route (the paper's clustering alone).
+  double start_window_m = 2.0;
+  // Arrival: at the end of a complete route, with at least this probability (Markov), after at
+  // least min_follow_frames frames of following (an initial localization at the end is not an
+  // arrival).
+  double arrive_min_probability = 0.5;
+  int min_follow_frames = 10;
+  // An image whose grey levels vary less than this (standard deviation) is unusable: the robot
+  // stops (black, over-exposed, a featureless wall).
+  double min_contrast = 3.0;
+  // Stopped this many frames in a row without a steering decision: localize again around the
+  // current position (the same small motions as at the start).
+  int relocalize_after_stopped_frames = 10;
+  // Markov localization is updated once per this much travel, in route images (see Update()).
+  double markov_update_images = 0.5;
+  int lookahead_images = 1;        // steer towards the route image this far ahead of the position
+  int arrive_within_images = 1;    // arrived at the end of a complete route within this many
+  int wait_within_images = 2;      // wait for a leader this close to the end it has taught so far
+  void Validate() const;
+};
+
+enum class FollowerState { kInitializing, kFollowing, kStopped, kWaitingForLeader, kArrived };
+const char* FollowerStateName(FollowerState state);
+
+struct FollowerStep {
+  FollowerState state = FollowerState::kInitializing;
+  Twist2 command;
+  int index = -1;            // localization on the route (route image)
+  double probability = 0.0;  // Markov: belief mass around it
+  int target = -1;           // route image steered towards
+  std::string reason;        // why the robot is stopped (kStopped, kWaitingForLeader)
+  control::SubWindowSteering steering;
+};
+
+class AppearanceFollower {
+ public:
+  explicit AppearanceFollower(AppearanceFollowerOptions options = {});
+  // One control period: the current image, the odometry and the latest route snapshot.
+  FollowerStep Update(const cv::Mat& image, const Pose2& odometry, const route::AppearanceRoute& route);
+
+ private:
+  FollowerStep Initialize(const appearance::Vector& projection, const Pose2& odometry,
+                          const route::AppearanceRoute& route);
+  // centre_index < 0: around the route start (or the whole route when start_window_m is 0).
+  void StartInitialization(const Pose2& odometry, int centre_index);
+
+  AppearanceFollowerOptions options_;
+  localization::MarkovLocalizer markov_;
+  bool initializing_ = true;
+  int init_centre_ = -1;
+  int stopped_frames_ = 0;
+  bool init_started_ = false;
+  int init_phase_ = 0;
+  Pose2 init_start_;
+  std::vector<int> init_localizations_;
+  bool have_odometry_ = false;
+  Pose2 last_odometry_;
+  bool arrived_ = false;
+  int follow_frames_ = 0;
+  bool have_localization_ = false;
+  localization::Localization last_localization_;
+  double pending_advance_images_ = 0.0;
+  int last_route_size_ = 0;
+};
+
+}  // namespace mapless::navigation
