@@ -137,6 +137,9 @@ grep -q -- "--database $TMP/none: not a directory" "$TMP/err"; check "localize n
 expect_exit "localize with a bad method exits 2" 2 "$MAPLESS" localize --database "$NL/summer" --query "$NL/winter" --method best
 grep -q "'best' is unknown" "$TMP/err"; check "localize names the bad method" $?
 
+expect_exit "eval eigenspace with an unknown scenario exits 2" 2 "$MAPLESS" eval eigenspace --only nowhere --runs 1
+grep -q "'nowhere': not a scenario of suite eigenspace" "$TMP/err"; check "eval eigenspace names the unknown scenario" $?
+
 # Teach from a recorded image folder, inspect, repeat open loop: one JSON line per frame.
 expect_exit "teach from an image folder" 0 "$MAPLESS" teach --source "$TMP/d1/frames" --out "$TMP/route"
 expect_exit "route info --json" 0 "$MAPLESS" route info "$TMP/route" --json

@@ -33,7 +33,7 @@ struct SubWindowSteeringOptions {
   // A fit is acceptable when its slope is within this fraction of the expected slope.
   double slope_tolerance = 0.5;
   int min_inliers = 3;                   // fewer inliers in every fit: no decision (stop)
-  double turn_gain_radps_per_px = 0.03;  // omega = gain * shift (px of the low-resolution image)
+  double turn_gain_radps_per_px = 0.02;  // omega = gain * shift (px of the low-resolution image)
   double max_turn_rate_radps = 0.5;
   double max_speed_mps = 0.3;
   double shift_for_stop_px = 12.0;  // the speed falls linearly to zero at this |shift|

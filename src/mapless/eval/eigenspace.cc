@@ -105,6 +105,22 @@ void Finalize(const EigenspaceRunOptions& options, const FollowerMetrics& metric
   }
 }
 
+// One follower frame: render, decide, command. Returns true when the follower has arrived.
+bool FollowerFrame(sim::Simulation* sim, int robot, navigation::AppearanceFollower* follower,
+                   const route::AppearanceRoute& route, const std::vector<Pose2>& image_truth,
+                   const EigenspaceRunOptions& options, const EigenspaceObserver& observer,
+                   FollowerMetrics* metrics, EigenspaceRun* run) {
+  const cv::Mat image = sim->Render(robot);
+  const Pose2 truth = sim->robot(robot).pose();
+  run->follower_path.push_back(truth);
+  const navigation::FollowerStep step = follower->Update(image, sim->robot(robot).odometry(), route);
+  metrics->Add(truth, step, image, route, image_truth, run->leader_path, options);
+  if (observer) observer(step, truth);
+  if (step.state == navigation::FollowerState::kArrived) return true;
+  sim->SetCommand(robot, step.command);
+  return false;
+}
+
 }  // namespace
 
 EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario, const EigenspaceRunOptions& options,
@@ -140,17 +156,9 @@ EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario, const Eigenspac
     std::string stop;
     bool arrived = false;
     while (true) {
-      const cv::Mat image = sim.Render(robot);
-      const Pose2 truth = sim.robot(robot).pose();
-      run.follower_path.push_back(truth);
-      const navigation::FollowerStep step = follower.Update(image, sim.robot(robot).odometry(), *route);
-      metrics.Add(truth, step, image, *route, image_truth, run.leader_path, options);
-      if (observer) observer(step, truth);
-      if (step.state == navigation::FollowerState::kArrived) {
-        arrived = true;
-        break;
-      }
-      sim.SetCommand(robot, step.command);
+      arrived = FollowerFrame(&sim, robot, &follower, *route, image_truth, options, observer,
+                              &metrics, &run);
+      if (arrived) break;
       sim.Advance(period);
       stop = SimulationStop(sim, robot, timeout_s);
       if (!stop.empty()) break;
@@ -190,18 +198,9 @@ EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario, const Eigenspac
       follow = sim.AddRobot(StartPose(scenario, options), FollowerRobot(scenario, options));
     }
     if (follow >= 0) {
-      const std::shared_ptr<const route::AppearanceRoute> route = channel.Latest();
-      const cv::Mat image = sim.Render(follow);
-      const Pose2 truth = sim.robot(follow).pose();
-      run.follower_path.push_back(truth);
-      const navigation::FollowerStep step = follower.Update(image, sim.robot(follow).odometry(), *route);
-      metrics.Add(truth, step, image, *route, image_truth, run.leader_path, options);
-      if (observer) observer(step, truth);
-      if (step.state == navigation::FollowerState::kArrived) {
-        arrived = true;
-        break;
-      }
-      sim.SetCommand(follow, step.command);
+      arrived = FollowerFrame(&sim, follow, &follower, *channel.Latest(), image_truth, options,
+                              observer, &metrics, &run);
+      if (arrived) break;
     }
     sim.Advance(period);
     stop = SimulationStop(sim, lead, timeout_s);

@@ -82,7 +82,7 @@ struct AppearanceFollowerOptions {
   // off where the leader did), so the initial localization only considers those route images;
   // on a route whose places repeat (identical doors) it cannot otherwise tell the start from its
   // twins. 0: the whole route (the paper's clustering alone).
-  double start_window_m = 2.0;
+  double start_window_m = 1.0;
   // Arrival: at the end of a complete route, with at least this probability (Markov), after at
   // least min_follow_frames frames of following (an initial localization at the end is not an
   // arrival).
