@@ -40,21 +40,3 @@ TEST(SubWindows, AShiftedViewMatchesShiftedWindows) {
 
 }  // namespace
 }  // namespace mapless::appearance
-#include <opencv2/imgcodecs.hpp>
-#include <cstdlib>
-namespace mapless::appearance {
-TEST(Probe, Pair) {
-  if (!std::getenv("CUR")) GTEST_SKIP();
-  const cv::Mat cur = cv::imread(std::getenv("CUR"), cv::IMREAD_GRAYSCALE);
-  const cv::Mat ref = cv::imread(std::getenv("REF"), cv::IMREAD_GRAYSCALE);
-  for (int res : {64, 128}) for (int dims : {8}) for (int w : {16}) for (double top : {0.25, 0.1}) {
-    SubWindowOptions o; o.dimensions = dims; o.window_width_px = w * res / 64; o.step_px = res / 64; o.band_top = top; o.band_bottom = 1 - top;
-    AppearanceImageOptions io; io.width = res; io.height = res * 3 / 4;
-    const SubWindowEigenspace r = BuildSubWindowEigenspace(LowResolution(ref, io), o);
-    std::printf("K'%d w%d top %.2f N'%d:", dims, w, top, r.windows());
-    for (const auto& m : MatchSubWindows(r, LowResolution(cur, io), o)) std::printf(" (%d,%d)", m.query, m.stored);
-    std::printf("  aligned:"); for (int q : QueryWindowIndices(r.windows())) std::printf(" %d", q);
-    std::printf("\n");
-  }
-}
-}
