@@ -29,6 +29,8 @@ void MarkovOptions::Validate() const {
                                                   << motion_sigma_fraction << "; must be >= 0");
   MAPLESS_CHECK(observation_floor >= 0.0 && observation_floor < 1.0,
                 "MarkovOptions.observation_floor = " << observation_floor << "; must be in [0, 1)");
+  MAPLESS_CHECK(uniform_mixing >= 0.0 && uniform_mixing < 1.0,
+                "MarkovOptions.uniform_mixing = " << uniform_mixing << "; must be in [0, 1)");
   MAPLESS_CHECK(probability_window >= 0,
                 "MarkovOptions.probability_window = " << probability_window << "; must be >= 0");
   MAPLESS_CHECK(lost_probability >= 0.0 && lost_probability <= 1.0,
@@ -92,6 +94,10 @@ void MarkovLocalizer::Predict(double advance_images) {
     }
   }
   belief_.swap(scratch_);
+  if (options_.uniform_mixing > 0.0) {
+    belief_ = belief_ * (1.0 - options_.uniform_mixing) +
+              Eigen::VectorXd::Constant(n, options_.uniform_mixing / n);
+  }
 }
 
 Localization MarkovLocalizer::Update(const Eigen::MatrixXf& projections,

@@ -23,6 +23,9 @@ struct MarkovOptions {
   double motion_sigma_fraction = 0.3;  // ... plus this fraction of the predicted advance
   // p(z|x) never falls below this, so that a wrong belief can recover from good observations.
   double observation_floor = 0.02;
+  // Each prediction mixes this much of a uniform belief in (the robot may be anywhere: without it
+  // the belief far from its peak underflows to zero and a wrong peak can never be left).
+  double uniform_mixing = 0.0;
   int probability_window = 1;     // probability = belief mass within ± this many images
   // Lost: for lost_after_updates in a row, either the probability is below lost_probability or
   // the observation disagrees with the prediction (the predicted belief puts less than

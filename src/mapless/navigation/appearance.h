@@ -65,6 +65,7 @@ class AppearanceLeader {
 };
 
 struct AppearanceFollowerOptions {
+  AppearanceFollowerOptions();  // sets markov.uniform_mixing = 0.01 (see appearance.cc)
   bool use_markov = true;  // false: nearest projection every frame (Section 3 alone)
   appearance::AppearanceImageOptions image;
   appearance::SubWindowOptions windows;
