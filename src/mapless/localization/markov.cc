@@ -43,6 +43,11 @@ void MarkovOptions::Validate() const {
 
 MarkovLocalizer::MarkovLocalizer(MarkovOptions options) : options_(options) { options_.Validate(); }
 
+void MarkovLocalizer::set_uniform_mixing(double mixing) {
+  options_.uniform_mixing = mixing;
+  options_.Validate();
+}
+
 void MarkovLocalizer::ResetUniform(int route_images) {
   MAPLESS_CHECK(route_images >= 0, "Markov localization: route of " << route_images << " images");
   belief_ = Eigen::VectorXd::Constant(route_images, route_images > 0 ? 1.0 / route_images : 0.0);

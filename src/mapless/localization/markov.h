@@ -64,6 +64,8 @@ class MarkovLocalizer {
                       double advance_images);
 
   const Eigen::VectorXd& belief() const { return belief_; }
+  // Changes MarkovOptions::uniform_mixing from the next prediction on.
+  void set_uniform_mixing(double mixing);
   const MarkovOptions& options() const { return options_; }
 
  private:

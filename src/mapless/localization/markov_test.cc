@@ -100,6 +100,33 @@ TEST(MarkovLocalizer, FollowsARouteThatGrowsWhileItIsUsed) {
   EXPECT_THROW(markov.Update(full.leftCols(5), full.col(0), 0.0), InputError);
 }
 
+// The robot stands at place 60 while for a long time the images look like place 20 (say, an
+// aliased twin seen first); then the images show place 60. Without mixing, the belief far from the
+// peak has underflowed to zero and never comes back; with 1% uniform mixing it moves to place 60.
+TEST(MarkovLocalizer, UniformMixingLetsAWrongBeliefGiveWay) {
+  const int n = 100;
+  Eigen::MatrixXf route(1, n);
+  for (int i = 0; i < n; ++i) route(0, i) = static_cast<float>(i);
+  Eigen::VectorXf twin(1);
+  twin << 20.0F;
+  Eigen::VectorXf truth(1);
+  truth << 60.0F;
+  for (const double mixing : {0.0, 0.01}) {
+    MarkovOptions options;
+    options.uniform_mixing = mixing;
+    MarkovLocalizer markov(options);
+    markov.ResetAt(n, 20.0, 1.0);
+    for (int t = 0; t < 300; ++t) markov.Update(route, twin, 0.0);
+    Localization loc;
+    for (int t = 0; t < 30; ++t) loc = markov.Update(route, truth, 0.0);
+    if (mixing == 0.0) {
+      EXPECT_EQ(loc.index, 20);
+    } else {
+      EXPECT_EQ(loc.index, 60);
+    }
+  }
+}
+
 TEST(MarkovOptions, RejectsBadValuesNamingTheField) {
   MarkovOptions options;
   options.kernels = 0;

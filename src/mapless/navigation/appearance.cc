@@ -120,6 +120,8 @@ void AppearanceFollowerOptions::Validate() const {
   MAPLESS_CHECK(relocalize_after_stopped_frames >= 1,
                 "AppearanceFollowerOptions.relocalize_after_stopped_frames = "
                     << relocalize_after_stopped_frames << "; must be >= 1");
+  MAPLESS_CHECK(uniform_mixing_for_m >= 0.0, "AppearanceFollowerOptions.uniform_mixing_for_m = "
+                                                 << uniform_mixing_for_m << "; must be >= 0");
   MAPLESS_CHECK(markov_update_images >= 0.0, "AppearanceFollowerOptions.markov_update_images = "
                                                  << markov_update_images << "; must be >= 0");
   MAPLESS_CHECK(lookahead_images >= 0, "AppearanceFollowerOptions.lookahead_images = "
@@ -133,9 +135,10 @@ void AppearanceFollowerOptions::Validate() const {
 AppearanceFollowerOptions::AppearanceFollowerOptions() {
   // The follower sees each place many times and its images usually agree with the route, so a
   // wrong belief (an aliased twin of the start) must be able to give way: 1% of the belief is
-  // spread uniformly at each prediction. (Measured: office route, start off to the left,
-  // localization within one image 0.46 -> 0.80-1.0. The same mixing ruins sequence localization
-  // with weak observations: Nordland winter on summer 0.90 -> 0.19, so MarkovOptions keeps 0.)
+  // spread uniformly at each prediction during the first uniform_mixing_for_m after each
+  // localization. (Measured: office route, start off to the left, localization within one image
+  // 0.46 -> ~1.0. The same mixing ruins sequence localization with weak observations: Nordland
+  // winter on summer 0.90 -> 0.19, so MarkovOptions keeps 0.)
   markov.uniform_mixing = 0.01;
 }
 
@@ -203,6 +206,7 @@ FollowerStep AppearanceFollower::Initialize(const appearance::Vector& projection
     return step;
   }
   markov_.ResetAt(route.size(), init.index, options_.init_sigma_images);
+  since_localized_m_ = 0.0;
   have_localization_ = false;
   pending_advance_images_ = 0.0;
   initializing_ = false;
@@ -222,6 +226,7 @@ FollowerStep AppearanceFollower::Update(const cv::Mat& image, const Pose2& odome
   }
   have_odometry_ = true;
   last_odometry_ = odometry;
+  since_localized_m_ += std::abs(advance_m);
 
   FollowerStep step;
   if (arrived_) {
@@ -256,6 +261,9 @@ FollowerStep AppearanceFollower::Update(const cv::Mat& image, const Pose2& odome
     // evidence many times over).
     if (!have_localization_ || std::abs(pending_advance_images_) >= options_.markov_update_images ||
         route.size() != last_route_size_) {
+      markov_.set_uniform_mixing(since_localized_m_ < options_.uniform_mixing_for_m
+                                     ? options_.markov.uniform_mixing
+                                     : 0.0);
       last_localization_ = markov_.Update(route.space.projections, projection, pending_advance_images_);
       pending_advance_images_ = 0.0;
       have_localization_ = true;

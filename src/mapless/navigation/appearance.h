@@ -95,6 +95,9 @@ struct AppearanceFollowerOptions {
   // Stopped this many frames in a row without a steering decision: localize again around the
   // current position (the same small motions as at the start).
   int relocalize_after_stopped_frames = 10;
+  // The Markov belief mixes in markov.uniform_mixing only during the first this many metres after
+  // each (initial) localization, while it may sit on an aliased twin of the true place.
+  double uniform_mixing_for_m = 12.0;
   // Markov localization is updated once per this much travel, in route images (see Update()).
   double markov_update_images = 0.5;
   int lookahead_images = 1;        // steer towards the route image this far ahead of the position
@@ -145,6 +148,7 @@ class AppearanceFollower {
   localization::Localization last_localization_;
   double pending_advance_images_ = 0.0;
   int last_route_size_ = 0;
+  double since_localized_m_ = 0.0;
 };
 
 }  // namespace mapless::navigation
