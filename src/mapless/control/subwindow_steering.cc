@@ -142,6 +142,8 @@ SubWindowSteering ComputeSubWindowSteering(const std::vector<WindowCorrespondenc
   constexpr std::array<std::array<int, 2>, 7> kRanges{
       {{0, 1}, {0, 2}, {0, 3}, {0, 4}, {1, 4}, {2, 4}, {3, 4}}};
   Candidate best;
+  Candidate left_half;   // A-C
+  Candidate right_half;  // C-E
   for (const auto& range : kRanges) {
     std::vector<Point> points;
     for (const WindowCorrespondence& m : matches) {
@@ -162,6 +164,18 @@ SubWindowSteering ComputeSubWindowSteering(const std::vector<WindowCorrespondenc
                              -std::abs(k.line.slope - expected_slope), k.span);
     };
     if (!best.ok || key(c) > key(best)) best = c;
+    if (range[0] == 0 && range[1] == 2) left_half = c;
+    if (range[0] == 2 && range[1] == 4) right_half = c;
+  }
+  // Not in the paper: near objects on one side (a parked car passed closer than during the teach)
+  // look bigger and bend that side's correspondences; the steering, read from all windows, then
+  // turns towards them, which makes them bigger still. When both halves give a fit, the ordinate
+  // is read from the half whose slope is nearer the expected one (the side that does not loom).
+  if (options.prefer_undistorted_half && left_half.ok && right_half.ok) {
+    best = std::abs(left_half.line.slope - expected_slope) <=
+                   std::abs(right_half.line.slope - expected_slope)
+               ? left_half
+               : right_half;
   }
   if (!best.ok) {
     result.reason = "no consistent sub-window fit (" + std::to_string(matches.size()) +

@@ -38,6 +38,21 @@ TEST(SubWindowSteering, TurnsRightWhenTheRouteViewLiesToTheLeft) {
   EXPECT_LT(s.twist.omega_radps, 0.0);
 }
 
+// A parked car passed closer on the right looms: D and E match stored windows further left than
+// aligned. Read from all windows the robot would turn right, towards the car; the better-sloped
+// half (A-C) says go straight.
+TEST(SubWindowSteering, ReadsTheOrdinateFromTheHalfThatDoesNotLoom) {
+  const std::vector<WindowCorrespondence> m = {{0, 0}, {1, 12}, {1, 13}, {2, 24}, {3, 31}, {3, 32}, {4, 38}};
+  SubWindowSteeringOptions halves;
+  halves.prefer_undistorted_half = true;
+  const SubWindowSteering all = ComputeSubWindowSteering(m, kWindows, 1, {});
+  const SubWindowSteering half = ComputeSubWindowSteering(m, kWindows, 1, halves);
+  ASSERT_TRUE(all.ok && half.ok);
+  EXPECT_LT(all.twist.omega_radps, -0.01);
+  EXPECT_EQ(half.fit, "A-C");
+  EXPECT_NEAR(half.shift_windows, 0.0, 0.5);
+}
+
 TEST(SubWindowSteering, StopsWithAReasonWhenNothingIsConsistent) {
   const std::vector<WindowCorrespondence> m = {{0, 40}, {1, 2}, {2, 45}, {3, 1}, {4, 20}};
   const SubWindowSteering s = ComputeSubWindowSteering(m, kWindows, 1, {});
