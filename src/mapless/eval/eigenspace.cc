@@ -107,13 +107,15 @@ void Finalize(const EigenspaceRunOptions& options, const FollowerMetrics& metric
 
 // One follower frame: render, decide, command. Returns true when the follower has arrived.
 bool FollowerFrame(sim::Simulation* sim, int robot, navigation::AppearanceFollower* follower,
-                   const route::AppearanceRoute& route, const std::vector<Pose2>& image_truth,
-                   const EigenspaceRunOptions& options, const EigenspaceObserver& observer,
-                   FollowerMetrics* metrics, EigenspaceRun* run) {
+                   sim::FaultyCamera* camera, const route::AppearanceRoute& route,
+                   const std::vector<Pose2>& image_truth, const EigenspaceRunOptions& options,
+                   const EigenspaceObserver& observer, FollowerMetrics* metrics,
+                   EigenspaceRun* run) {
   const cv::Mat image = sim->Render(robot);
   const Pose2 truth = sim->robot(robot).pose();
   run->follower_path.push_back(truth);
-  const navigation::FollowerStep step = follower->Update(image, sim->robot(robot).odometry(), route);
+  const navigation::FollowerStep step = follower->Update(
+      camera->Apply(image, ToSeconds(sim->now_ns())), sim->robot(robot).odometry(), route);
   metrics->Add(truth, step, image, route, image_truth, run->leader_path, options);
   if (observer) observer(step, truth);
   if (step.state == navigation::FollowerState::kArrived) return true;
@@ -131,6 +133,7 @@ EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario, const Eigenspac
   const double period = 1.0 / scenario.camera.rate_hz;
   navigation::AppearanceLeader leader(options.leader);
   navigation::AppearanceFollower follower(options.follower);
+  sim::FaultyCamera faulty_camera(options.camera_faults, options.seed);
   route::AppearanceRouteChannel channel;
   std::vector<Pose2> image_truth;
   FollowerMetrics metrics;
@@ -156,7 +159,7 @@ EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario, const Eigenspac
     std::string stop;
     bool arrived = false;
     while (true) {
-      arrived = FollowerFrame(&sim, robot, &follower, *route, image_truth, options, observer,
+      arrived = FollowerFrame(&sim, robot, &follower, &faulty_camera, *route, image_truth, options, observer,
                               &metrics, &run);
       if (arrived) break;
       sim.Advance(period);
@@ -198,7 +201,7 @@ EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario, const Eigenspac
       follow = sim.AddRobot(StartPose(scenario, options), FollowerRobot(scenario, options));
     }
     if (follow >= 0) {
-      arrived = FollowerFrame(&sim, follow, &follower, *channel.Latest(), image_truth, options,
+      arrived = FollowerFrame(&sim, follow, &follower, &faulty_camera, *channel.Latest(), image_truth, options,
                               observer, &metrics, &run);
       if (arrived) break;
     }

@@ -11,6 +11,7 @@
 
 #include "mapless/eval/suite.h"
 #include "mapless/navigation/appearance.h"
+#include "mapless/sim/camera_faults.h"
 #include "mapless/sim/scenario.h"
 
 namespace mapless::eval {
@@ -30,6 +31,7 @@ struct EigenspaceRunOptions {
   double converged_lateral_m = 0.15;
   double arrive_tolerance_m = 0.6;     // success: arrived within this distance of the route end
   double timeout_factor = 3.0;         // give up after this many times the nominal duration
+  std::vector<sim::CameraFaultWindow> camera_faults;  // the follower's camera (sim/camera_faults.h)
   navigation::AppearanceLeaderOptions leader;
   navigation::AppearanceFollowerOptions follower;
 };

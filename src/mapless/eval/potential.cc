@@ -109,10 +109,11 @@ PotentialRun RunPotential(const sim::Scenario& scenario,
       options.timeout_factor * length / nav.potential.max_translation_mps + 20.0;
 
   PotentialRun run;
+  sim::FaultyCamera faulty_camera(options.camera_faults, options.seed);
   while (true) {
     const Pose2 pose = sim.robot(r).pose();
     run.path.push_back(pose);
-    const cv::Mat image = sim.Render(r);
+    const cv::Mat image = faulty_camera.Apply(sim.Render(r), ToSeconds(sim.now_ns()));
     const navigation::PotentialStep step = navigator.Update(image, sim.robot(r).odometry());
     if (observer) observer(pose, image, step);
     if (step.status == navigation::PotentialStatus::kSearching && !step.plane_mask.empty())

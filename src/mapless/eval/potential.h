@@ -11,6 +11,7 @@
 
 #include "mapless/eval/suite.h"
 #include "mapless/navigation/potential.h"
+#include "mapless/sim/camera_faults.h"
 #include "mapless/sim/scenario.h"
 
 namespace mapless::eval {
@@ -35,6 +36,7 @@ struct PotentialRunOptions {
   bool homing = false;              // return to the start after the destination
   double timeout_factor = 3.0;      // of the path length at T_m (destination and back for homing)
   double success_radius_m = 0.3;    // final distance to the goal (the issue: 0.3 m)
+  std::vector<sim::CameraFaultWindow> camera_faults;  // hardening tests (sim/camera_faults.h)
   std::uint64_t seed = 1;
   void Validate() const;
 };

@@ -98,10 +98,11 @@ RepeatRun RepeatOnSimulator(const sim::Scenario& scenario, const TaughtRoute& ta
   const double period = 1.0 / scenario.camera.rate_hz;
   const double timeout = options.timeout_factor * std::max(taught.duration_s, 1.0);
   RepeatRun run;
+  sim::FaultyCamera faulty_camera(options.camera_faults, options.seed);
   while (true) {
     const Pose2 pose = sim.robot(r).pose();
     run.path.push_back(pose);
-    const cv::Mat image = sim.Render(r);
+    const cv::Mat image = faulty_camera.Apply(sim.Render(r), ToSeconds(sim.now_ns()));
     const navigation::RepeatStep step = session.Update(image, sim.now_ns());
     if (observer) observer(pose, image, step);
     run.steps.push_back(step);

@@ -9,6 +9,7 @@
 
 #include "mapless/navigation/repeat.h"
 #include "mapless/navigation/teach.h"
+#include "mapless/sim/camera_faults.h"
 #include "mapless/sim/scenario.h"
 #include "mapless/sim/simulation.h"
 
@@ -33,6 +34,7 @@ struct RepeatRunOptions {
   double timeout_factor = 3.0;        // of the taught duration
   double max_repeat_speed_mps = 0.2;  // suites: repeat at the teach speed, at most this
   double success_radius_m = 0.5;      // final pose within this of the taught end
+  std::vector<sim::CameraFaultWindow> camera_faults;  // hardening tests (sim/camera_faults.h)
   std::uint64_t seed = 1;
   void Validate() const;
 };

@@ -95,6 +95,7 @@ void AppearanceFollowerOptions::Validate() const {
   image.Validate();
   windows.Validate();
   steering.Validate();
+  camera.Validate();
   markov.Validate();
   clustering.Validate();
   MAPLESS_CHECK(init_turn_rad >= 0.0 && init_turn_rad < kPi,
@@ -143,7 +144,7 @@ AppearanceFollowerOptions::AppearanceFollowerOptions() {
 }
 
 AppearanceFollower::AppearanceFollower(AppearanceFollowerOptions options)
-    : options_(options), markov_(options.markov) {
+    : options_(options), camera_(options.camera), markov_(options.markov) {
   options_.Validate();
 }
 
@@ -217,6 +218,22 @@ FollowerStep AppearanceFollower::Initialize(const appearance::Vector& projection
 }
 
 FollowerStep AppearanceFollower::Update(const cv::Mat& image, const Pose2& odometry,
+                                        const route::AppearanceRoute& route) {
+  FollowerStep step;
+  const CameraCheck camera = camera_.Check(image, last_command_);
+  if (arrived_) {
+    step.state = FollowerState::kArrived;
+  } else if (!camera.usable()) {
+    step.state = initializing_ ? FollowerState::kInitializing : FollowerState::kStopped;
+    step.reason = camera.reason;
+  } else {
+    step = Decide(image, odometry, route);
+  }
+  last_command_ = step.command;
+  return step;
+}
+
+FollowerStep AppearanceFollower::Decide(const cv::Mat& image, const Pose2& odometry,
                                         const route::AppearanceRoute& route) {
   double advance_m = 0.0;
   if (have_odometry_) {

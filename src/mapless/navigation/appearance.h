@@ -23,6 +23,7 @@
 #include "mapless/core/pose.h"
 #include "mapless/localization/initial.h"
 #include "mapless/localization/markov.h"
+#include "mapless/navigation/camera_check.h"
 #include "mapless/route/appearance_route.h"
 
 namespace mapless::navigation {
@@ -103,6 +104,7 @@ struct AppearanceFollowerOptions {
   int lookahead_images = 1;        // steer towards the route image this far ahead of the position
   int arrive_within_images = 1;    // arrived at the end of a complete route within this many
   int wait_within_images = 2;      // wait for a leader this close to the end it has taught so far
+  CameraCheckOptions camera;       // camera faults: stop until the images are usable again
   void Validate() const;
 };
 
@@ -122,16 +124,22 @@ struct FollowerStep {
 class AppearanceFollower {
  public:
   explicit AppearanceFollower(AppearanceFollowerOptions options = {});
-  // One control period: the current image, the odometry and the latest route snapshot.
+  // One control period: the current image, the odometry and the latest route snapshot. A camera
+  // fault stops the robot (kStopped, or kInitializing while it localizes) with the fault as the
+  // reason; the frame is otherwise ignored, so localization resumes where it was.
   FollowerStep Update(const cv::Mat& image, const Pose2& odometry, const route::AppearanceRoute& route);
 
  private:
+  FollowerStep Decide(const cv::Mat& image, const Pose2& odometry,
+                      const route::AppearanceRoute& route);
   FollowerStep Initialize(const appearance::Vector& projection, const Pose2& odometry,
                           const route::AppearanceRoute& route);
   // centre_index < 0: around the route start (or the whole route when start_window_m is 0).
   void StartInitialization(const Pose2& odometry, int centre_index);
 
   AppearanceFollowerOptions options_;
+  CameraMonitor camera_;
+  Twist2 last_command_;
   localization::MarkovLocalizer markov_;
   bool initializing_ = true;
   int init_centre_ = -1;

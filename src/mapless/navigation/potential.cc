@@ -135,6 +135,7 @@ void PotentialNavOptions::Validate() const {
   flow.Validate();
   plane.Validate();
   potential.Validate();
+  camera.Validate();
   MAPLESS_CHECK(arrive_radius_m > 0.0, "PotentialNavOptions.arrive_radius_m must be > 0");
   MAPLESS_CHECK(approach_radius_m >= 0.0, "PotentialNavOptions.approach_radius_m must be >= 0");
   MAPLESS_CHECK(creep_fraction > 0.0 && creep_fraction <= 1.0,
@@ -174,6 +175,7 @@ const char* PotentialStatusName(PotentialStatus s) {
     case PotentialStatus::kTurningAround: return "turning_around";
     case PotentialStatus::kArrived: return "arrived";
     case PotentialStatus::kAborted: return "aborted";
+    case PotentialStatus::kCameraFault: return "camera_fault";
   }
   return "?";
 }
@@ -185,6 +187,7 @@ PotentialNavigator::PotentialNavigator(PlanarFlowCalibration calibration,
       noise_(options_.noise_seed) {
   calibration_.Validate();
   options_.Validate();
+  camera_ = CameraMonitor(options_.camera);
   const cv::Size size(calibration_.width, calibration_.height);
   translational_flow_ = ground::PlanarFlow(calibration_.translational, size);
   rotational_flow_ = ground::PlanarFlow(calibration_.rotational, size);
@@ -274,6 +277,24 @@ PotentialStep PotentialNavigator::Search(PotentialStep step, const Pose2& odomet
 }
 
 PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odometry) {
+  PotentialStep step;
+  const CameraCheck camera = camera_.Check(image, last_command_);
+  if (finished()) {
+    step.status = status_;
+    step.leg = leg_;
+    step.reason = status_ == PotentialStatus::kArrived ? "destination reached" : "aborted";
+  } else if (!camera.usable()) {
+    step.status = PotentialStatus::kCameraFault;
+    step.leg = leg_;
+    step.reason = camera.reason;
+  } else {
+    step = Decide(image, odometry);
+  }
+  last_command_ = step.command;
+  return step;
+}
+
+PotentialStep PotentialNavigator::Decide(const cv::Mat& image, const Pose2& odometry) {
   MAPLESS_CHECK(image.cols == calibration_.width && image.rows == calibration_.height,
                 "PotentialNavigator: image is " << image.cols << "x" << image.rows
                                                 << ", the calibration is for " << calibration_.width

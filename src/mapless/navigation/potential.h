@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "mapless/control/visual_potential.h"
+#include "mapless/navigation/camera_check.h"
 #include "mapless/core/pose.h"
 #include "mapless/core/rng.h"
 #include "mapless/flow/flow.h"
@@ -128,6 +129,7 @@ struct PotentialNavOptions {
   // and -u_hat of a left turn points left, so the turn feeds itself (on the simulator the robot
   // spins on the spot in the straight corridor).
   bool follow_planar_flow = false;
+  CameraCheckOptions camera;  // camera faults: stop until the images are usable again
   void Validate() const;
 };
 
@@ -138,6 +140,7 @@ enum class PotentialStatus {
   kTurningAround,  // homing: turning 180 degrees at the destination
   kArrived,        // the (last) destination is reached: stopped
   kAborted,        // no ground found after max_search_steps: stopped
+  kCameraFault,    // the frame is unusable (camera_check.h): stopped until images return
 };
 const char* PotentialStatusName(PotentialStatus s);
 
@@ -165,12 +168,15 @@ class PotentialNavigator {
   void SetDestination(const Eigen::Vector2d& destination);
 
   // One control period: the camera image and the robot's odometry pose at the same time.
+  // A camera fault gives kCameraFault with a zero command; the frame is otherwise ignored, so the
+  // next usable frame's flow is measured against the last usable one.
   PotentialStep Update(const cv::Mat& image, const Pose2& odometry);
   bool finished() const {
     return status_ == PotentialStatus::kArrived || status_ == PotentialStatus::kAborted;
   }
 
  private:
+  PotentialStep Decide(const cv::Mat& image, const Pose2& odometry);
   PotentialStep Search(PotentialStep step, const Pose2& odometry, const std::string& why);
   double GroundMismatch(const cv::Mat& model, const Pose2& motion) const;
   // +1 (left) or -1: the side of theta, or the side chosen by a turn within escape_distance_m.
@@ -186,6 +192,8 @@ class PotentialNavigator {
   std::optional<Eigen::Vector2d> start_;
   int leg_ = 0;
   PotentialStatus status_ = PotentialStatus::kLooking;
+  CameraMonitor camera_;
+  Twist2 last_command_;
   cv::Mat previous_;
   Pose2 previous_odometry_;
   double turn_target_rad_ = 0.0;  // searching / turning around: heading to reach

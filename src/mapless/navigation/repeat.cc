@@ -52,6 +52,7 @@ void RepeatOptions::Validate() const {
   features.Validate();
   matching.Validate();
   klt.Validate();
+  camera.Validate();
   sloped.Validate();
   standard.Validate();
   switch_rule.Validate();
@@ -81,6 +82,7 @@ RepeatSession::RepeatSession(std::shared_ptr<const route::Route> route, RepeatOp
     : route_(std::move(route)),
       options_(options),
       extractor_((options.Validate(), options.features)),
+      camera_(options.camera),
       mse_(options.mse_rising_frames) {
   MAPLESS_CHECK(route_ != nullptr, "RepeatSession: no route");
   MAPLESS_CHECK(route_->keyframes.size() >= 2, "RepeatSession: the route has "
@@ -170,7 +172,20 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
   step.destination = destination_;
   if (finished())
     return Stop(step, status_, status_ == RepeatStatus::kCompleted ? "route completed" : "aborted");
-  MAPLESS_CHECK(!image.empty(), "RepeatSession: empty frame");
+  const CameraCheck camera = camera_.Check(image, last_command_);
+  if (!camera.usable()) {
+    step.matches = last_matches_;
+    step = Stop(step, RepeatStatus::kWaiting, camera.reason);
+  } else {
+    step = Decide(image, t_ns);
+  }
+  last_command_ = step.command;
+  return step;
+}
+
+RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
+  RepeatStep step;
+  step.destination = destination_;
   cv::Mat grey = image;
   if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
   MAPLESS_CHECK(grey.cols == route_->image_width && grey.rows == route_->image_height,

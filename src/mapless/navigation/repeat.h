@@ -21,6 +21,7 @@
 #include "mapless/control/funnel_lane.h"
 #include "mapless/features/features.h"
 #include "mapless/features/klt.h"
+#include "mapless/navigation/camera_check.h"
 #include "mapless/route/route.h"
 
 namespace mapless::navigation {
@@ -60,6 +61,7 @@ struct RepeatOptions {
   // guided_release_s for features, so a wrong prediction cannot hold the robot forever.
   double guided_window_px = 40.0;
   double guided_release_s = 1.0;
+  CameraCheckOptions camera;  // camera faults: the robot waits, the session carries on after
   void Validate() const;
 };
 
@@ -85,6 +87,8 @@ class RepeatSession {
  public:
   RepeatSession(std::shared_ptr<const route::Route> route, RepeatOptions options);
 
+  // One control period. A camera fault (see camera_check.h) gives kWaiting with the fault as the
+  // reason and a zero command; it does not count towards abort_after_s.
   RepeatStep Update(const cv::Mat& image, Timestamp t_ns);
   bool finished() const {
     return status_ == RepeatStatus::kCompleted || status_ == RepeatStatus::kAborted;
@@ -92,6 +96,7 @@ class RepeatSession {
   int destination() const { return destination_; }
 
  private:
+  RepeatStep Decide(const cv::Mat& image, Timestamp t_ns);
   void DetectAndMatch(const cv::Mat& grey, RepeatStep* step);
   std::vector<control::FeaturePair> Pairs() const;
   RepeatStep Stop(RepeatStep step, RepeatStatus status, const std::string& reason);
@@ -99,6 +104,8 @@ class RepeatSession {
   std::shared_ptr<const route::Route> route_;
   RepeatOptions options_;
   features::FeatureExtractor extractor_;
+  CameraMonitor camera_;
+  Twist2 last_command_;
   std::vector<features::Features> keyframe_features_;
   control::MseSwitch mse_;
   double cx_ = 0.0;
