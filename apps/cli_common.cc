@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "mapless/core/check.h"
-#include "mapless/io/yaml_reader.h"
+#include "mapless/io/atomic_file.h"
 
 namespace mapless::app {
 
@@ -49,43 +49,8 @@ void JsonLines::Write(const nlohmann::json& j) {
 }
 
 sim::DriveOptions LoadDriveOptions(const std::string& config_path) {
-  sim::DriveOptions options;
-  if (config_path.empty()) return options;
-  const io::YamlMap root = io::YamlMap::LoadFile(config_path);
-  root.CheckKnownKeys({"render", "simulation", "drive"});
-  if (root.Has("render")) {
-    const io::YamlMap r = root.GetMap("render");
-    r.CheckKnownKeys({"edge_supersample", "near_m", "far_m", "anisotropy"});
-    auto& o = options.sim.render;
-    o.edge_supersample = r.GetInt("edge_supersample", o.edge_supersample);
-    o.near_m = r.GetDouble("near_m", o.near_m);
-    o.far_m = r.GetDouble("far_m", o.far_m);
-    o.anisotropy = r.GetDouble("anisotropy", o.anisotropy);
-    try {
-      o.Validate();
-    } catch (const InputError& e) {
-      r.Fail("", e.what());
-    }
-  }
-  if (root.Has("simulation")) {
-    const io::YamlMap s = root.GetMap("simulation");
-    s.CheckKnownKeys({"physics_dt_s", "robot_body_height_m"});
-    options.sim.physics_dt_s = s.GetDouble("physics_dt_s", options.sim.physics_dt_s);
-    options.sim.robot_body_height_m =
-        s.GetDouble("robot_body_height_m", options.sim.robot_body_height_m);
-  }
-  if (root.Has("drive")) {
-    const io::YamlMap d = root.GetMap("drive");
-    d.CheckKnownKeys({"timeout_factor", "stop_on_collision"});
-    options.timeout_factor = d.GetDouble("timeout_factor", options.timeout_factor);
-    options.stop_on_collision = d.GetBool("stop_on_collision", options.stop_on_collision);
-  }
-  try {
-    options.Validate();
-  } catch (const InputError& e) {
-    throw InputError(config_path + ": " + e.what());
-  }
-  return options;
+  if (config_path.empty()) return sim::DriveOptions{};
+  return sim::ParseDriveOptions(io::ReadFile(config_path), config_path);
 }
 
 cv::Mat ReadImageOrThrow(const std::string& path, int flags) {

@@ -59,6 +59,7 @@ void AddDemoCommand(CLI::App* app);
 void AddBenchCommand(CLI::App* app);
 void AddShiftCommand(CLI::App* app);
 void AddEvalCommand(CLI::App* app);
+void AddSoakCommand(CLI::App* app);
 void AddTeachRepeatCommands(CLI::App* app);
 void AddFlowCommand(CLI::App* app);
 void AddGroundCommand(CLI::App* app);

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   mapless::app::AddNavigateCommand(&app);
   mapless::app::AddLocalizeCommand(&app);
   mapless::app::AddEvalCommand(&app);
+  mapless::app::AddSoakCommand(&app);
   mapless::app::AddBenchCommand(&app);
   try {
     app.parse(argc, argv);

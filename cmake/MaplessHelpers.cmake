@@ -24,16 +24,22 @@ function(mapless_library)
   mapless_target_warnings(${target})
 endfunction()
 
-# mapless_test(NAME name SRCS ... DEPS ...): one GoogleTest binary, tests discovered by ctest.
+# mapless_test(NAME name SRCS ... DEPS ... [SANITIZE_ENV VAR=VALUE ...]): one GoogleTest binary,
+# tests discovered by ctest. SANITIZE_ENV: extra environment for its tests in the sanitizer build.
 function(mapless_test)
   if(NOT MAPLESS_BUILD_TESTS)
     return()
   endif()
-  cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS;SANITIZE_ENV" ${ARGN})
   add_executable(${ARG_NAME} ${ARG_SRCS})
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
   target_compile_definitions(${ARG_NAME} PRIVATE
     MAPLESS_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   mapless_target_warnings(${ARG_NAME})
-  gtest_discover_tests(${ARG_NAME} WORKING_DIRECTORY ${PROJECT_BINARY_DIR} DISCOVERY_TIMEOUT 60)
+  if(MAPLESS_SANITIZE AND ARG_SANITIZE_ENV)
+    gtest_discover_tests(${ARG_NAME} WORKING_DIRECTORY ${PROJECT_BINARY_DIR} DISCOVERY_TIMEOUT 60
+                         PROPERTIES ENVIRONMENT "${ARG_SANITIZE_ENV}")
+  else()
+    gtest_discover_tests(${ARG_NAME} WORKING_DIRECTORY ${PROJECT_BINARY_DIR} DISCOVERY_TIMEOUT 60)
+  endif()
 endfunction()

@@ -20,8 +20,9 @@ bool EndsWith(const std::string& s, std::string_view suffix) {
 
 }  // namespace
 
-cv::Mat ReadFlo(const std::string& path) {
-  const std::string bytes = ReadFile(path);
+cv::Mat ReadFlo(const std::string& path) { return ParseFlo(ReadFile(path), path); }
+
+cv::Mat ParseFlo(const std::string& bytes, const std::string& path) {
   if (bytes.size() < 12) throw InputError(path + ": not a .flo file (shorter than its header)");
   float magic = 0.f;
   std::int32_t width = 0;

@@ -11,6 +11,8 @@ namespace mapless::io {
 // Reads a CV_32FC2 field; throws InputError naming the file when it is missing, truncated or not a
 // .flo file.
 cv::Mat ReadFlo(const std::string& path);
+// The same on the file's bytes (`name` stands for the file in errors; fuzz/fuzz_flo.cc).
+cv::Mat ParseFlo(const std::string& bytes, const std::string& name);
 // Writes a CV_32FC2 field atomically.
 void WriteFlo(const std::string& path, const cv::Mat& flow);
 

@@ -171,10 +171,37 @@ std::vector<YamlMap> YamlMap::GetMapList(const std::string& key) const {
   return out;
 }
 
-void YamlMap::CheckKnownKeys(std::initializer_list<const char*> known) const {
+std::vector<double> YamlMap::AsDoubles(int n) const {
+  const std::string expected = "expected a list of " + std::to_string(n) + " numbers";
+  if (!node_.IsSequence() || static_cast<int>(node_.size()) != n) {
+    Fail("", expected + ", got " + ShortValue(node_));
+  }
+  std::vector<double> out;
+  for (const auto& item : node_) {
+    double value = 0.0;
+    if (!item.IsScalar() || !YAML::convert<double>::decode(item, value) || !std::isfinite(value)) {
+      Fail("", expected + ", got element " + ShortValue(item));
+    }
+    out.push_back(value);
+  }
+  return out;
+}
+
+std::vector<std::string> YamlMap::Keys() const {
   if (!node_.IsMap()) Fail("", "expected a mapping, got " + ShortValue(node_));
+  std::vector<std::string> keys;
   for (const auto& kv : node_) {
-    const std::string key = kv.first.as<std::string>();
+    if (!kv.first.IsScalar()) {
+      throw InputError(Where(kv.first) + ": " + (path_.empty() ? "" : path_ + ": ") +
+                       "expected a plain key, got " + ShortValue(kv.first));
+    }
+    keys.push_back(kv.first.Scalar());
+  }
+  return keys;
+}
+
+void YamlMap::CheckKnownKeys(std::initializer_list<const char*> known) const {
+  for (const std::string& key : Keys()) {
     const bool ok =
         std::any_of(known.begin(), known.end(), [&](const char* k) { return key == k; });
     if (!ok) {

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "mapless/core/check.h"
+
 namespace mapless::io {
 
 class YamlMap {
@@ -45,6 +47,11 @@ class YamlMap {
   // Elements of a list, any node type (for mixed lists such as waypoints).
   std::vector<YamlMap> GetList(const std::string& key) const;
 
+  // This node itself as a list of exactly `n` finite numbers (for list elements such as [x, y]).
+  std::vector<double> AsDoubles(int n) const;
+  // The keys of this mapping (a key that is not a plain scalar is an error).
+  std::vector<std::string> Keys() const;
+
   // Throws on any key not in `known`.
   void CheckKnownKeys(std::initializer_list<const char*> known) const;
 
@@ -61,5 +68,17 @@ class YamlMap {
   std::string file_;
   std::string path_;
 };
+
+// Runs `parse`, turning any yaml-cpp exception that escapes the checked getters into an InputError
+// "NAME:LINE:COL: message" (defence in depth: bad input must never surface as another exception).
+template <typename F>
+auto WithYamlErrors(const std::string& name, F&& parse) -> decltype(parse()) {
+  try {
+    return parse();
+  } catch (const YAML::Exception& e) {
+    throw InputError(name + ":" + std::to_string(e.mark.line + 1) + ":" +
+                     std::to_string(e.mark.column + 1) + ": " + e.msg);
+  }
+}
 
 }  // namespace mapless::io

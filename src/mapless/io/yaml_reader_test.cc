@@ -47,6 +47,32 @@ TEST(YamlMap, MissingRequiredFieldIsNamed) {
   EXPECT_NE(err.find("missing required field 'b'"), std::string::npos) << err;
 }
 
+TEST(YamlMap, AKeyThatIsNotAPlainScalarIsAnErrorNotACrash) {
+  // Found by fuzz/fuzz_config: "? [a]: 1" made yaml-cpp throw its own exception type.
+  const YamlMap m = YamlMap::LoadString("render:\n  ? [a, b]\n  : 1\n", "c.yaml");
+  const std::string err =
+      testing::InputErrorOf([&] { m.GetMap("render").CheckKnownKeys({"near_m"}); });
+  EXPECT_NE(err.find("c.yaml:2:"), std::string::npos) << err;
+  EXPECT_NE(err.find("render: expected a plain key"), std::string::npos) << err;
+}
+
+TEST(YamlMap, AsDoublesChecksEachElement) {
+  const YamlMap m = YamlMap::LoadString("p: [[1, 2], [3, x]]\n", "p.yaml");
+  const std::vector<YamlMap> list = m.GetList("p");
+  EXPECT_EQ(list[0].AsDoubles(2), (std::vector<double>{1.0, 2.0}));
+  EXPECT_NE(testing::InputErrorOf([&] { list[1].AsDoubles(2); }).find("p.yaml:1:"),
+            std::string::npos);
+  EXPECT_NE(testing::InputErrorOf([&] { list[0].AsDoubles(3); }).find("list of 3 numbers"),
+            std::string::npos);
+}
+
+TEST(YamlMap, WithYamlErrorsTurnsYamlCppExceptionsIntoInputErrors) {
+  const std::string err = testing::InputErrorOf([] {
+    WithYamlErrors("x.yaml", [] { return YAML::Load("a: [1]")["a"].as<int>(); });
+  });
+  EXPECT_NE(err.find("x.yaml:1:"), std::string::npos) << err;
+}
+
 TEST(YamlMap, MissingFileIsNamed) {
   const std::string err = testing::InputErrorOf([] { YamlMap::LoadFile("/nonexistent/x.yaml"); });
   EXPECT_NE(err.find("/nonexistent/x.yaml: cannot open file"), std::string::npos) << err;

@@ -85,7 +85,8 @@ std::string CalibrationToYaml(const PlanarFlowCalibration& c) {
   return out.str();
 }
 
-PlanarFlowCalibration CalibrationFromYaml(const std::string& text, const std::string& source) {
+static PlanarFlowCalibration CalibrationFromYamlUnchecked(const std::string& text,
+                                                          const std::string& source) {
   const io::YamlMap y = io::YamlMap::LoadString(text, source);
   y.CheckKnownKeys({"format", "version", "width", "height", "period_s", "speed_mps",
                     "omega_radps", "translational", "rotational"});
@@ -112,6 +113,10 @@ PlanarFlowCalibration CalibrationFromYaml(const std::string& text, const std::st
     throw InputError(source + ": " + e.what());
   }
   return c;
+}
+
+PlanarFlowCalibration CalibrationFromYaml(const std::string& text, const std::string& source) {
+  return io::WithYamlErrors(source, [&] { return CalibrationFromYamlUnchecked(text, source); });
 }
 
 ground::DominantPlaneOptions DefaultPlaneOptions() {

@@ -1,13 +1,17 @@
 #include "mapless/route/route_store.h"
 
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <filesystem>
+#include <string_view>
 #include <nlohmann/json.hpp>
 #include <opencv2/core/persistence.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "mapless/core/check.h"
 #include "mapless/io/atomic_file.h"
+#include "mapless/io/yaml_reader.h"
 
 namespace mapless::route {
 namespace {
@@ -34,44 +38,37 @@ std::string SerializeKeyframe(const Keyframe& kf) {
   return fs.releaseAndGetString();
 }
 
-Keyframe ReadKeyframe(const std::string& path, const std::string& thumbnail_path) {
-  if (!std::filesystem::exists(path)) throw InputError(path + ": keyframe file is missing");
-  Keyframe kf;
-  try {
-    cv::FileStorage fs(path, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);
-    if (!fs.isOpened()) throw InputError(path + ": cannot read keyframe file");
-    if (static_cast<std::string>(fs["format"]) != "mapless-keyframe") {
-      throw InputError(path + ": not a mapless keyframe file");
-    }
-    if (static_cast<int>(fs["end"]) != 1) throw InputError(path + ": truncated keyframe file");
-    kf.index = static_cast<int>(fs["index"]);
-    kf.t_ns = std::stoll(static_cast<std::string>(fs["t_ns"]));
-    fs["keypoints"] >> kf.keypoints;
-    fs["descriptors"] >> kf.descriptors;
-    fs["segment_start_px"] >> kf.segment_start_px;
-    fs["segment_end_px"] >> kf.segment_end_px;
-  } catch (const cv::Exception& e) {
-    throw InputError(path + ": corrupt keyframe file (" + e.err + ")");
-  } catch (const std::invalid_argument&) {
-    throw InputError(path + ": corrupt keyframe file (t_ns)");
-  } catch (const std::out_of_range&) {
-    throw InputError(path + ": corrupt keyframe file (t_ns)");
+// A path inside the route directory: relative, without "..".
+bool InsideRoute(const std::string& relative) {
+  if (relative.empty()) return false;
+  const std::filesystem::path p(relative);
+  if (p.is_absolute() || p.has_root_name() || p.has_root_directory()) return false;
+  for (const auto& part : p) {
+    if (part == "..") return false;
   }
-  if (static_cast<std::size_t>(kf.descriptors.rows) != kf.keypoints.size()) {
-    throw InputError(path + ": corrupt keyframe file (" + std::to_string(kf.keypoints.size()) +
-                     " keypoints but " + std::to_string(kf.descriptors.rows) + " descriptors)");
+  return true;
+}
+
+// An integer field of the manifest, checked before conversion (a float or an out-of-range number
+// must not reach get<int>(), whose conversion would be undefined).
+int ManifestInt(const nlohmann::json& j, const char* key, const std::string& name) {
+  const nlohmann::json& v = j.at(key);
+  if (!v.is_number_integer() || v.get<long long>() < -(1LL << 31) ||
+      v.get<long long>() > (1LL << 31) - 1 ||
+      (v.is_number_unsigned() && v.get<unsigned long long>() > (1ULL << 31))) {
+    throw InputError(name + ": corrupt manifest (" + key + " is not an integer)");
   }
-  if (kf.segment_start_px.size() != kf.segment_end_px.size()) {
-    throw InputError(path + ": corrupt keyframe file (segment tracks of different lengths)");
-  }
-  try {
-    kf.thumbnail = cv::imread(thumbnail_path, cv::IMREAD_GRAYSCALE);
-  } catch (const cv::Exception&) {
-    kf.thumbnail.release();
-  }
-  if (kf.thumbnail.empty())
-    throw InputError(thumbnail_path + ": missing or corrupt keyframe image");
-  return kf;
+  return static_cast<int>(v.get<long long>());
+}
+
+// Conversions that would be undefined for out-of-range values are checked first.
+bool FitsFloat(double v) {
+  return std::isfinite(v) && std::abs(v) <= static_cast<double>(std::numeric_limits<float>::max());
+}
+bool IsInt(double v) {
+  return std::isfinite(v) && v == std::floor(v) &&
+         v >= static_cast<double>(std::numeric_limits<int>::min()) &&
+         v <= static_cast<double>(std::numeric_limits<int>::max());
 }
 
 }  // namespace
@@ -131,50 +128,161 @@ void RouteWriter::WriteManifest() const {
   io::WriteFileAtomic((std::filesystem::path(dir_) / "manifest.json").string(), j.dump(1) + "\n");
 }
 
+Keyframe ParseKeyframe(const std::string& text, const std::string& name) {
+  // Written by OpenCV's FileStorage, read with yaml-cpp: OpenCV 4.6's own YAML reader hangs on
+  // some corrupt files (found by fuzz/fuzz_route_keyframe), yaml-cpp refuses them. OpenCV starts
+  // the file with the non-standard directive "%YAML:1.0", which is dropped first.
+  std::string yaml = text;
+  constexpr std::string_view kOpenCvHeader = "%YAML:1.0\n";
+  if (yaml.compare(0, kOpenCvHeader.size(), kOpenCvHeader) == 0) yaml.erase(0, kOpenCvHeader.size());
+  return io::WithYamlErrors(name, [&] {
+    const io::YamlMap root = io::YamlMap::LoadString(yaml, name);
+    if (root.GetString("format", "") != "mapless-keyframe") {
+      throw InputError(name + ": not a mapless keyframe file");
+    }
+    if (!root.Has("end") || root.GetInt("end") != 1) {
+      throw InputError(name + ": truncated keyframe file");
+    }
+    Keyframe kf;
+    kf.index = root.GetInt("index");
+    if (kf.index < 0) root.Fail("index", "must be >= 0");
+    try {
+      kf.t_ns = std::stoll(root.GetString("t_ns"));
+    } catch (const std::logic_error&) {  // invalid_argument, out_of_range
+      root.Fail("t_ns", "expected a whole number of nanoseconds");
+    }
+    if (root.Has("keypoints")) {
+      for (const io::YamlMap& k : root.GetList("keypoints")) {
+        const std::vector<double> v = k.AsDoubles(7);  // x, y, size, angle, response, octave, id
+        for (int i = 0; i < 5; ++i) {
+          if (!FitsFloat(v[static_cast<std::size_t>(i)])) k.Fail("", "a value is out of range");
+        }
+        if (!IsInt(v[5]) || !IsInt(v[6])) k.Fail("", "octave and class id must be integers");
+        kf.keypoints.emplace_back(static_cast<float>(v[0]), static_cast<float>(v[1]),
+                                  static_cast<float>(v[2]), static_cast<float>(v[3]),
+                                  static_cast<float>(v[4]), static_cast<int>(v[5]),
+                                  static_cast<int>(v[6]));
+      }
+    }
+    if (root.Has("descriptors")) {
+      const io::YamlMap d = root.GetMap("descriptors");
+      const int rows = d.GetInt("rows");
+      const int cols = d.GetInt("cols");
+      const std::string dt = d.GetString("dt");
+      if (dt != "u" && dt != "f") d.Fail("dt", "expected u (ORB) or f (float descriptors)");
+      if (rows < 0 || cols < 0 || rows > 100'000 || cols > 4096) {  // rows * cols fits an int
+        d.Fail("", "implausible size " + std::to_string(rows) + "x" + std::to_string(cols));
+      }
+      const std::vector<double> data = d.GetDoubles("data", rows * cols);
+      if (rows * cols > 0) {
+        kf.descriptors.create(rows, cols, dt == "u" ? CV_8UC1 : CV_32FC1);
+        for (int i = 0; i < rows * cols; ++i) {
+          const double value = data[static_cast<std::size_t>(i)];
+          if (dt == "u") {
+            if (value < 0.0 || value > 255.0) d.Fail("data", "a value is not a byte");
+            kf.descriptors.at<std::uint8_t>(i / cols, i % cols) = static_cast<std::uint8_t>(value);
+          } else {
+            if (!FitsFloat(value)) d.Fail("data", "a value is out of range");
+            kf.descriptors.at<float>(i / cols, i % cols) = static_cast<float>(value);
+          }
+        }
+      }
+    }
+    const auto points = [&](const char* key) {
+      std::vector<cv::Point2f> out;
+      if (!root.Has(key)) return out;
+      const std::vector<double> v = root.GetDoubles(key, -1);
+      if (v.size() % 2 != 0) root.Fail(key, "expected x, y pairs");
+      for (std::size_t i = 0; i + 1 < v.size(); i += 2) {
+        if (!FitsFloat(v[i]) || !FitsFloat(v[i + 1])) root.Fail(key, "a value is out of range");
+        out.emplace_back(static_cast<float>(v[i]), static_cast<float>(v[i + 1]));
+      }
+      return out;
+    };
+    kf.segment_start_px = points("segment_start_px");
+    kf.segment_end_px = points("segment_end_px");
+    if (static_cast<std::size_t>(kf.descriptors.rows) != kf.keypoints.size()) {
+      throw InputError(name + ": corrupt keyframe file (" + std::to_string(kf.keypoints.size()) +
+                       " keypoints but " + std::to_string(kf.descriptors.rows) + " descriptors)");
+    }
+    if (kf.segment_start_px.size() != kf.segment_end_px.size()) {
+      throw InputError(name + ": corrupt keyframe file (segment tracks of different lengths)");
+    }
+    return kf;
+  });
+}
+
+Manifest ParseManifest(const std::string& text, const std::string& name) {
+  Manifest m;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(text);
+    if (!j.is_object()) throw InputError(name + ": corrupt manifest (not a JSON object)");
+    if (j.at("format").get<std::string>() != "mapless-route") {
+      throw InputError(name + ": not a mapless route manifest");
+    }
+    const int version = ManifestInt(j, "version", name);
+    if (version != kRouteFormatVersion) {
+      throw InputError(name + ": route format version " + std::to_string(version) +
+                       " is not supported (this mapless reads version " +
+                       std::to_string(kRouteFormatVersion) + ")");
+    }
+    m.detector = j.at("detector").get<std::string>();
+    m.image_width = ManifestInt(j, "image_width", name);
+    m.image_height = ManifestInt(j, "image_height", name);
+    m.complete = j.at("complete").get<bool>();
+    for (const auto& entry : j.at("keyframes")) {
+      ManifestEntry e;
+      e.index = ManifestInt(entry, "index", name);
+      e.data = entry.at("data").get<std::string>();
+      e.thumbnail = entry.at("thumbnail").get<std::string>();
+      if (e.index != static_cast<int>(m.keyframes.size())) {
+        throw InputError(name + ": keyframe " + std::to_string(m.keyframes.size()) +
+                         " has index " + std::to_string(e.index));
+      }
+      if (!InsideRoute(e.data) || !InsideRoute(e.thumbnail)) {
+        throw InputError(name + ": keyframe " + std::to_string(e.index) +
+                         " names a file outside the route directory");
+      }
+      m.keyframes.push_back(std::move(e));
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(name + ": corrupt manifest (" + std::string(e.what()) + ")");
+  }
+  if (m.image_width <= 0 || m.image_height <= 0 || m.image_width > 1 << 15 ||
+      m.image_height > 1 << 15) {
+    throw InputError(name + ": corrupt manifest (image size " + std::to_string(m.image_width) +
+                     "x" + std::to_string(m.image_height) + ")");
+  }
+  return m;
+}
+
 Route LoadRoute(const std::string& dir) {
   const std::string manifest_path = (std::filesystem::path(dir) / "manifest.json").string();
   if (!std::filesystem::exists(manifest_path)) {
     throw InputError(manifest_path + ": no route here (manifest.json is missing)");
   }
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(io::ReadFile(manifest_path));
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(manifest_path + ": corrupt manifest (" + std::string(e.what()) + ")");
-  }
+  const Manifest manifest = ParseManifest(io::ReadFile(manifest_path), manifest_path);
   Route route;
-  try {
-    if (j.at("format").get<std::string>() != "mapless-route") {
-      throw InputError(manifest_path + ": not a mapless route manifest");
+  route.detector = manifest.detector;
+  route.image_width = manifest.image_width;
+  route.image_height = manifest.image_height;
+  route.complete = manifest.complete;
+  for (const ManifestEntry& entry : manifest.keyframes) {
+    const std::string data = (std::filesystem::path(dir) / entry.data).string();
+    const std::string thumb = (std::filesystem::path(dir) / entry.thumbnail).string();
+    if (!std::filesystem::exists(data)) throw InputError(data + ": keyframe file is missing");
+    Keyframe kf = ParseKeyframe(io::ReadFile(data), data);
+    if (kf.index != entry.index) {
+      throw InputError(data + ": keyframe index " + std::to_string(kf.index) +
+                       " does not match the manifest");
     }
-    const int version = j.at("version").get<int>();
-    if (version != kRouteFormatVersion) {
-      throw InputError(manifest_path + ": route format version " + std::to_string(version) +
-                       " is not supported (this mapless reads version " +
-                       std::to_string(kRouteFormatVersion) + ")");
+    try {
+      kf.thumbnail = cv::imread(thumb, cv::IMREAD_GRAYSCALE);
+    } catch (const cv::Exception&) {
+      kf.thumbnail.release();
     }
-    route.detector = j.at("detector").get<std::string>();
-    route.image_width = j.at("image_width").get<int>();
-    route.image_height = j.at("image_height").get<int>();
-    route.complete = j.at("complete").get<bool>();
-    for (const auto& entry : j.at("keyframes")) {
-      const std::string data =
-          (std::filesystem::path(dir) / entry.at("data").get<std::string>()).string();
-      const std::string thumb =
-          (std::filesystem::path(dir) / entry.at("thumbnail").get<std::string>()).string();
-      Keyframe kf = ReadKeyframe(data, thumb);
-      if (kf.index != entry.at("index").get<int>() ||
-          kf.index != static_cast<int>(route.keyframes.size())) {
-        throw InputError(data + ": keyframe index " + std::to_string(kf.index) +
-                         " does not match the manifest");
-      }
-      route.keyframes.push_back(std::move(kf));
-    }
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(manifest_path + ": corrupt manifest (" + std::string(e.what()) + ")");
-  }
-  if (route.image_width <= 0 || route.image_height <= 0) {
-    throw InputError(manifest_path + ": corrupt manifest (image size)");
+    if (kf.thumbnail.empty()) throw InputError(thumb + ": missing or corrupt keyframe image");
+    route.keyframes.push_back(std::move(kf));
   }
   return route;
 }

@@ -51,4 +51,22 @@ class RouteWriter {
 // corrupt, wrong version, inconsistent).
 Route LoadRoute(const std::string& dir);
 
+// The parsers behind LoadRoute, on bytes already read (`name` stands for the file in errors).
+// Fuzzed by fuzz/fuzz_route_manifest.cc and fuzz/fuzz_route_keyframe.cc.
+struct ManifestEntry {
+  int index = 0;
+  std::string data;       // relative to the route directory; never absolute, never ".."
+  std::string thumbnail;  // likewise
+};
+struct Manifest {
+  std::string detector;
+  int image_width = 0;
+  int image_height = 0;
+  bool complete = false;
+  std::vector<ManifestEntry> keyframes;
+};
+Manifest ParseManifest(const std::string& text, const std::string& name);
+// A keyframe's data file (everything but its image).
+Keyframe ParseKeyframe(const std::string& text, const std::string& name);
+
 }  // namespace mapless::route

@@ -120,6 +120,18 @@ TEST(RouteStore, CorruptOrMissingFilesGiveOneClearError) {
       std::string::npos);
 }
 
+TEST(RouteStore, AManifestCannotPointOutsideTheRoute) {
+  const std::string manifest =
+      R"({"format": "mapless-route", "version": 1, "detector": "orb", "image_width": 320,
+          "image_height": 240, "complete": true, "keyframes": [{"index": 0, "t_s": 0.0,
+          "data": "../../secret.yml", "thumbnail": "keyframes/000000.png"}]})";
+  EXPECT_NE(testing::InputErrorOf([&] { ParseManifest(manifest, "m.json"); })
+                .find("m.json: keyframe 0 names a file outside the route directory"),
+            std::string::npos);
+  EXPECT_NE(testing::InputErrorOf([&] { ParseManifest("[1, 2]", "m.json"); }).find("m.json"),
+            std::string::npos);
+}
+
 TEST(RouteStore, NewerFormatVersionIsRefusedByName) {
   const std::string dir = FreshDir("version");
   { RouteWriter writer(dir, "orb", 320, 240); }

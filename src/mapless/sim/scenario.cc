@@ -84,8 +84,8 @@ void ParseObject(const YamlMap& m, std::uint64_t seed, const std::string& base_d
       const auto list = m.GetList("points");
       if (list.size() < 2) m.Fail("points", "a wall needs at least 2 points");
       for (const auto& p : list) {
-        if (!p.node().IsSequence() || p.node().size() != 2) p.Fail("", "expected [x, y]");
-        pts.emplace_back(p.node()[0].as<double>(), p.node()[1].as<double>());
+        const std::vector<double> xy = p.AsDoubles(2);
+        pts.emplace_back(xy[0], xy[1]);
       }
     } else {
       const Eigen::Vector2d lo = Vec2(m, "min");
@@ -306,8 +306,8 @@ double Scenario::PathLength() const {
   return length;
 }
 
-Scenario ParseScenario(const std::string& yaml_text, const std::string& source,
-                       const std::string& base_dir) {
+static Scenario ParseScenarioUnchecked(const std::string& yaml_text, const std::string& source,
+                                       const std::string& base_dir) {
   const YamlMap root = YamlMap::LoadString(yaml_text, source);
   root.CheckKnownKeys({"name", "description", "paper", "seed", "world", "camera", "robot", "teach",
                        "repeat", "destinations"});
@@ -344,10 +344,7 @@ Scenario ParseScenario(const std::string& yaml_text, const std::string& source,
       if (v.Has("remove")) s.repeat_variant.remove = v.GetStrings("remove");
       if (v.Has("move")) {
         const YamlMap mv = v.GetMap("move");
-        for (const auto& kv : mv.node()) {
-          const std::string tag = kv.first.as<std::string>();
-          s.repeat_variant.move_m[tag] = Vec2(mv, tag);
-        }
+        for (const std::string& tag : mv.Keys()) s.repeat_variant.move_m[tag] = Vec2(mv, tag);
       }
       try {
         ApplyVariant(s.world, s.repeat_variant);
@@ -358,8 +355,8 @@ Scenario ParseScenario(const std::string& yaml_text, const std::string& source,
   }
   if (root.Has("destinations")) {
     for (const YamlMap& d : root.GetList("destinations")) {
-      if (!d.node().IsSequence() || d.node().size() != 2) d.Fail("", "expected [x, y]");
-      s.destinations.emplace_back(d.node()[0].as<double>(), d.node()[1].as<double>());
+      const std::vector<double> xy = d.AsDoubles(2);
+      s.destinations.emplace_back(xy[0], xy[1]);
     }
   }
   try {
@@ -368,6 +365,11 @@ Scenario ParseScenario(const std::string& yaml_text, const std::string& source,
     throw InputError(source + ": " + e.what());
   }
   return s;
+}
+
+Scenario ParseScenario(const std::string& yaml_text, const std::string& source,
+                       const std::string& base_dir) {
+  return io::WithYamlErrors(source, [&] { return ParseScenarioUnchecked(yaml_text, source, base_dir); });
 }
 
 std::vector<std::string> BuiltinScenarioNames() {

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "mapless/core/check.h"
+#include "mapless/io/yaml_reader.h"
 #include "mapless/sim/driver.h"
 
 namespace mapless::sim {
@@ -129,6 +130,49 @@ cv::Mat Simulation::Render(int robot) {
   if (!camera_.effects.Any()) return image;
   Rng rng = Rng::Derive(seed_, (frame << 8) + i + 1);
   return ApplyEffects(image, camera_.effects, &rng);
+}
+
+static DriveOptions ParseDriveOptionsUnchecked(const std::string& yaml_text, const std::string& name) {
+  DriveOptions options;
+  const io::YamlMap root = io::YamlMap::LoadString(yaml_text, name);
+  root.CheckKnownKeys({"render", "simulation", "drive"});
+  if (root.Has("render")) {
+    const io::YamlMap r = root.GetMap("render");
+    r.CheckKnownKeys({"edge_supersample", "near_m", "far_m", "anisotropy"});
+    auto& o = options.sim.render;
+    o.edge_supersample = r.GetInt("edge_supersample", o.edge_supersample);
+    o.near_m = r.GetDouble("near_m", o.near_m);
+    o.far_m = r.GetDouble("far_m", o.far_m);
+    o.anisotropy = r.GetDouble("anisotropy", o.anisotropy);
+    try {
+      o.Validate();
+    } catch (const InputError& e) {
+      r.Fail("", e.what());
+    }
+  }
+  if (root.Has("simulation")) {
+    const io::YamlMap s = root.GetMap("simulation");
+    s.CheckKnownKeys({"physics_dt_s", "robot_body_height_m"});
+    options.sim.physics_dt_s = s.GetDouble("physics_dt_s", options.sim.physics_dt_s);
+    options.sim.robot_body_height_m =
+        s.GetDouble("robot_body_height_m", options.sim.robot_body_height_m);
+  }
+  if (root.Has("drive")) {
+    const io::YamlMap d = root.GetMap("drive");
+    d.CheckKnownKeys({"timeout_factor", "stop_on_collision"});
+    options.timeout_factor = d.GetDouble("timeout_factor", options.timeout_factor);
+    options.stop_on_collision = d.GetBool("stop_on_collision", options.stop_on_collision);
+  }
+  try {
+    options.Validate();
+  } catch (const InputError& e) {
+    throw InputError(name + ": " + e.what());
+  }
+  return options;
+}
+
+DriveOptions ParseDriveOptions(const std::string& yaml_text, const std::string& name) {
+  return io::WithYamlErrors(name, [&] { return ParseDriveOptionsUnchecked(yaml_text, name); });
 }
 
 DriveSummary DriveTaughtPath(const Scenario& scenario, const DriveOptions& options,

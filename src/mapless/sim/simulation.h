@@ -105,6 +105,10 @@ struct DriveSummary {
   std::string status;  // "completed", "collision at ...", "timeout after ..."
 };
 
+// Parses a run configuration (config/default.yaml: render, simulation, drive); errors name `name`,
+// the line and the field. Fuzzed by fuzz/fuzz_config.cc.
+DriveOptions ParseDriveOptions(const std::string& yaml_text, const std::string& name);
+
 DriveSummary DriveTaughtPath(const Scenario& scenario, const DriveOptions& options,
                              const std::function<void(const DriveFrame&)>& on_frame);
 

@@ -1,0 +1,66 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (preset `fuzz`: clang, ASan + UBSan) and runs each one for a fixed
+# number of executions or a time limit, whichever comes first.
+#
+#   scripts/fuzz.sh [-r RUNS] [-t SECONDS] [TARGET ...]
+#     -r RUNS     executions per target (default 1000000)
+#     -t SECONDS  time limit per target (default 600)
+#     TARGET      route_manifest route_keyframe scenario config calibration flo tum (default: all)
+#
+# Each target starts from fuzz/corpus/<target>/ (kept inputs) and grows a working corpus in
+# build/fuzz/corpus/<target>/. A crash, sanitizer report, leak or hang stops that target; its input is
+# written to build/fuzz/artifacts/<target>/ and the script exits non-zero. Keep such an input as a
+# regression test: copy it to fuzz/corpus/<target>/crash-<what> (the ordinary test suite runs every
+# kept input through the same harness), fix the parser, and run this script again.
+# A summary line per target, with the executions done, ends the output (also in build/fuzz/summary.txt).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+runs=1000000
+seconds=600
+while getopts "r:t:" opt; do
+  case "$opt" in
+    r) runs="$OPTARG" ;;
+    t) seconds="$OPTARG" ;;
+    *) echo "usage: scripts/fuzz.sh [-r RUNS] [-t SECONDS] [TARGET ...]" >&2; exit 2 ;;
+  esac
+done
+shift $((OPTIND - 1))
+targets=("$@")
+if [ ${#targets[@]} -eq 0 ]; then
+  targets=(route_manifest route_keyframe scenario config calibration flo tum)
+fi
+
+bash scripts/setup.sh
+cmake --preset fuzz >/dev/null
+cmake --build --preset fuzz -j "$(nproc)"
+
+out=build/fuzz
+summary="$out/summary.txt"
+: > "$summary"
+status=0
+for t in "${targets[@]}"; do
+  bin="$out/fuzz/fuzz_$t"
+  [ -x "$bin" ] || { echo "fuzz.sh: no target '$t'" >&2; exit 2; }
+  mkdir -p "$out/corpus/$t" "$out/artifacts/$t"
+  log="$out/fuzz_$t.log"
+  echo "fuzz.sh: $t (up to $runs executions or $seconds s)"
+  set +e
+  # Leak checks stay on; -timeout flags a single input that takes over 10 s (a hang).
+  "$bin" -runs="$runs" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+    -max_len=65536 -print_final_stats=1 -artifact_prefix="$out/artifacts/$t/" \
+    "$out/corpus/$t" "fuzz/corpus/$t" >"$log" 2>&1
+  rc=$?
+  set -e
+  done_runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1 || true)
+  secs=$(grep -o 'Done [0-9]* runs in [0-9]* second' "$log" | grep -o 'in [0-9]*' | grep -o '[0-9]*' | tail -1 || true)
+  if [ "$rc" -eq 0 ]; then
+    line="$t: ${done_runs:-?} executions in ${secs:-?} s, no crash"
+  else
+    line="$t: FAILED after ${done_runs:-?} executions (exit $rc); input in $out/artifacts/$t/, log $log"
+    status=1
+  fi
+  echo "$line" | tee -a "$summary"
+done
+echo "fuzz.sh: summary in $summary"
+exit "$status"
