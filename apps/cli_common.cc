@@ -38,14 +38,16 @@ Pose2 ParsePoseDeg(const std::string& text, const std::string& option) {
 
 JsonLines::JsonLines(const std::string& path) {
   if (path.empty() || path == "-") return;
-  file_.open(path, std::ios::out | std::ios::trunc);
-  if (!file_) throw InputError(path + ": cannot write");
+  file_ = std::make_unique<io::JournalFile>(path);
 }
 
 void JsonLines::Write(const nlohmann::json& j) {
-  std::ostream& out = file_.is_open() ? static_cast<std::ostream&>(file_) : std::cout;
-  out << j.dump() << "\n";
-  out.flush();
+  if (file_) {
+    file_->Append(j.dump());
+    return;
+  }
+  std::cout << j.dump() << "\n";
+  std::cout.flush();
 }
 
 sim::DriveOptions LoadDriveOptions(const std::string& config_path) {

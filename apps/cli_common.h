@@ -3,12 +3,13 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
-#include <fstream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
 
 #include "mapless/core/pose.h"
+#include "mapless/io/journal.h"
 #include "mapless/sim/simulation.h"
 
 namespace mapless::app {
@@ -32,6 +33,8 @@ Pose2 ParsePoseDeg(const std::string& text, const std::string& option);
 
 // A journal of JSON lines: each line is flushed as it is written, so an interrupted run keeps every
 // complete line.
+// Decision logs, one JSON object per line. To a file, each line is a journal record
+// (io/journal.h): a run killed at any moment leaves every line it finished, whole.
 class JsonLines {
  public:
   // "" or "-": standard output.
@@ -39,7 +42,7 @@ class JsonLines {
   void Write(const nlohmann::json& j);
 
  private:
-  std::ofstream file_;
+  std::unique_ptr<io::JournalFile> file_;
 };
 
 

@@ -60,7 +60,7 @@ void AddDemoCommand(CLI::App* app) {
     run_options.seed = args->seed;
     const double speed = eval::RepeatSpeedFor(scenario, run_options.max_repeat_speed_mps);
     run_options.repeat.sloped.max_speed_mps = speed;
-    std::ofstream log((out / "repeat.jsonl").string());
+    JsonLines log((out / "repeat.jsonl").string());
     int frame = 0;
     const eval::RepeatRun run = eval::RepeatOnSimulator(
         scenario, taught, run_options,
@@ -76,8 +76,7 @@ void AddDemoCommand(CLI::App* app) {
                            {"v_mps", s.command.v_mps},
                            {"omega_radps", s.command.omega_radps},
                            {"status", navigation::RepeatStatusName(s.status)}};
-          log << j.dump() << "\n";
-          log.flush();
+          log.Write(j);
         });
     const cv::Mat top =
         viz::DrawTopDown(sim::ApplyVariant(scenario.world, scenario.repeat_variant),

@@ -9,6 +9,7 @@
 #include "cli_common.h"
 #include "mapless/core/check.h"
 #include "mapless/io/atomic_file.h"
+#include "mapless/io/journal.h"
 #include "mapless/io/tum.h"
 #include "mapless/sim/world.h"
 #include "mapless/viz/topdown.h"
@@ -21,7 +22,14 @@ sim::DriveSummary DriveToDirectory(const sim::Scenario& scenario, const sim::Dri
   io::MakeDirectories((dir / "frames").string());
   std::vector<io::StampedPose> truth;
   std::vector<io::StampedPose> odom;
-  std::string frames_csv = "index,t_s,file\n";
+  // Journals, written frame by frame after the frame's image: a recording killed at any moment
+  // keeps every frame it finished, listed and with its poses (see io/journal.h).
+  io::JournalFile frames_csv((dir / "frames.csv").string());
+  io::JournalFile truth_tum((dir / "groundtruth.tum").string());
+  io::JournalFile odom_tum((dir / "odometry.tum").string());
+  frames_csv.Append("index,t_s,file");
+  truth_tum.Append(io::kTumHeader);
+  odom_tum.Append(io::kTumHeader);
   const sim::DriveSummary summary =
       sim::DriveTaughtPath(scenario, options, [&](const sim::DriveFrame& f) {
         char name[32];
@@ -30,12 +38,14 @@ sim::DriveSummary DriveToDirectory(const sim::Scenario& scenario, const sim::Dri
         truth.push_back({f.t_ns, f.truth});
         odom.push_back({f.t_ns, f.odometry});
         char row[96];
-        std::snprintf(row, sizeof(row), "%d,%.3f,frames/%s\n", f.index, ToSeconds(f.t_ns), name);
-        frames_csv += row;
+        std::snprintf(row, sizeof(row), "%d,%.3f,frames/%s", f.index, ToSeconds(f.t_ns), name);
+        frames_csv.Append(row);
+        truth_tum.Append(io::FormatTumLine(truth.back()));
+        odom_tum.Append(io::FormatTumLine(odom.back()));
       });
-  io::WriteFileAtomic((dir / "frames.csv").string(), frames_csv);
-  io::WriteTumAtomic((dir / "groundtruth.tum").string(), truth);
-  io::WriteTumAtomic((dir / "odometry.tum").string(), odom);
+  frames_csv.Sync();
+  truth_tum.Sync();
+  odom_tum.Sync();
   std::vector<Pose2> truth_poses;
   std::vector<Pose2> odom_poses;
   for (const auto& p : truth) truth_poses.push_back(p.pose);

@@ -27,7 +27,7 @@ expect_exit() {
 }
 
 # Every subcommand answers --help with exit 0 and a usage text.
-for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench" "shift" "teach" "repeat" "route" "route info" "eval" "flow" "ground" "navigate" "localize"; do
+for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench" "shift" "teach" "repeat" "route" "route info" "eval" "soak" "flow" "ground" "navigate" "localize"; do
   # shellcheck disable=SC2086
   expect_exit "help: mapless $sub --help" 0 "$MAPLESS" $sub --help
   grep -qi "usage" "$TMP/out"; check "help text: mapless $sub" $?
@@ -171,6 +171,26 @@ if kill -9 "$pid" 2>/dev/null; then
   grep -q '"complete":false' "$TMP/out" && grep -q '"keyframes":[1-9]' "$TMP/out"; check "killed teach keeps its completed keyframes ($(cat "$TMP/out"))" $?
 else
   wait "$pid"; check "teach was still running when killed (machine too fast?)" 1
+fi
+
+# A recording killed with SIGKILL keeps every frame it finished: listed, with whole poses.
+"$MAPLESS" sim drive --scenario outdoor_70m --out "$TMP/killedrec" >/dev/null 2>&1 &
+pid=$!
+for _ in $(seq 1 200); do [ -f "$TMP/killedrec/frames/000020.png" ] && break; sleep 0.05; done
+if kill -9 "$pid" 2>/dev/null; then
+  wait "$pid" 2>/dev/null
+  [ ! -f "$TMP/killedrec/summary.json" ]; check "killed recording: it was killed before its end" $?
+  bad=$(awk 'FNR > 1 && NF != 8' "$TMP/killedrec/groundtruth.tum" "$TMP/killedrec/odometry.tum" | wc -l)
+  [ "$bad" -eq 0 ]; check "killed recording: every TUM record is whole ($bad bad)" $?
+  listed=$(($(wc -l < "$TMP/killedrec/frames.csv") - 1))
+  poses=$(($(wc -l < "$TMP/killedrec/groundtruth.tum") - 1))
+  [ "$listed" -ge 20 ] && [ $((listed - poses)) -le 1 ] && [ $((listed - poses)) -ge 0 ]
+  check "killed recording: $listed frames listed, $poses poses" $?
+  missing=0
+  while IFS=, read -r _ _ file; do [ -f "$TMP/killedrec/$file" ] || missing=$((missing + 1)); done < <(tail -n +2 "$TMP/killedrec/frames.csv")
+  [ "$missing" -eq 0 ]; check "killed recording: every listed frame is on disk ($missing missing)" $?
+else
+  wait "$pid"; check "recording was still running when killed (machine too fast?)" 1
 fi
 
 # Demo on a short scenario: teach, route, repeat, picture.

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "mapless/core/check.h"
+#include "mapless/core/testing.h"
 #include "mapless/io/tum.h"
 
 namespace mapless::io {
@@ -43,6 +44,16 @@ TEST(Tum, RoundTripsPlanarPoses) {
     EXPECT_NEAR(back[i].pose.y_m, poses[i].pose.y_m, 1e-6);
     EXPECT_NEAR(back[i].pose.theta_rad, poses[i].pose.theta_rad, 1e-6);
   }
+}
+
+TEST(Tum, ACutLastRecordIsDroppedAMalformedLineElsewhereIsAnError) {
+  const std::string whole = FormatTum({{0, Pose2{1, 2, 0.5}}, {100'000'000, Pose2{3, 4, 0.0}}});
+  EXPECT_EQ(ParseTum(whole + "0.2 5.0 6", "t").size(), 2U);  // killed mid-record
+  EXPECT_NE(testing::InputErrorOf([&] { ParseTum(whole + "0.2 5.0 6\n", "t.tum"); })
+                .find("t.tum:4: expected 8 numbers"),
+            std::string::npos);
+  EXPECT_NE(testing::InputErrorOf([&] { ParseTum("x\n" + whole, "t.tum"); }).find("t.tum:1:"),
+            std::string::npos);
 }
 
 }  // namespace

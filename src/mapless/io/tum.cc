@@ -9,15 +9,17 @@
 
 namespace mapless::io {
 
-std::string FormatTum(const std::vector<StampedPose>& poses) {
-  std::string out = "# timestamp tx ty tz qx qy qz qw\n";
+std::string FormatTumLine(const StampedPose& p) {
   char line[256];
-  for (const auto& p : poses) {
-    const double half = 0.5 * p.pose.theta_rad;
-    std::snprintf(line, sizeof(line), "%.6f %.6f %.6f 0 0 0 %.9f %.9f\n", ToSeconds(p.t_ns),
-                  p.pose.x_m, p.pose.y_m, std::sin(half), std::cos(half));
-    out += line;
-  }
+  const double half = 0.5 * p.pose.theta_rad;
+  std::snprintf(line, sizeof(line), "%.6f %.6f %.6f 0 0 0 %.9f %.9f", ToSeconds(p.t_ns), p.pose.x_m,
+                p.pose.y_m, std::sin(half), std::cos(half));
+  return line;
+}
+
+std::string FormatTum(const std::vector<StampedPose>& poses) {
+  std::string out = std::string(kTumHeader) + "\n";
+  for (const auto& p : poses) out += FormatTumLine(p) + "\n";
   return out;
 }
 
@@ -32,6 +34,9 @@ std::vector<StampedPose> ParseTum(const std::string& text, const std::string& na
     std::istringstream fields(line);
     double t = 0, x = 0, y = 0, z = 0, qx = 0, qy = 0, qz = 0, qw = 0;
     if (!(fields >> t >> x >> y >> z >> qx >> qy >> qz >> qw)) {
+      // A last line without its newline that does not parse is a record cut short by a killed
+      // recorder (io/journal.h): everything before it is kept.
+      if (in.eof() && !text.empty() && text.back() != '\n') break;
       throw InputError(name + ":" + std::to_string(line_no) + ": expected 8 numbers per line");
     }
     out.push_back({FromSeconds(t), Pose2{x, y, 2.0 * std::atan2(qz, qw)}});

@@ -14,8 +14,12 @@ struct StampedPose {
   Pose2 pose;
 };
 
+inline constexpr const char* kTumHeader = "# timestamp tx ty tz qx qy qz qw";
 std::string FormatTum(const std::vector<StampedPose>& poses);
-// Parses TUM text; throws InputError "NAME:LINE: ..." on a malformed line.
+// One pose as a TUM line, without the newline (for journals written while recording).
+std::string FormatTumLine(const StampedPose& pose);
+// Parses TUM text; throws InputError "NAME:LINE: ..." on a malformed line. A malformed last line
+// without a newline is dropped instead: a record cut short when the recorder was killed.
 std::vector<StampedPose> ParseTum(const std::string& text, const std::string& name);
 void WriteTumAtomic(const std::string& path, const std::vector<StampedPose>& poses);
 

@@ -1,0 +1,41 @@
+#include "mapless/io/journal.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include "mapless/core/check.h"
+
+namespace mapless::io {
+
+JournalFile::JournalFile(const std::string& path) : path_(path) {
+  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw InputError(path + ": cannot write: " + std::strerror(errno));
+}
+
+JournalFile::~JournalFile() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void JournalFile::Append(std::string_view record) {
+  std::string line(record);
+  if (line.empty() || line.back() != '\n') line.push_back('\n');
+  // One write for the whole line; a short write (a full disk) is finished, or reported.
+  std::size_t done = 0;
+  while (done < line.size()) {
+    const ssize_t n = ::write(fd_, line.data() + done, line.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      throw InputError(path_ + ": cannot write: " + std::strerror(errno));
+    }
+    done += static_cast<std::size_t>(n);
+  }
+}
+
+void JournalFile::Sync() {
+  if (::fsync(fd_) != 0) throw InputError(path_ + ": cannot write: " + std::strerror(errno));
+}
+
+}  // namespace mapless::io
