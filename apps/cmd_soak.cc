@@ -5,6 +5,7 @@
 // fails. Memory is read from /proc/self/status (Linux).
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -109,6 +110,10 @@ void AddSoakCommand(CLI::App* app) {
                            {"p95_frame_ms", lap.p95_frame_ms},
                            {"rss_mib", rss},
                            {"peak_rss_mib", peak}});
+    }, [] {
+      return std::chrono::duration<double, std::milli>(
+                 std::chrono::steady_clock::now().time_since_epoch())
+          .count();
     });
     const std::size_t k = std::min<std::size_t>(3, lap_medians.size());
     const double early = Median({lap_medians.begin(), lap_medians.begin() + static_cast<std::ptrdiff_t>(k)});

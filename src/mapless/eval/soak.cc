@@ -1,7 +1,6 @@
 #include "mapless/eval/soak.h"
 
 #include <algorithm>
-#include <chrono>
 
 #include "mapless/core/check.h"
 #include "mapless/core/rng.h"
@@ -26,7 +25,8 @@ void SoakOptions::Validate() const {
   repeat.Validate();
 }
 
-SoakSummary RunSoak(const SoakOptions& options, const std::function<void(const SoakLap&)>& on_lap) {
+SoakSummary RunSoak(const SoakOptions& options, const std::function<void(const SoakLap&)>& on_lap,
+                    const std::function<double()>& now_ms) {
   options.Validate();
   const sim::Scenario scenario = sim::LoadScenario(options.scenario);
   const TaughtRoute taught = TeachOnSimulator(scenario, navigation::TeachOptions{});
@@ -63,11 +63,10 @@ SoakSummary RunSoak(const SoakOptions& options, const std::function<void(const S
     lap.lap = summary.laps + 1;
     frame_ms.clear();
     while (true) {
-      const auto t0 = std::chrono::steady_clock::now();
+      const double t0 = now_ms ? now_ms() : 0.0;
       const cv::Mat image = sim.Render(r);
       const navigation::RepeatStep step = session.Update(image, sim.now_ns());
-      frame_ms.push_back(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      frame_ms.push_back(now_ms ? now_ms() - t0 : 0.0);
       ++lap.frames;
       if (session.finished()) {
         lap.completed = step.status == navigation::RepeatStatus::kCompleted;

@@ -40,7 +40,9 @@ struct SoakSummary {
 };
 
 // Runs laps until duration_s of simulated time has passed; `on_lap` is called after each lap
-// (the app measures memory there).
-SoakSummary RunSoak(const SoakOptions& options, const std::function<void(const SoakLap&)>& on_lap);
+// (the app measures memory there). `now_ms` is the clock that times each frame, passed in by the
+// app (library code reads no clock); without one the frame costs are 0.
+SoakSummary RunSoak(const SoakOptions& options, const std::function<void(const SoakLap&)>& on_lap,
+                    const std::function<double()>& now_ms = {});
 
 }  // namespace mapless::eval
