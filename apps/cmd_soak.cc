@@ -90,48 +90,54 @@ void AddSoakCommand(CLI::App* app) {
     double peak_end = 0.0;
     std::fprintf(table, "%4s %8s %6s %-9s %8s %10s %9s %9s %9s\n", "lap", "sim s", "frames",
                  "result", "final", "frame med", "frame p95", "RSS MiB", "peak MiB");
-    const eval::SoakSummary summary = eval::RunSoak(options, [&](const eval::SoakLap& lap) {
-      const auto [rss, peak] = ResidentMiB();
-      if (lap.lap == 1) peak_after_first = peak;
-      peak_end = peak;
-      lap_medians.push_back(lap.median_frame_ms);
-      const char* result = lap.completed ? "completed" : lap.collided ? "collided" : "timeout";
-      std::fprintf(table, "%4d %8.0f %6d %-9s %7.2fm %8.2fms %7.2fms %9.1f %9.1f\n", lap.lap,
-                   lap.end_time_s, lap.frames, result, lap.final_error_m, lap.median_frame_ms,
-                   lap.p95_frame_ms, rss, peak);
-      std::fflush(table);
-      j["laps"].push_back({{"lap", lap.lap},
-                           {"end_time_s", lap.end_time_s},
-                           {"frames", lap.frames},
-                           {"completed", lap.completed},
-                           {"collided", lap.collided},
-                           {"final_error_m", lap.final_error_m},
-                           {"median_frame_ms", lap.median_frame_ms},
-                           {"p95_frame_ms", lap.p95_frame_ms},
-                           {"rss_mib", rss},
-                           {"peak_rss_mib", peak}});
-    }, [] {
-      return std::chrono::duration<double, std::milli>(
-                 std::chrono::steady_clock::now().time_since_epoch())
-          .count();
-    });
+    const eval::SoakSummary summary = eval::RunSoak(
+        options,
+        [&](const eval::SoakLap& lap) {
+          const auto [rss, peak] = ResidentMiB();
+          if (lap.lap == 1) peak_after_first = peak;
+          peak_end = peak;
+          lap_medians.push_back(lap.median_frame_ms);
+          const char* result = lap.completed ? "completed" : lap.collided ? "collided" : "timeout";
+          std::fprintf(table, "%4d %8.0f %6d %-9s %7.2fm %8.2fms %7.2fms %9.1f %9.1f\n", lap.lap,
+                       lap.end_time_s, lap.frames, result, lap.final_error_m, lap.median_frame_ms,
+                       lap.p95_frame_ms, rss, peak);
+          std::fflush(table);
+          j["laps"].push_back({{"lap", lap.lap},
+                               {"end_time_s", lap.end_time_s},
+                               {"frames", lap.frames},
+                               {"completed", lap.completed},
+                               {"collided", lap.collided},
+                               {"final_error_m", lap.final_error_m},
+                               {"median_frame_ms", lap.median_frame_ms},
+                               {"p95_frame_ms", lap.p95_frame_ms},
+                               {"rss_mib", rss},
+                               {"peak_rss_mib", peak}});
+        },
+        [] {
+          return std::chrono::duration<double, std::milli>(
+                     std::chrono::steady_clock::now().time_since_epoch())
+              .count();
+        });
     const std::size_t k = std::min<std::size_t>(3, lap_medians.size());
-    const double early = Median({lap_medians.begin(), lap_medians.begin() + static_cast<std::ptrdiff_t>(k)});
-    const double late = Median({lap_medians.end() - static_cast<std::ptrdiff_t>(k), lap_medians.end()});
+    const double early =
+        Median({lap_medians.begin(), lap_medians.begin() + static_cast<std::ptrdiff_t>(k)});
+    const double late =
+        Median({lap_medians.end() - static_cast<std::ptrdiff_t>(k), lap_medians.end()});
     const double rss_growth = peak_after_first > 0.0 ? peak_end / peak_after_first - 1.0 : 0.0;
     const double cost_drift = early > 0.0 ? late / early - 1.0 : 0.0;
     const bool rss_ok = rss_growth <= args->max_rss_growth;
     const bool cost_ok = args->max_cost_drift <= 0.0 || cost_drift <= args->max_cost_drift;
-    std::fprintf(table,
-                 "soak: %d laps (%d completed), %d frames, %.0f simulated s; peak RSS %.1f MiB "
-                 "after lap 1, %.1f MiB at the end (%+.1f%%, limit %+.0f%%); median frame cost "
-                 "%.2f ms (first 3 laps) -> %.2f ms (last 3) (%+.1f%%%s)\n",
-                 summary.laps, summary.completed_laps, summary.frames, summary.simulated_s,
-                 peak_after_first, peak_end, 100.0 * rss_growth, 100.0 * args->max_rss_growth,
-                 early, late, 100.0 * cost_drift,
-                 args->max_cost_drift > 0.0
-                     ? (", limit +" + std::to_string(static_cast<int>(100.0 * args->max_cost_drift)) + "%").c_str()
-                     : ", not checked");
+    std::fprintf(
+        table,
+        "soak: %d laps (%d completed), %d frames, %.0f simulated s; peak RSS %.1f MiB "
+        "after lap 1, %.1f MiB at the end (%+.1f%%, limit %+.0f%%); median frame cost "
+        "%.2f ms (first 3 laps) -> %.2f ms (last 3) (%+.1f%%%s)\n",
+        summary.laps, summary.completed_laps, summary.frames, summary.simulated_s, peak_after_first,
+        peak_end, 100.0 * rss_growth, 100.0 * args->max_rss_growth, early, late, 100.0 * cost_drift,
+        args->max_cost_drift > 0.0
+            ? (", limit +" + std::to_string(static_cast<int>(100.0 * args->max_cost_drift)) + "%")
+                  .c_str()
+            : ", not checked");
     j["summary"] = {{"laps", summary.laps},
                     {"completed_laps", summary.completed_laps},
                     {"frames", summary.frames},
@@ -147,7 +153,8 @@ void AddSoakCommand(CLI::App* app) {
     if (args->json) std::cout << j.dump() << "\n";
     if (!rss_ok) throw RunFailed("soak: peak RSS grew " + std::to_string(100.0 * rss_growth) + "%");
     if (!cost_ok)
-      throw RunFailed("soak: the median frame cost drifted " + std::to_string(100.0 * cost_drift) + "%");
+      throw RunFailed("soak: the median frame cost drifted " + std::to_string(100.0 * cost_drift) +
+                      "%");
   });
 }
 

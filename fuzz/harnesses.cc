@@ -52,11 +52,13 @@ void Tum(const std::string& input) {
 }
 
 const std::vector<NamedHarness>& Harnesses() {
-  static const std::vector<NamedHarness> harnesses = {
-      {"route_manifest", RouteManifest}, {"route_keyframe", RouteKeyframe},
-      {"scenario", Scenario},            {"config", Config},
-      {"calibration", Calibration},      {"flo", Flo},
-      {"tum", Tum}};
+  static const std::vector<NamedHarness> harnesses = {{"route_manifest", RouteManifest},
+                                                      {"route_keyframe", RouteKeyframe},
+                                                      {"scenario", Scenario},
+                                                      {"config", Config},
+                                                      {"calibration", Calibration},
+                                                      {"flo", Flo},
+                                                      {"tum", Tum}};
   return harnesses;
 }
 

@@ -37,9 +37,12 @@ std::vector<sim::CameraFaultWindow> Schedule() {
 
 std::string ExpectedReason(CameraFaultKind kind) {
   switch (kind) {
-    case CameraFaultKind::kBlack: return CameraFaultName(navigation::CameraFault::kBlack);
-    case CameraFaultKind::kFrozen: return CameraFaultName(navigation::CameraFault::kFrozen);
-    case CameraFaultKind::kDropped: return CameraFaultName(navigation::CameraFault::kNoImage);
+    case CameraFaultKind::kBlack:
+      return CameraFaultName(navigation::CameraFault::kBlack);
+    case CameraFaultKind::kFrozen:
+      return CameraFaultName(navigation::CameraFault::kFrozen);
+    case CameraFaultKind::kDropped:
+      return CameraFaultName(navigation::CameraFault::kNoImage);
     case CameraFaultKind::kOverExposed:
       return CameraFaultName(navigation::CameraFault::kOverExposed);
     case CameraFaultKind::kFeatureless:
@@ -57,7 +60,8 @@ void CheckFaultHandling(const std::vector<Frame>& frames, double period_s) {
     const std::string name = sim::CameraFaultKindName(w.kind);
     const int first = static_cast<int>(std::ceil(w.start_s / period_s - 1e-6));
     const int last = static_cast<int>(std::ceil(w.end_s / period_s - 1e-6)) - 1;
-    ASSERT_LT(last, static_cast<int>(frames.size())) << "the run ended before the " << name << " fault";
+    ASSERT_LT(last, static_cast<int>(frames.size()))
+        << "the run ended before the " << name << " fault";
     int flagged = 0;
     for (int k = first; k <= last; ++k) {
       const Frame& f = frames[static_cast<std::size_t>(k)];
@@ -112,10 +116,11 @@ TEST(CameraFaults, VisualPotentialStopsOnEachFaultAndDrivesDownTheCorridor) {
   PotentialRunOptions o;
   o.camera_faults = Schedule();
   std::vector<Frame> frames;
-  const PotentialRun run = RunPotential(
-      scenario, calibration, o, [&](const Pose2&, const cv::Mat&, const navigation::PotentialStep& s) {
-        frames.push_back({s.command, s.reason});
-      });
+  const PotentialRun run =
+      RunPotential(scenario, calibration, o,
+                   [&](const Pose2&, const cv::Mat&, const navigation::PotentialStep& s) {
+                     frames.push_back({s.command, s.reason});
+                   });
   CheckFaultHandling(frames, 1.0 / scenario.camera.rate_hz);
   EXPECT_TRUE(run.success) << run.status;
   EXPECT_FALSE(run.collided);

@@ -51,11 +51,10 @@ SoakSummary RunSoak(const SoakOptions& options, const std::function<void(const S
   SoakSummary summary;
   std::vector<double> frame_ms;
   while (ToSeconds(sim.now_ns()) < options.duration_s) {
-    const Pose2 start =
-        scenario.repeat_start *
-        Pose2{rng.Uniform(-o.start_offset_m, o.start_offset_m),
-              rng.Uniform(-o.start_offset_m, o.start_offset_m),
-              DegToRad(rng.Uniform(-o.start_offset_deg, o.start_offset_deg))};
+    const Pose2 start = scenario.repeat_start *
+                        Pose2{rng.Uniform(-o.start_offset_m, o.start_offset_m),
+                              rng.Uniform(-o.start_offset_m, o.start_offset_m),
+                              DegToRad(rng.Uniform(-o.start_offset_deg, o.start_offset_deg))};
     sim.PlaceRobot(r, start);
     navigation::RepeatSession session(route, o.repeat);
     const double lap_start_s = ToSeconds(sim.now_ns());

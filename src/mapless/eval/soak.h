@@ -22,10 +22,10 @@ struct SoakOptions {
 };
 
 struct SoakLap {
-  int lap = 0;                // from 1
-  double end_time_s = 0.0;    // simulated time at the end of the lap
+  int lap = 0;              // from 1
+  double end_time_s = 0.0;  // simulated time at the end of the lap
   int frames = 0;
-  bool completed = false;     // reached the end of the route
+  bool completed = false;  // reached the end of the route
   bool collided = false;
   double final_error_m = 0.0;
   double median_frame_ms = 0.0;  // wall time of render + repeat step, per frame

@@ -37,8 +37,9 @@ TEST(JournalFile, AppendsWholeLines) {
 }
 
 TEST(JournalFile, UnwritablePathIsNamed) {
-  EXPECT_NE(testing::InputErrorOf([] { JournalFile("/nonexistent-dir/x.txt"); })
-                .find("/nonexistent-dir/x.txt: cannot write"),
+  EXPECT_NE(testing::InputErrorOf([] {
+              JournalFile("/nonexistent-dir/x.txt");
+            }).find("/nonexistent-dir/x.txt: cannot write"),
             std::string::npos);
 }
 
@@ -57,8 +58,8 @@ TEST(JournalFile, AProcessKilledMidRunLeavesOnlyWholeRecords) {
     }
   }
   // Wait until it has written something, then kill it mid-stream.
-  for (int i = 0; i < 200 && (!std::filesystem::exists(path) ||
-                              std::filesystem::file_size(path) < 200'000);
+  for (int i = 0;
+       i < 200 && (!std::filesystem::exists(path) || std::filesystem::file_size(path) < 200'000);
        ++i) {
     ::usleep(10'000);
   }

@@ -23,7 +23,8 @@ CameraCheck Fault(CameraFault fault, const std::string& detail) {
 }  // namespace
 
 void CameraCheckOptions::Validate() const {
-  if (!(black_mean >= 0.0 && black_mean < 255.0)) throw InputError("camera.black_mean must be in [0, 255)");
+  if (!(black_mean >= 0.0 && black_mean < 255.0))
+    throw InputError("camera.black_mean must be in [0, 255)");
   if (!(saturated_level > 0.0 && saturated_level <= 255.0))
     throw InputError("camera.saturated_level must be in (0, 255]");
   if (!(max_saturated_fraction > 0.0 && max_saturated_fraction <= 1.0))
@@ -35,12 +36,18 @@ void CameraCheckOptions::Validate() const {
 
 const char* CameraFaultName(CameraFault f) {
   switch (f) {
-    case CameraFault::kNone: return "none";
-    case CameraFault::kNoImage: return "no image";
-    case CameraFault::kBlack: return "black frame";
-    case CameraFault::kOverExposed: return "over-exposed";
-    case CameraFault::kFeatureless: return "featureless view";
-    case CameraFault::kFrozen: return "frozen camera";
+    case CameraFault::kNone:
+      return "none";
+    case CameraFault::kNoImage:
+      return "no image";
+    case CameraFault::kBlack:
+      return "black frame";
+    case CameraFault::kOverExposed:
+      return "over-exposed";
+    case CameraFault::kFeatureless:
+      return "featureless view";
+    case CameraFault::kFrozen:
+      return "frozen camera";
   }
   return "unknown";
 }
@@ -58,8 +65,8 @@ CameraCheck CameraMonitor::Check(const cv::Mat& image, const Twist2& last_comman
   cv::Mat grey = image;
   if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
   if (grey.depth() != CV_8U) {
-    return Fault(CameraFault::kNoImage, "expected 8-bit images, got OpenCV depth " +
-                                            std::to_string(grey.depth()));
+    return Fault(CameraFault::kNoImage,
+                 "expected 8-bit images, got OpenCV depth " + std::to_string(grey.depth()));
   }
 
   const bool moving = std::abs(last_command.v_mps) > options_.moving_speed_mps ||
@@ -80,7 +87,8 @@ CameraCheck CameraMonitor::Check(const cv::Mat& image, const Twist2& last_comman
   const double saturated = static_cast<double>(cv::countNonZero(grey >= options_.saturated_level)) /
                            static_cast<double>(grey.total());
   if (saturated > options_.max_saturated_fraction) {
-    return Fault(CameraFault::kOverExposed, Fixed(100.0 * saturated, 0) + "% of the pixels saturated");
+    return Fault(CameraFault::kOverExposed,
+                 Fixed(100.0 * saturated, 0) + "% of the pixels saturated");
   }
   if (stddev[0] < options_.min_stddev) {
     return Fault(CameraFault::kFeatureless, "grey-level standard deviation " + Fixed(stddev[0], 2));

@@ -19,12 +19,12 @@
 namespace mapless::navigation {
 
 struct CameraCheckOptions {
-  double black_mean = 8.0;             // mean grey level at or below this: black frame
-  double saturated_level = 250.0;      // a pixel at or above this is saturated ...
-  double max_saturated_fraction = 0.7; // ... and more than this fraction of them: over-exposed
-  double min_stddev = 2.0;             // grey-level standard deviation below this: featureless
-  double moving_speed_mps = 0.02;      // commanded faster than this (or turning faster than
-  double moving_rate_radps = 0.05;     // this) counts as moving, for the frozen check
+  double black_mean = 8.0;              // mean grey level at or below this: black frame
+  double saturated_level = 250.0;       // a pixel at or above this is saturated ...
+  double max_saturated_fraction = 0.7;  // ... and more than this fraction of them: over-exposed
+  double min_stddev = 2.0;              // grey-level standard deviation below this: featureless
+  double moving_speed_mps = 0.02;       // commanded faster than this (or turning faster than
+  double moving_rate_radps = 0.05;      // this) counts as moving, for the frozen check
   void Validate() const;
 };
 

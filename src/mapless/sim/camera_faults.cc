@@ -8,19 +8,24 @@ namespace mapless::sim {
 
 const char* CameraFaultKindName(CameraFaultKind kind) {
   switch (kind) {
-    case CameraFaultKind::kBlack: return "black";
-    case CameraFaultKind::kFrozen: return "frozen";
-    case CameraFaultKind::kDropped: return "dropped";
-    case CameraFaultKind::kOverExposed: return "over-exposed";
-    case CameraFaultKind::kFeatureless: return "featureless";
+    case CameraFaultKind::kBlack:
+      return "black";
+    case CameraFaultKind::kFrozen:
+      return "frozen";
+    case CameraFaultKind::kDropped:
+      return "dropped";
+    case CameraFaultKind::kOverExposed:
+      return "over-exposed";
+    case CameraFaultKind::kFeatureless:
+      return "featureless";
   }
   return "?";
 }
 
 CameraFaultKind ParseCameraFaultKind(const std::string& name) {
-  for (CameraFaultKind k : {CameraFaultKind::kBlack, CameraFaultKind::kFrozen,
-                            CameraFaultKind::kDropped, CameraFaultKind::kOverExposed,
-                            CameraFaultKind::kFeatureless}) {
+  for (CameraFaultKind k :
+       {CameraFaultKind::kBlack, CameraFaultKind::kFrozen, CameraFaultKind::kDropped,
+        CameraFaultKind::kOverExposed, CameraFaultKind::kFeatureless}) {
     if (name == CameraFaultKindName(k)) return k;
   }
   throw InputError("camera fault '" + name +
