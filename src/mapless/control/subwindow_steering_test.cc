@@ -45,7 +45,9 @@ TEST(SubWindowSteering, ReadsTheOrdinateFromTheHalfThatDoesNotLoom) {
   const std::vector<WindowCorrespondence> m = {{0, 0}, {1, 12}, {1, 13}, {2, 24}, {3, 31}, {3, 32}, {4, 38}};
   SubWindowSteeringOptions halves;
   halves.prefer_undistorted_half = true;
-  const SubWindowSteering all = ComputeSubWindowSteering(m, kWindows, 1, {});
+  SubWindowSteeringOptions whole;
+  whole.prefer_undistorted_half = false;
+  const SubWindowSteering all = ComputeSubWindowSteering(m, kWindows, 1, whole);
   const SubWindowSteering half = ComputeSubWindowSteering(m, kWindows, 1, halves);
   ASSERT_TRUE(all.ok && half.ok);
   EXPECT_LT(all.twist.omega_radps, -0.01);

@@ -117,6 +117,16 @@ Localization MarkovLocalizer::Update(const Eigen::MatrixXf& projections,
                                          << belief_.size() << " to " << n << " images");
   Grow(n);
   Predict(advance_images);
+  const int lo = std::clamp(min_index_, 0, n - 1);
+  const int hi = max_index_ < 0 ? n - 1 : std::clamp(max_index_, lo, n - 1);
+  if (lo > 0 || hi < n - 1) {
+    const double kept = belief_.segment(lo, hi - lo + 1).sum();
+    if (kept > 0.0) {
+      belief_.head(lo).setZero();
+      belief_.tail(n - 1 - hi).setZero();
+      belief_ /= kept;
+    }
+  }
 
   // Eq. (6): p(z|x) = 1/k Σ γ_j exp(-((x - x_j)/σ)²), γ_j = d_1 / d_j in (0, 1].
   result.neighbours = NearestProjections(projections, query, options_.kernels);

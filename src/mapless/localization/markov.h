@@ -66,6 +66,13 @@ class MarkovLocalizer {
   const Eigen::VectorXd& belief() const { return belief_; }
   // Changes MarkovOptions::uniform_mixing from the next prediction on.
   void set_uniform_mixing(double mixing);
+  // From the next update on, the belief before route image `min_index` and beyond `max_index` is
+  // set to zero after each prediction (the robot cannot be there, e.g. further along than it has
+  // driven). A negative value removes that limit; a limit that would leave no belief is ignored.
+  void set_index_limits(int min_index, int max_index) {
+    min_index_ = min_index;
+    max_index_ = max_index;
+  }
   const MarkovOptions& options() const { return options_; }
 
  private:
@@ -76,6 +83,8 @@ class MarkovLocalizer {
   Eigen::VectorXd belief_;
   Eigen::VectorXd scratch_;
   int low_updates_ = 0;
+  int min_index_ = -1;
+  int max_index_ = -1;
 };
 
 }  // namespace mapless::localization

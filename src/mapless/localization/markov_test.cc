@@ -127,6 +127,62 @@ TEST(MarkovLocalizer, UniformMixingLetsAWrongBeliefGiveWay) {
   }
 }
 
+// The robot is at place 10 but its images look like place 25 (an aliased twin further along).
+// Without a limit the belief goes to 25; with the belief limited to place 14 (it cannot have got
+// further) it stays at or before 14, the mass beyond is zero, and lifting the limit lets it go.
+TEST(MarkovLocalizer, AMaximumIndexKeepsTheBeliefFromRunningAhead) {
+  const int n = 60;
+  Eigen::MatrixXf route(1, n);
+  for (int i = 0; i < n; ++i) route(0, i) = static_cast<float>(i);
+  Eigen::VectorXf twin(1);
+  twin << 25.0F;
+  MarkovOptions options;
+  options.uniform_mixing = 0.01;  // even a belief that may be anywhere stays within the limit
+  for (const int limit : {-1, 14}) {
+    MarkovLocalizer markov(options);
+    markov.ResetAt(n, 10.0, 2.0);
+    markov.set_index_limits(-1, limit);
+    Localization loc;
+    for (int t = 0; t < 20; ++t) loc = markov.Update(route, twin, 0.0);
+    if (limit < 0) {
+      EXPECT_EQ(loc.index, 25);
+    } else {
+      EXPECT_LE(loc.index, 14);
+      EXPECT_GE(loc.index, 10);
+      EXPECT_EQ(markov.belief().tail(n - 15).sum(), 0.0);
+      EXPECT_NEAR(markov.belief().sum(), 1.0, 1e-9);
+      markov.set_index_limits(-1, -1);
+      for (int t = 0; t < 20; ++t) loc = markov.Update(route, twin, 0.0);
+      EXPECT_EQ(loc.index, 25);
+    }
+  }
+}
+
+// The same from the other side: at place 40, images like place 25 (a twin behind); limited to
+// places 36 and on, the belief stays there.
+TEST(MarkovLocalizer, AMinimumIndexKeepsTheBeliefFromFallingBack) {
+  const int n = 60;
+  Eigen::MatrixXf route(1, n);
+  for (int i = 0; i < n; ++i) route(0, i) = static_cast<float>(i);
+  Eigen::VectorXf twin(1);
+  twin << 25.0F;
+  MarkovOptions options;
+  options.uniform_mixing = 0.01;
+  for (const int limit : {-1, 36}) {
+    MarkovLocalizer markov(options);
+    markov.ResetAt(n, 40.0, 2.0);
+    markov.set_index_limits(limit, -1);
+    Localization loc;
+    for (int t = 0; t < 20; ++t) loc = markov.Update(route, twin, 0.0);
+    if (limit < 0) {
+      EXPECT_EQ(loc.index, 25);
+    } else {
+      EXPECT_GE(loc.index, 36);
+      EXPECT_EQ(markov.belief().head(36).sum(), 0.0);
+    }
+  }
+}
+
 TEST(MarkovOptions, RejectsBadValuesNamingTheField) {
   MarkovOptions options;
   options.kernels = 0;

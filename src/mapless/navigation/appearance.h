@@ -66,7 +66,7 @@ class AppearanceLeader {
 };
 
 struct AppearanceFollowerOptions {
-  AppearanceFollowerOptions();  // sets markov.uniform_mixing = 0.01 (see appearance.cc)
+  AppearanceFollowerOptions();  // sets markov.uniform_mixing = 0.01 (used only with uniform_mixing_for_m > 0)
   bool use_markov = true;  // false: nearest projection every frame (Section 3 alone)
   appearance::AppearanceImageOptions image;
   appearance::SubWindowOptions windows;
@@ -97,10 +97,26 @@ struct AppearanceFollowerOptions {
   // current position (the same small motions as at the start).
   int relocalize_after_stopped_frames = 10;
   // The Markov belief mixes in markov.uniform_mixing only during the first this many metres after
-  // each (initial) localization, while it may sit on an aliased twin of the true place.
-  double uniform_mixing_for_m = 12.0;
+  // each (initial) localization, so that a belief on an aliased twin can give way. Off (0) by
+  // default since the ahead limit below: the mixing also let the belief jump back onto the twin
+  // 3 m behind (appearance.cc).
+  double uniform_mixing_for_m = 0.0;
   // Markov localization is updated once per this much travel, in route images (see Update()).
   double markov_update_images = 0.5;
+  // Limits of the Markov belief (not in the paper). A follower that sets off near the route start
+  // (start_window_m > 0) cannot get further along the route than it has driven, nor much less far:
+  // after the start localization at image i0, with d the distance driven since then by the
+  // odometry, the belief is kept within
+  //   i0 + (d (1 - behind_fraction) - ahead_margin_m - start_window_m) / spacing  and
+  //   i0 + (d (1 + ahead_fraction) + ahead_margin_m) / spacing.
+  // Without the upper limit the view from behind the route start, which looks like the view a few
+  // metres in, pulls the belief ahead onto an aliased twin; without the lower one, a belief that
+  // is momentarily unsure can fall back onto a look-alike place far behind (appearance.cc,
+  // docs/appearance_route_following.md). Negative ahead_margin_m: no limits; behind_fraction >= 1:
+  // no lower limit.
+  double ahead_margin_m = 0.3;
+  double ahead_fraction = 0.05;   // the odometry may under-report the distance by this fraction
+  double behind_fraction = 0.1;   // ... and the path be this much longer than the route (detours)
   int lookahead_images = 1;        // steer towards the route image this far ahead of the position
   int arrive_within_images = 1;    // arrived at the end of a complete route within this many
   int wait_within_images = 2;      // wait for a leader this close to the end it has taught so far
@@ -157,6 +173,8 @@ class AppearanceFollower {
   double pending_advance_images_ = 0.0;
   int last_route_size_ = 0;
   double since_localized_m_ = 0.0;
+  double driven_m_ = 0.0;
+  int start_index_ = -1;
 };
 
 }  // namespace mapless::navigation
