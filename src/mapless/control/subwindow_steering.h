@@ -33,7 +33,7 @@ struct SubWindowSteeringOptions {
   double outlier_fraction_of_slope = 0.2;
   // A fit is acceptable when its slope is within this fraction of the expected slope.
   double slope_tolerance = 0.5;
-  int min_inliers = 3;                   // fewer inliers in every fit: no decision (stop)
+  int min_inliers = 3;  // fewer inliers in every fit: no decision (stop)
   // Read the ordinate from the half (A-C or C-E) whose slope is nearer the expected one when both
   // fit: a side with near objects that loom bends its correspondences (see the .cc). Not in the
   // paper. With the lower gain below it takes the outdoor off-route-right start from 2/10 to

@@ -10,7 +10,8 @@ namespace {
 constexpr int kWindows = 49;  // aligned indices of A..E: 0, 12, 24, 36, 48
 
 TEST(SubWindowSteering, GoesStraightWhenAligned) {
-  const std::vector<WindowCorrespondence> m = {{0, 0}, {1, 12}, {1, 13}, {2, 24}, {3, 36}, {3, 35}, {4, 48}};
+  const std::vector<WindowCorrespondence> m = {{0, 0},  {1, 12}, {1, 13}, {2, 24},
+                                               {3, 36}, {3, 35}, {4, 48}};
   const SubWindowSteering s = ComputeSubWindowSteering(m, kWindows, 1, {});
   ASSERT_TRUE(s.ok) << s.reason;
   EXPECT_NEAR(s.shift_windows, 0.0, 0.3);
@@ -21,7 +22,8 @@ TEST(SubWindowSteering, GoesStraightWhenAligned) {
 // Fig. 2 of the paper: the scene sits further right in the route image (every window matches a
 // higher index) and E falls outside it (an outlier): turn left.
 TEST(SubWindowSteering, TurnsLeftWhenTheRouteViewLiesToTheRightAndDropsTheOutlier) {
-  const std::vector<WindowCorrespondence> m = {{0, 6}, {1, 18}, {1, 19}, {2, 30}, {2, 31}, {3, 42}, {4, 3}};
+  const std::vector<WindowCorrespondence> m = {{0, 6},  {1, 18}, {1, 19}, {2, 30},
+                                               {2, 31}, {3, 42}, {4, 3}};
   const SubWindowSteering s = ComputeSubWindowSteering(m, kWindows, 1, {});
   ASSERT_TRUE(s.ok) << s.reason;
   EXPECT_NEAR(s.shift_windows, 6.3, 0.6);
@@ -31,7 +33,8 @@ TEST(SubWindowSteering, TurnsLeftWhenTheRouteViewLiesToTheRightAndDropsTheOutlie
 }
 
 TEST(SubWindowSteering, TurnsRightWhenTheRouteViewLiesToTheLeft) {
-  const std::vector<WindowCorrespondence> m = {{1, 4}, {2, 16}, {2, 17}, {3, 28}, {4, 40}, {4, 41}, {0, 30}};
+  const std::vector<WindowCorrespondence> m = {{1, 4},  {2, 16}, {2, 17}, {3, 28},
+                                               {4, 40}, {4, 41}, {0, 30}};
   const SubWindowSteering s = ComputeSubWindowSteering(m, kWindows, 1, {});
   ASSERT_TRUE(s.ok) << s.reason;
   EXPECT_LT(s.shift_windows, -6.0);
@@ -42,7 +45,8 @@ TEST(SubWindowSteering, TurnsRightWhenTheRouteViewLiesToTheLeft) {
 // aligned. Read from all windows the robot would turn right, towards the car; the better-sloped
 // half (A-C) says go straight.
 TEST(SubWindowSteering, ReadsTheOrdinateFromTheHalfThatDoesNotLoom) {
-  const std::vector<WindowCorrespondence> m = {{0, 0}, {1, 12}, {1, 13}, {2, 24}, {3, 31}, {3, 32}, {4, 38}};
+  const std::vector<WindowCorrespondence> m = {{0, 0},  {1, 12}, {1, 13}, {2, 24},
+                                               {3, 31}, {3, 32}, {4, 38}};
   SubWindowSteeringOptions halves;
   halves.prefer_undistorted_half = true;
   SubWindowSteeringOptions whole;

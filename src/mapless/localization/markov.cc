@@ -137,8 +137,8 @@ Localization MarkovLocalizer::Update(const Eigen::MatrixXf& projections,
   scratch_ = Eigen::VectorXd::Constant(n, options_.observation_floor);
   for (const Neighbour& neighbour : result.neighbours) {
     const double gamma = neighbour.distance > 0.0F ? nearest / neighbour.distance : 1.0;
-    for (int x = std::max(0, neighbour.index - reach); x <= std::min(n - 1, neighbour.index + reach);
-         ++x) {
+    for (int x = std::max(0, neighbour.index - reach);
+         x <= std::min(n - 1, neighbour.index + reach); ++x) {
       const double z = (x - neighbour.index) / sigma;
       scratch_(x) += gamma * std::exp(-z * z) / k;
     }
@@ -159,11 +159,11 @@ Localization MarkovLocalizer::Update(const Eigen::MatrixXf& projections,
   const int from = std::max(0, result.index - w);
   const int to = std::min(n - 1, result.index + w);
   result.probability = belief_.segment(from, to - from + 1).sum();
-  const bool doubtful = result.probability < options_.lost_probability ||
-                        result.agreement < options_.min_agreement;
+  const bool doubtful =
+      result.probability < options_.lost_probability || result.agreement < options_.min_agreement;
   low_updates_ = doubtful ? low_updates_ + 1 : 0;
   result.status = low_updates_ >= options_.lost_after_updates ? LocalizationStatus::kLost
-                                                               : LocalizationStatus::kTracking;
+                                                              : LocalizationStatus::kTracking;
   return result;
 }
 

@@ -26,7 +26,7 @@ struct MarkovOptions {
   // Each prediction mixes this much of a uniform belief in (the robot may be anywhere: without it
   // the belief far from its peak underflows to zero and a wrong peak can never be left).
   double uniform_mixing = 0.0;
-  int probability_window = 1;     // probability = belief mass within ± this many images
+  int probability_window = 1;  // probability = belief mass within ± this many images
   // Lost: for lost_after_updates in a row, either the probability is below lost_probability or
   // the observation disagrees with the prediction (the predicted belief puts less than
   // min_agreement of the best possible weight on the places the image looks like). The second

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -26,6 +27,20 @@ Eigen::MatrixXf AliasedRoute(int n, int period, float signature = 0.0F) {
     p(2, i) = signature * (static_cast<float>(state >> 8) / 16777216.0F - 0.5F);
   }
   return p;
+}
+
+// A route whose place i looks like the value i: every place is distinct.
+Eigen::MatrixXf LinearRoute(int n) {
+  Eigen::MatrixXf route(1, n);
+  for (int i = 0; i < n; ++i) route(0, i) = static_cast<float>(i);
+  return route;
+}
+
+// An image that looks like place `place` of a LinearRoute.
+Eigen::VectorXf LooksLike(float place) {
+  Eigen::VectorXf image(1);
+  image << place;
+  return image;
 }
 
 TEST(NearestProjection, FindsTheClosestColumn) {
@@ -105,12 +120,9 @@ TEST(MarkovLocalizer, FollowsARouteThatGrowsWhileItIsUsed) {
 // peak has underflowed to zero and never comes back; with 1% uniform mixing it moves to place 60.
 TEST(MarkovLocalizer, UniformMixingLetsAWrongBeliefGiveWay) {
   const int n = 100;
-  Eigen::MatrixXf route(1, n);
-  for (int i = 0; i < n; ++i) route(0, i) = static_cast<float>(i);
-  Eigen::VectorXf twin(1);
-  twin << 20.0F;
-  Eigen::VectorXf truth(1);
-  truth << 60.0F;
+  const Eigen::MatrixXf route = LinearRoute(n);
+  const Eigen::VectorXf twin = LooksLike(20.0F);
+  const Eigen::VectorXf truth = LooksLike(60.0F);
   for (const double mixing : {0.0, 0.01}) {
     MarkovOptions options;
     options.uniform_mixing = mixing;
@@ -127,60 +139,48 @@ TEST(MarkovLocalizer, UniformMixingLetsAWrongBeliefGiveWay) {
   }
 }
 
-// The robot is at place 10 but its images look like place 25 (an aliased twin further along).
-// Without a limit the belief goes to 25; with the belief limited to place 14 (it cannot have got
-// further) it stays at or before 14, the mass beyond is zero, and lifting the limit lets it go.
-TEST(MarkovLocalizer, AMaximumIndexKeepsTheBeliefFromRunningAhead) {
+// The images look like place 25, an aliased twin of where the robot is. Unlimited, the belief
+// (with 1% uniform mixing: it may go anywhere) moves to 25 after `updates` updates from a belief
+// around `start`; limited to [min_index, max_index], it stays inside and holds no mass outside.
+void ExpectLimitsHold(double start, int min_index, int max_index) {
   const int n = 60;
-  Eigen::MatrixXf route(1, n);
-  for (int i = 0; i < n; ++i) route(0, i) = static_cast<float>(i);
-  Eigen::VectorXf twin(1);
-  twin << 25.0F;
-  MarkovOptions options;
-  options.uniform_mixing = 0.01;  // even a belief that may be anywhere stays within the limit
-  for (const int limit : {-1, 14}) {
-    MarkovLocalizer markov(options);
-    markov.ResetAt(n, 10.0, 2.0);
-    markov.set_index_limits(-1, limit);
-    Localization loc;
-    for (int t = 0; t < 20; ++t) loc = markov.Update(route, twin, 0.0);
-    if (limit < 0) {
-      EXPECT_EQ(loc.index, 25);
-    } else {
-      EXPECT_LE(loc.index, 14);
-      EXPECT_GE(loc.index, 10);
-      EXPECT_EQ(markov.belief().tail(n - 15).sum(), 0.0);
-      EXPECT_NEAR(markov.belief().sum(), 1.0, 1e-9);
-      markov.set_index_limits(-1, -1);
-      for (int t = 0; t < 20; ++t) loc = markov.Update(route, twin, 0.0);
-      EXPECT_EQ(loc.index, 25);
-    }
-  }
-}
-
-// The same from the other side: at place 40, images like place 25 (a twin behind); limited to
-// places 36 and on, the belief stays there.
-TEST(MarkovLocalizer, AMinimumIndexKeepsTheBeliefFromFallingBack) {
-  const int n = 60;
-  Eigen::MatrixXf route(1, n);
-  for (int i = 0; i < n; ++i) route(0, i) = static_cast<float>(i);
-  Eigen::VectorXf twin(1);
-  twin << 25.0F;
+  const Eigen::MatrixXf route = LinearRoute(n);
+  const Eigen::VectorXf twin = LooksLike(25.0F);
   MarkovOptions options;
   options.uniform_mixing = 0.01;
-  for (const int limit : {-1, 36}) {
-    MarkovLocalizer markov(options);
-    markov.ResetAt(n, 40.0, 2.0);
-    markov.set_index_limits(limit, -1);
-    Localization loc;
-    for (int t = 0; t < 20; ++t) loc = markov.Update(route, twin, 0.0);
-    if (limit < 0) {
-      EXPECT_EQ(loc.index, 25);
-    } else {
-      EXPECT_GE(loc.index, 36);
-      EXPECT_EQ(markov.belief().head(36).sum(), 0.0);
-    }
+  MarkovLocalizer unlimited(options);
+  MarkovLocalizer limited(options);
+  unlimited.ResetAt(n, start, 2.0);
+  limited.ResetAt(n, start, 2.0);
+  limited.set_index_limits(min_index, max_index);
+  Localization free_loc;
+  Localization loc;
+  for (int t = 0; t < 20; ++t) {
+    free_loc = unlimited.Update(route, twin, 0.0);
+    loc = limited.Update(route, twin, 0.0);
   }
+  EXPECT_EQ(free_loc.index, 25);
+  const int lo = std::max(min_index, 0);
+  const int hi = max_index < 0 ? n - 1 : max_index;
+  EXPECT_GE(loc.index, lo);
+  EXPECT_LE(loc.index, hi);
+  EXPECT_EQ(limited.belief().head(lo).sum() + limited.belief().tail(n - 1 - hi).sum(), 0.0);
+  EXPECT_NEAR(limited.belief().sum(), 1.0, 1e-9);
+  // Lifted, the limits no longer hold the belief.
+  limited.set_index_limits(-1, -1);
+  for (int t = 0; t < 20; ++t) loc = limited.Update(route, twin, 0.0);
+  EXPECT_EQ(loc.index, 25);
+}
+
+// At place 10, images like place 25 further along: a robot that cannot have got past place 14
+// stays at or before it.
+TEST(MarkovLocalizer, AMaximumIndexKeepsTheBeliefFromRunningAhead) {
+  ExpectLimitsHold(10.0, -1, 14);
+}
+
+// At place 40, images like place 25 behind: a robot that cannot be before place 36 stays there.
+TEST(MarkovLocalizer, AMinimumIndexKeepsTheBeliefFromFallingBack) {
+  ExpectLimitsHold(40.0, 36, -1);
 }
 
 TEST(MarkovOptions, RejectsBadValuesNamingTheField) {

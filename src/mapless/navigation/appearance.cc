@@ -1,9 +1,8 @@
 #include "mapless/navigation/appearance.h"
 
-#include <opencv2/core.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <opencv2/core.hpp>
 
 #include "mapless/core/check.h"
 #include "mapless/localization/nearest.h"
@@ -60,7 +59,8 @@ void AppearanceLeader::Finish() {
   finished_ = true;
   if (options_.incremental || vectors_.empty()) return;
   appearance::Matrix data(vectors_.front().size(), static_cast<Eigen::Index>(vectors_.size()));
-  for (std::size_t i = 0; i < vectors_.size(); ++i) data.col(static_cast<Eigen::Index>(i)) = vectors_[i];
+  for (std::size_t i = 0; i < vectors_.size(); ++i)
+    data.col(static_cast<Eigen::Index>(i)) = vectors_[i];
   batch_ = appearance::BatchPcaSvd(data, options_.pca.max_dimensions);
 }
 
@@ -98,19 +98,19 @@ void AppearanceFollowerOptions::Validate() const {
   camera.Validate();
   markov.Validate();
   clustering.Validate();
-  MAPLESS_CHECK(init_turn_rad >= 0.0 && init_turn_rad < kPi,
-                "AppearanceFollowerOptions.init_turn_rad = " << init_turn_rad
-                                                             << "; must be in [0, pi)");
+  MAPLESS_CHECK(
+      init_turn_rad >= 0.0 && init_turn_rad < kPi,
+      "AppearanceFollowerOptions.init_turn_rad = " << init_turn_rad << "; must be in [0, pi)");
   MAPLESS_CHECK(init_turn_rate_radps > 0.0, "AppearanceFollowerOptions.init_turn_rate_radps = "
                                                 << init_turn_rate_radps << "; must be > 0");
-  MAPLESS_CHECK(init_forward_m >= 0.0,
-                "AppearanceFollowerOptions.init_forward_m = " << init_forward_m << "; must be >= 0");
+  MAPLESS_CHECK(init_forward_m >= 0.0, "AppearanceFollowerOptions.init_forward_m = "
+                                           << init_forward_m << "; must be >= 0");
   MAPLESS_CHECK(init_forward_speed_mps > 0.0, "AppearanceFollowerOptions.init_forward_speed_mps = "
                                                   << init_forward_speed_mps << "; must be > 0");
   MAPLESS_CHECK(init_sigma_images > 0.0, "AppearanceFollowerOptions.init_sigma_images = "
                                              << init_sigma_images << "; must be > 0");
-  MAPLESS_CHECK(start_window_m >= 0.0,
-                "AppearanceFollowerOptions.start_window_m = " << start_window_m << "; must be >= 0");
+  MAPLESS_CHECK(start_window_m >= 0.0, "AppearanceFollowerOptions.start_window_m = "
+                                           << start_window_m << "; must be >= 0");
   MAPLESS_CHECK(arrive_min_probability >= 0.0 && arrive_min_probability <= 1.0,
                 "AppearanceFollowerOptions.arrive_min_probability = " << arrive_min_probability
                                                                       << "; must be in [0, 1]");
@@ -123,10 +123,10 @@ void AppearanceFollowerOptions::Validate() const {
                     << relocalize_after_stopped_frames << "; must be >= 1");
   MAPLESS_CHECK(uniform_mixing_for_m >= 0.0, "AppearanceFollowerOptions.uniform_mixing_for_m = "
                                                  << uniform_mixing_for_m << "; must be >= 0");
-  MAPLESS_CHECK(behind_fraction >= 0.0,
-                "AppearanceFollowerOptions.behind_fraction = " << behind_fraction << "; must be >= 0");
-  MAPLESS_CHECK(ahead_fraction >= 0.0,
-                "AppearanceFollowerOptions.ahead_fraction = " << ahead_fraction << "; must be >= 0");
+  MAPLESS_CHECK(behind_fraction >= 0.0, "AppearanceFollowerOptions.behind_fraction = "
+                                            << behind_fraction << "; must be >= 0");
+  MAPLESS_CHECK(ahead_fraction >= 0.0, "AppearanceFollowerOptions.ahead_fraction = "
+                                           << ahead_fraction << "; must be >= 0");
   MAPLESS_CHECK(markov_update_images >= 0.0, "AppearanceFollowerOptions.markov_update_images = "
                                                  << markov_update_images << "; must be >= 0");
   MAPLESS_CHECK(lookahead_images >= 0, "AppearanceFollowerOptions.lookahead_images = "
@@ -183,7 +183,8 @@ FollowerStep AppearanceFollower::Initialize(const appearance::Vector& projection
   }
   init_localizations_.push_back(
       from + localization::NearestProjection(
-                 route.space.projections.middleCols(from, to - from + 1), projection).index);
+                 route.space.projections.middleCols(from, to - from + 1), projection)
+                 .index);
   step.index = init_localizations_.back();
   const double turned = WrapAngle(odometry.theta_rad - init_start_.theta_rad);
   const double theta = options_.init_turn_rad;
@@ -192,7 +193,8 @@ FollowerStep AppearanceFollower::Initialize(const appearance::Vector& projection
   if (init_phase_ == 0 && turned >= theta) init_phase_ = 1;
   if (init_phase_ == 1 && turned <= -theta) init_phase_ = 2;
   if (init_phase_ == 2 && turned >= 0.0) init_phase_ = 3;
-  if (init_phase_ == 3 && odometry.DistanceTo(init_start_) >= options_.init_forward_m) init_phase_ = 4;
+  if (init_phase_ == 3 && odometry.DistanceTo(init_start_) >= options_.init_forward_m)
+    init_phase_ = 4;
   switch (init_phase_) {
     case 0:
     case 2:
@@ -294,24 +296,28 @@ FollowerStep AppearanceFollower::Decide(const cv::Mat& image, const Pose2& odome
     if (!have_localization_ || std::abs(pending_advance_images_) >= options_.markov_update_images ||
         route.size() != last_route_size_) {
       if (options_.ahead_margin_m >= 0.0 && options_.start_window_m > 0.0 && start_index_ >= 0) {
-        const double ahead_m = driven_m_ * (1.0 + options_.ahead_fraction) + options_.ahead_margin_m;
-        const double behind_m = driven_m_ * (1.0 - options_.behind_fraction) - options_.ahead_margin_m -
-                                options_.start_window_m;
+        const double ahead_m =
+            driven_m_ * (1.0 + options_.ahead_fraction) + options_.ahead_margin_m;
+        const double behind_m = driven_m_ * (1.0 - options_.behind_fraction) -
+                                options_.ahead_margin_m - options_.start_window_m;
         markov_.set_index_limits(
-            options_.behind_fraction < 1.0 ? start_index_ + static_cast<int>(std::floor(behind_m / spacing)) : -1,
+            options_.behind_fraction < 1.0
+                ? start_index_ + static_cast<int>(std::floor(behind_m / spacing))
+                : -1,
             start_index_ + static_cast<int>(std::ceil(ahead_m / spacing)));
       }
       markov_.set_uniform_mixing(since_localized_m_ < options_.uniform_mixing_for_m
                                      ? options_.markov.uniform_mixing
                                      : 0.0);
-      last_localization_ = markov_.Update(route.space.projections, projection, pending_advance_images_);
+      last_localization_ =
+          markov_.Update(route.space.projections, projection, pending_advance_images_);
       pending_advance_images_ = 0.0;
       have_localization_ = true;
       last_route_size_ = route.size();
     }
     const localization::Localization& loc = last_localization_;
-    step.index = std::clamp(loc.index + static_cast<int>(std::lround(pending_advance_images_)), 0,
-                            n - 1);
+    step.index =
+        std::clamp(loc.index + static_cast<int>(std::lround(pending_advance_images_)), 0, n - 1);
     step.probability = loc.probability;
     if (loc.status == localization::LocalizationStatus::kLost) {
       StartInitialization(odometry, loc.index);

@@ -66,8 +66,9 @@ class AppearanceLeader {
 };
 
 struct AppearanceFollowerOptions {
-  AppearanceFollowerOptions();  // sets markov.uniform_mixing = 0.01 (used only with uniform_mixing_for_m > 0)
-  bool use_markov = true;  // false: nearest projection every frame (Section 3 alone)
+  AppearanceFollowerOptions();  // sets markov.uniform_mixing = 0.01 (used only with
+                                // uniform_mixing_for_m > 0)
+  bool use_markov = true;       // false: nearest projection every frame (Section 3 alone)
   appearance::AppearanceImageOptions image;
   appearance::SubWindowOptions windows;
   control::SubWindowSteeringOptions steering;
@@ -115,12 +116,12 @@ struct AppearanceFollowerOptions {
   // docs/appearance_route_following.md). Negative ahead_margin_m: no limits; behind_fraction >= 1:
   // no lower limit.
   double ahead_margin_m = 0.3;
-  double ahead_fraction = 0.05;   // the odometry may under-report the distance by this fraction
-  double behind_fraction = 0.1;   // ... and the path be this much longer than the route (detours)
-  int lookahead_images = 1;        // steer towards the route image this far ahead of the position
-  int arrive_within_images = 1;    // arrived at the end of a complete route within this many
-  int wait_within_images = 2;      // wait for a leader this close to the end it has taught so far
-  CameraCheckOptions camera;       // camera faults: stop until the images are usable again
+  double ahead_fraction = 0.05;  // the odometry may under-report the distance by this fraction
+  double behind_fraction = 0.1;  // ... and the path be this much longer than the route (detours)
+  int lookahead_images = 1;      // steer towards the route image this far ahead of the position
+  int arrive_within_images = 1;  // arrived at the end of a complete route within this many
+  int wait_within_images = 2;    // wait for a leader this close to the end it has taught so far
+  CameraCheckOptions camera;     // camera faults: stop until the images are usable again
   void Validate() const;
 };
 
@@ -143,7 +144,8 @@ class AppearanceFollower {
   // One control period: the current image, the odometry and the latest route snapshot. A camera
   // fault stops the robot (kStopped, or kInitializing while it localizes) with the fault as the
   // reason; the frame is otherwise ignored, so localization resumes where it was.
-  FollowerStep Update(const cv::Mat& image, const Pose2& odometry, const route::AppearanceRoute& route);
+  FollowerStep Update(const cv::Mat& image, const Pose2& odometry,
+                      const route::AppearanceRoute& route);
 
  private:
   FollowerStep Decide(const cv::Mat& image, const Pose2& odometry,
