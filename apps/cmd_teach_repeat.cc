@@ -29,6 +29,7 @@ nlohmann::json StepJson(int frame, Timestamp t_ns, const navigation::RepeatStep&
   j["switched"] = s.switched;
   j["std_ratio"] = s.switching.std_ratio;
   j["ed_px"] = s.switching.ed_px;
+  if (s.local_scale.ok) j["local_scale"] = s.local_scale.ratio;
   j["slope_x"] = s.sloped.slope_x;
   j["slope_y"] = s.sloped.slope_y;
   j["v_mps"] = s.command.v_mps;

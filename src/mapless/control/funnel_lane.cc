@@ -195,6 +195,42 @@ SwitchDecision CheckSwitch(const std::vector<FeaturePair>& features, const Switc
   return d;
 }
 
+void LocalScaleOptions::Validate() const {
+  MAPLESS_CHECK(min_pair_px > 0.0,
+                "LocalScaleOptions.min_pair_px = " << min_pair_px << "; must be > 0");
+  MAPLESS_CHECK(max_pair_px > min_pair_px,
+                "LocalScaleOptions.max_pair_px = " << max_pair_px << "; must be > min_pair_px");
+  MAPLESS_CHECK(min_pairs >= 1, "LocalScaleOptions.min_pairs = " << min_pairs << "; must be >= 1");
+}
+
+LocalScale MeasureLocalScale(const std::vector<FeaturePoint>& features,
+                             const LocalScaleOptions& options) {
+  LocalScale s;
+  std::vector<double> log_ratios;
+  const double min2 = options.min_pair_px * options.min_pair_px;
+  const double max2 = options.max_pair_px * options.max_pair_px;
+  for (std::size_t a = 0; a < features.size(); ++a) {
+    const FeaturePoint& fa = features[a];
+    for (std::size_t b = a + 1; b < features.size(); ++b) {
+      const FeaturePoint& fb = features[b];
+      const double djx = fa.x_destination_px - fb.x_destination_px;
+      const double djy = fa.y_destination_px - fb.y_destination_px;
+      const double dj2 = djx * djx + djy * djy;
+      if (dj2 < min2 || dj2 > max2) continue;
+      const double dcx = fa.x_current_px - fb.x_current_px;
+      const double dcy = fa.y_current_px - fb.y_current_px;
+      const double dc2 = dcx * dcx + dcy * dcy;
+      if (dc2 <= 0.0) continue;
+      log_ratios.push_back(0.5 * std::log(dc2 / dj2));
+    }
+  }
+  s.pairs = static_cast<int>(log_ratios.size());
+  if (s.pairs < options.min_pairs) return s;
+  s.ok = true;
+  s.ratio = std::exp(Median(std::move(log_ratios)));
+  return s;
+}
+
 bool MseSwitch::Update(const std::vector<FeaturePair>& features) {
   if (features.empty()) return false;
   double mse = 0.0;

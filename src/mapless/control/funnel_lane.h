@@ -112,6 +112,40 @@ struct SwitchDecision {
 // (the current features spread at least as wide as the keyframe's) and ED < max_ed_px.
 SwitchDecision CheckSwitch(const std::vector<FeaturePair>& features, const SwitchOptions& options);
 
+// ---- The route's end (not in the paper) --------------------------------------------------------
+
+// One feature matched between the current image and the destination keyframe, both coordinates.
+struct FeaturePoint {
+  double x_current_px = 0.0;
+  double y_current_px = 0.0;
+  double x_destination_px = 0.0;
+  double y_destination_px = 0.0;
+};
+
+struct LocalScaleOptions {
+  // Pairs of features whose keyframe positions are this far apart (px) are compared: near enough
+  // to lie on one object (one depth), far enough for the pixel noise to matter little.
+  double min_pair_px = 6.0;
+  double max_pair_px = 40.0;
+  int min_pairs = 20;  // fewer: no estimate
+  void Validate() const;
+};
+
+struct LocalScale {
+  bool ok = false;
+  double ratio = 0.0;  // median over pairs of |p_c,a - p_c,b| / |p_j,a - p_j,b|
+  int pairs = 0;
+};
+
+// How much larger the scene looks now than in the destination keyframe, measured object by object:
+// the median over nearby feature pairs of the ratio of their image distances. For two points at
+// one depth the ratio is Z_keyframe / Z_now whatever the robot's lateral offset, so the median
+// crosses 1 where the robot reaches the keyframe along its heading, also off the taught path.
+// StdRatio mixes all depths: off to one side, the nearer side's features spread wider and it
+// crosses 1 up to 0.7 m early (see docs/teach_and_repeat.md).
+LocalScale MeasureLocalScale(const std::vector<FeaturePoint>& features,
+                             const LocalScaleOptions& options);
+
 // Chen & Birchfield's criterion: switch when the mean squared error between current and
 // destination coordinates, after decreasing, increases for `rising_frames` frames in a row.
 class MseSwitch {

@@ -131,6 +131,64 @@ TEST(MseSwitch, SwitchesWhenTheErrorRisesAfterFalling) {
   EXPECT_FALSE(s.Update(Map(kDest, 1.4, 0.0)));
 }
 
+// A pinhole view (f = 277 px, as a 60 degree 320 px camera) of a near object on the right (a car's
+// side, 2.5 m ahead) and a far wall (12 m ahead, mostly left), from a camera `lateral_m` to the
+// side of the keyframe's (negative: left) and `before_m` short of it.
+std::vector<FeaturePoint> View(double lateral_m, double before_m) {
+  const double f = 277.0;
+  struct P3 {
+    double x, y, z;
+  };
+  std::vector<P3> scene;
+  for (double x = 1.0; x <= 2.21; x += 0.15)
+    for (double y = -0.4; y <= 0.61; y += 0.2) scene.push_back({x, y, 2.5});
+  for (double x = -4.0; x <= 1.01; x += 0.5)
+    for (double y = -0.4; y <= 2.61; y += 0.5) scene.push_back({x, y, 12.0});
+  std::vector<FeaturePoint> out;
+  for (const P3& p : scene) {
+    out.push_back({f * (p.x - lateral_m) / (p.z + before_m), f * p.y / (p.z + before_m),
+                   f * p.x / p.z, f * p.y / p.z});
+  }
+  return out;
+}
+
+std::vector<FeaturePair> XOnly(const std::vector<FeaturePoint>& points) {
+  std::vector<FeaturePair> out;
+  for (const FeaturePoint& p : points) out.push_back({p.x_current_px, p.x_destination_px});
+  return out;
+}
+
+TEST(LocalScale, CrossesOneAtTheKeyframeAlsoOffThePathWhereStdRatioDoesNot) {
+  // On the taught path both say "not yet" before the keyframe and "there" at it.
+  EXPECT_LT(CheckSwitch(XOnly(View(0.0, 0.3)), {}).std_ratio, 1.0);
+  EXPECT_LT(MeasureLocalScale(View(0.0, 0.3), {}).ratio, 1.0);
+  EXPECT_NEAR(MeasureLocalScale(View(0.0, 0.0), {}).ratio, 1.0, 1e-9);
+  // 0.3 m to the left the near object's features spread wider: StdRatio passes 1 well before the
+  // keyframe, the local scale does not.
+  EXPECT_GT(CheckSwitch(XOnly(View(-0.3, 0.3)), {}).std_ratio, 1.0);
+  const LocalScale before = MeasureLocalScale(View(-0.3, 0.3), {});
+  ASSERT_TRUE(before.ok);
+  EXPECT_LT(before.ratio, 1.0);
+  EXPECT_GE(before.pairs, LocalScaleOptions{}.min_pairs);
+  EXPECT_NEAR(MeasureLocalScale(View(-0.3, 0.0), {}).ratio, 1.0, 1e-9);
+  EXPECT_GT(MeasureLocalScale(View(-0.3, -0.1), {}).ratio, 1.0);  // passed it
+}
+
+TEST(LocalScale, NeedsEnoughNearbyPairs) {
+  // Features far apart in the keyframe lie on different objects: no pair qualifies.
+  std::vector<FeaturePoint> sparse;
+  for (int i = 0; i < 6; ++i) sparse.push_back({60.0 * i, 0.0, 50.0 * i, 0.0});
+  const LocalScale s = MeasureLocalScale(sparse, {});
+  EXPECT_FALSE(s.ok);
+  EXPECT_EQ(s.pairs, 0);
+  LocalScaleOptions wide;
+  wide.max_pair_px = 120.0;
+  wide.min_pairs = 5;
+  const LocalScale w = MeasureLocalScale(sparse, wide);
+  ASSERT_TRUE(w.ok);
+  EXPECT_NEAR(w.ratio, 1.2, 1e-9);
+}
+
 TEST(FunnelLaneOptions, InvalidValuesNameTheField) {
   SlopedFunnelLaneOptions o;
   o.turn_threshold = -0.2;
@@ -140,6 +198,16 @@ TEST(FunnelLaneOptions, InvalidValuesNameTheField) {
   } catch (const InputError& e) {
     EXPECT_NE(
         std::string(e.what()).find("SlopedFunnelLaneOptions.turn_threshold = -0.2; must be >= 0"),
+        std::string::npos);
+  }
+  LocalScaleOptions l;
+  l.max_pair_px = 5.0;
+  try {
+    l.Validate();
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(
+        std::string(e.what()).find("LocalScaleOptions.max_pair_px = 5; must be > min_pair_px"),
         std::string::npos);
   }
 }

@@ -56,6 +56,7 @@ void RepeatOptions::Validate() const {
   sloped.Validate();
   standard.Validate();
   switch_rule.Validate();
+  local_scale.Validate();
   MAPLESS_CHECK(min_features >= 2,
                 "RepeatOptions.min_features = " << min_features << "; must be >= 2");
   MAPLESS_CHECK(redetect_every_frames >= 0, "RepeatOptions.redetect_every_frames = "
@@ -245,10 +246,25 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
   std::vector<control::FeaturePair> pairs = Pairs();
   step.switching = control::CheckSwitch(pairs, options_.switch_rule);
   const bool enough = static_cast<int>(pairs.size()) >= options_.min_switch_features;
-  switch_votes_ = (step.switching.switch_now && enough) ? switch_votes_ + 1 : 0;
   const bool last = destination_ + 1 >= static_cast<int>(route_->keyframes.size());
+  const bool end_by_scale = last && options_.end_by_local_scale;
+  bool condition = step.switching.switch_now;
+  if (end_by_scale) {
+    // The route's end: the local scale instead of StdRatio (see RepeatOptions).
+    std::vector<control::FeaturePoint> points;
+    points.reserve(current_px_.size());
+    for (std::size_t i = 0; i < current_px_.size(); ++i) {
+      points.push_back(
+          {current_px_[i].x, current_px_[i].y, destination_px_[i].x, destination_px_[i].y});
+    }
+    step.local_scale = control::MeasureLocalScale(points, options_.local_scale);
+    condition = step.local_scale.ok &&
+                step.local_scale.ratio > options_.switch_rule.min_std_ratio &&
+                step.switching.ed_px < options_.switch_rule.max_ed_px;
+  }
+  switch_votes_ = (condition && enough) ? switch_votes_ + 1 : 0;
   const int confirm = last ? options_.final_confirm_frames : options_.switch_confirm_frames;
-  const bool switch_now = options_.switching == Switching::kStdRatio
+  const bool switch_now = options_.switching == Switching::kStdRatio || end_by_scale
                               ? switch_votes_ >= confirm
                               : (mse_.Update(pairs) && enough);
   if (switch_now) {

@@ -41,10 +41,18 @@ struct RepeatOptions {
   control::StandardFunnelLaneOptions standard;
   control::SwitchOptions switch_rule;
   int mse_rising_frames = 2;
-  int switch_confirm_frames = 3;     // the StdRatio/ED condition must hold this many frames
+  int switch_confirm_frames = 3;  // the StdRatio/ED condition must hold this many frames
   // ... and this many for the last keyframe, whose switch ends the route: an early end cannot be
   // caught up by a later segment.
   int final_confirm_frames = 3;
+  // The route's end (not in the paper): the last keyframe counts as passed when the local scale
+  // (control::MeasureLocalScale) exceeds min_std_ratio and ED < max_ed_px for
+  // final_confirm_frames frames, whatever `switching` is. Off the taught path StdRatio crosses 1
+  // up to 0.7 m early, and an early end cannot be caught up by a later segment; the local scale
+  // compares features on one object with each other, which a lateral offset does not change.
+  // false: the last keyframe is switched like the others.
+  bool end_by_local_scale = true;
+  control::LocalScaleOptions local_scale;
   int min_switch_features = 20;      // no switching on fewer features (their spread is noise)
   double ransac_threshold_px = 3.0;  // outlier rejection of matches by a fundamental matrix
                                      // (RANSAC, needs no calibration); 0 disables it
@@ -78,6 +86,7 @@ struct RepeatStep {
   bool redetected = false;  // features were detected and matched this frame
   bool switched = false;    // the segment switched this frame
   control::SwitchDecision switching;
+  control::LocalScale local_scale;  // measured on the last segment only (end_by_local_scale)
   control::SlopedFunnelLaneResult sloped;
   control::StandardFunnelLaneResult standard;
   Twist2 command;  // zero unless driving
