@@ -76,6 +76,7 @@ void AddDemoCommand(CLI::App* app) {
                            {"v_mps", s.command.v_mps},
                            {"omega_radps", s.command.omega_radps},
                            {"status", navigation::RepeatStatusName(s.status)}};
+          if (s.local_scale.ok) j["local_scale"] = s.local_scale.ratio;
           log.Write(j);
         });
     const cv::Mat top =

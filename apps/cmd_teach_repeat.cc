@@ -113,6 +113,7 @@ void AddTeachRepeatCommands(CLI::App* app) {
     std::string source;
     std::string controller = "sloped";
     std::string switching = "stdratio";
+    std::string end = "scale";
     std::string log;
     std::uint64_t seed = 1;
     double motion_noise = 0.1;
@@ -130,6 +131,11 @@ void AddTeachRepeatCommands(CLI::App* app) {
   repeat
       ->add_option("--switching", r->switching,
                    "stdratio (Kassir et al.) or mse (Chen & Birchfield)")
+      ->capture_default_str();
+  repeat
+      ->add_option("--end", r->end,
+                   "How the last keyframe is passed: scale (local scale of nearby features, "
+                   "robust to a lateral offset) or switching (like every other keyframe)")
       ->capture_default_str();
   repeat->add_option("--log", r->log,
                      "Per-frame decisions as JSON lines to this file (default: stdout)");
@@ -153,6 +159,9 @@ void AddTeachRepeatCommands(CLI::App* app) {
       options.switching = navigation::Switching::kMse;
     else
       throw InputError("--switching '" + r->switching + "': expected stdratio or mse");
+    if (r->end != "scale" && r->end != "switching")
+      throw InputError("--end '" + r->end + "': expected scale or switching");
+    options.end_by_local_scale = r->end == "scale";
     options.features.type = features::ParseDetectorType(route->detector);
     JsonLines log(r->log);
     int frame_index = 0;

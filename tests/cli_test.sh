@@ -149,6 +149,12 @@ grep -q "already holds a route" "$TMP/err"; check "overwrite refusal is explaine
 expect_exit "repeat open loop" 0 "$MAPLESS" repeat --route "$TMP/route" --source "$TMP/d1/frames" --log "$TMP/rep.jsonl"
 [ "$(wc -l <"$TMP/rep.jsonl")" -eq "$n_frames" ]; check "one decision line per frame" $?
 head -1 "$TMP/rep.jsonl" | grep -q '"destination":' && head -1 "$TMP/rep.jsonl" | grep -q '"v_mps":'; check "decision lines carry segment and command" $?
+# The route's end: the local scale by default, the paper's StdRatio with --end switching.
+expect_exit "teach on the simulator" 0 "$MAPLESS" teach --source sim:rotation_in_place --out "$TMP/simroute"
+expect_exit "repeat with the paper's end rule" 0 "$MAPLESS" repeat --route "$TMP/simroute" --source sim:rotation_in_place --end switching --log "$TMP/rep2.jsonl"
+tail -1 "$TMP/rep2.jsonl" | grep -q '"status":"completed"' && ! grep -q '"local_scale":' "$TMP/rep2.jsonl"; check "--end switching completes without the local scale" $?
+expect_exit "unknown --end exits 2" 2 "$MAPLESS" repeat --route "$TMP/route" --source "$TMP/d1/frames" --end sideways
+grep -q "\-\-end 'sideways'" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "unknown --end names the value in one line" $?
 
 # Bad routes: one line naming the file, exit 2, never a crash.
 expect_exit "missing route exits 2" 2 "$MAPLESS" repeat --route "$TMP/nothing" --source "$TMP/d1/frames"
@@ -164,7 +170,7 @@ grep -q "manifest.json: corrupt manifest" "$TMP/err"; check "truncated manifest 
 # A teach killed with SIGKILL leaves a route that loads, with every keyframe completed before.
 "$MAPLESS" teach --source sim:outdoor_70m --out "$TMP/killed" >/dev/null 2>&1 &
 pid=$!
-for _ in $(seq 1 100); do [ -f "$TMP/killed/keyframes/000002.png" ] && break; sleep 0.05; done
+for _ in $(seq 1 400); do [ -f "$TMP/killed/keyframes/000002.png" ] && break; sleep 0.05; done
 if kill -9 "$pid" 2>/dev/null; then
   wait "$pid" 2>/dev/null
   expect_exit "killed teach: route loads" 0 "$MAPLESS" route info "$TMP/killed" --json
@@ -176,7 +182,7 @@ fi
 # A recording killed with SIGKILL keeps every frame it finished: listed, with whole poses.
 "$MAPLESS" sim drive --scenario outdoor_70m --out "$TMP/killedrec" >/dev/null 2>&1 &
 pid=$!
-for _ in $(seq 1 200); do [ -f "$TMP/killedrec/frames/000020.png" ] && break; sleep 0.05; done
+for _ in $(seq 1 400); do [ -f "$TMP/killedrec/frames/000020.png" ] && break; sleep 0.05; done
 if kill -9 "$pid" 2>/dev/null; then
   wait "$pid" 2>/dev/null
   [ ! -f "$TMP/killedrec/summary.json" ]; check "killed recording: it was killed before its end" $?
@@ -199,6 +205,7 @@ for f in topdown.png summary.json repeat.jsonl route/manifest.json teach/groundt
   [ -s "$TMP/demo/$f" ]; check "demo writes $f" $?
 done
 grep -q '"success": true' "$TMP/demo/summary.json"; check "demo repeat succeeded" $?
+tail -1 "$TMP/demo/repeat.jsonl" | grep -q '"status":"completed"' && tail -1 "$TMP/demo/repeat.jsonl" | grep -Eq '"local_scale":1\.'; check "the route ends on a local scale above 1" $?
 
 # Bench: one JSON object with the render stage and its reference.
 expect_exit "bench --json" 0 "$MAPLESS" bench --json --repeats 5

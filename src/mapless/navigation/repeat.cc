@@ -247,10 +247,9 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
   step.switching = control::CheckSwitch(pairs, options_.switch_rule);
   const bool enough = static_cast<int>(pairs.size()) >= options_.min_switch_features;
   const bool last = destination_ + 1 >= static_cast<int>(route_->keyframes.size());
-  const bool end_by_scale = last && options_.end_by_local_scale;
-  bool condition = step.switching.switch_now;
-  if (end_by_scale) {
-    // The route's end: the local scale instead of StdRatio (see RepeatOptions).
+  // The route's end: the local scale instead of StdRatio (see RepeatOptions); with too few nearby
+  // pairs (a sparse view), the rule of every other keyframe.
+  if (last && options_.end_by_local_scale) {
     std::vector<control::FeaturePoint> points;
     points.reserve(current_px_.size());
     for (std::size_t i = 0; i < current_px_.size(); ++i) {
@@ -258,15 +257,16 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
           {current_px_[i].x, current_px_[i].y, destination_px_[i].x, destination_px_[i].y});
     }
     step.local_scale = control::MeasureLocalScale(points, options_.local_scale);
-    condition = step.local_scale.ok &&
-                step.local_scale.ratio > options_.switch_rule.min_std_ratio &&
-                step.switching.ed_px < options_.switch_rule.max_ed_px;
   }
+  const bool by_scale = step.local_scale.ok;
+  const bool condition = by_scale ? step.local_scale.ratio > options_.switch_rule.min_std_ratio &&
+                                        step.switching.ed_px < options_.switch_rule.max_ed_px
+                                  : step.switching.switch_now;
   switch_votes_ = (condition && enough) ? switch_votes_ + 1 : 0;
+  const bool mse_says = options_.switching == Switching::kMse && mse_.Update(pairs) && enough;
   const int confirm = last ? options_.final_confirm_frames : options_.switch_confirm_frames;
-  const bool switch_now = options_.switching == Switching::kStdRatio || end_by_scale
-                              ? switch_votes_ >= confirm
-                              : (mse_.Update(pairs) && enough);
+  const bool switch_now =
+      options_.switching == Switching::kStdRatio || by_scale ? switch_votes_ >= confirm : mse_says;
   if (switch_now) {
     step.switched = true;
     ++destination_;

@@ -50,7 +50,8 @@ struct RepeatOptions {
   // final_confirm_frames frames, whatever `switching` is. Off the taught path StdRatio crosses 1
   // up to 0.7 m early, and an early end cannot be caught up by a later segment; the local scale
   // compares features on one object with each other, which a lateral offset does not change.
-  // false: the last keyframe is switched like the others.
+  // With fewer than local_scale.min_pairs nearby pairs the last keyframe is switched like the
+  // others. false: always like the others (the paper).
   bool end_by_local_scale = true;
   control::LocalScaleOptions local_scale;
   int min_switch_features = 20;      // no switching on fewer features (their spread is noise)
