@@ -112,7 +112,8 @@ void RunEigenspaceSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
   std::vector<eval::EigenspaceEntry> entries;
   for (const auto& e : eval::EigenspaceSuiteEntries())
     if (only.empty() || e.scenario == only) entries.push_back(e);
-  if (entries.empty()) throw InputError("--only '" + only + "': not a scenario of suite eigenspace");
+  if (entries.empty())
+    throw InputError("--only '" + only + "': not a scenario of suite eigenspace");
   std::vector<eval::EigenspaceEntryResult> results(entries.size());
   RunInBatches(entries.size(), jobs, [&](std::size_t k) {
     results[k] = eval::RunEigenspaceEntry(entries[k], runs, seed);
@@ -149,6 +150,8 @@ void AddEvalCommand(CLI::App* app) {
     bool json = false;
     int jobs = 1;
     std::string only;
+    std::string switching = "stdratio";
+    std::string end = "scale";
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app->add_subcommand(
@@ -165,7 +168,23 @@ void AddEvalCommand(CLI::App* app) {
       ->capture_default_str()
       ->check(CLI::Range(1, 64));
   cmd->add_option("--only", args->only, "Evaluate only this scenario of the suite");
+  cmd->add_option("--switching", args->switching,
+                  "table1, funnel-scenarios: keyframe switching, stdratio, mse or scale")
+      ->capture_default_str();
+  cmd->add_option("--end", args->end,
+                  "table1, funnel-scenarios: the last keyframe by scale, or by the switching rule "
+                  "(switching)")
+      ->capture_default_str();
   cmd->callback([args] {
+    const bool teach_repeat = args->suite != "potential" && args->suite != "eigenspace";
+    if (!teach_repeat && (args->switching != "stdratio" || args->end != "scale"))
+      throw InputError("--switching and --end apply to table1 and funnel-scenarios, not " +
+                       args->suite);
+    if (args->end != "scale" && args->end != "switching")
+      throw InputError("--end '" + args->end + "': expected scale or switching");
+    eval::RepeatRunOptions base;
+    base.repeat.switching = navigation::ParseSwitching(args->switching);
+    base.repeat.end_by_local_scale = args->end == "scale";
     if (args->suite == "potential") {
       RunPotentialSuite(args->runs, args->seed, args->json, args->jobs, args->only);
       return;
@@ -197,12 +216,14 @@ void AddEvalCommand(CLI::App* app) {
     std::vector<eval::EntryResult> results(entries.size());
     RunInBatches(entries.size(), args->jobs, [&](std::size_t k) {
       const auto& [scenario, route] = taught.at(entries[k].scenario);
-      results[k] = eval::RunEntry(scenario, route, entries[k].controller, args->runs, args->seed,
-                                  eval::RepeatRunOptions{});
+      results[k] =
+          eval::RunEntry(scenario, route, entries[k].controller, args->runs, args->seed, base);
       spdlog::info("eval: {} {}: {}/{} successes", entries[k].scenario, results[k].controller,
                    results[k].successes, results[k].runs);
     });
     nlohmann::json j = SuiteJson(args->suite, args->runs, args->seed);
+    j["switching"] = args->switching;
+    j["end"] = args->end;
     FILE* table = args->json ? stderr : stdout;
     std::fprintf(table, "%-30s %-9s %9s %10s %10s %10s %5s\n", "scenario", "control", "success",
                  "final rms", "final std", "lateral", "coll");

@@ -130,7 +130,8 @@ void AddTeachRepeatCommands(CLI::App* app) {
   repeat->add_option("--controller", r->controller, "sloped or standard")->capture_default_str();
   repeat
       ->add_option("--switching", r->switching,
-                   "stdratio (Kassir et al.) or mse (Chen & Birchfield)")
+                   "stdratio (Kassir et al.), mse (Chen & Birchfield) or scale (local scale of "
+                   "nearby features, not in the papers)")
       ->capture_default_str();
   repeat
       ->add_option("--end", r->end,
@@ -153,12 +154,9 @@ void AddTeachRepeatCommands(CLI::App* app) {
                    route->keyframes.size());
     navigation::RepeatOptions options;
     options.controller = navigation::ParseController(r->controller);
-    if (r->switching == "stdratio")
-      options.switching = navigation::Switching::kStdRatio;
-    else if (r->switching == "mse")
-      options.switching = navigation::Switching::kMse;
-    else
-      throw InputError("--switching '" + r->switching + "': expected stdratio or mse");
+    if (r->switching != "stdratio" && r->switching != "mse" && r->switching != "scale")
+      throw InputError("--switching '" + r->switching + "': expected stdratio, mse or scale");
+    options.switching = navigation::ParseSwitching(r->switching);
     if (r->end != "scale" && r->end != "switching")
       throw InputError("--end '" + r->end + "': expected scale or switching");
     options.end_by_local_scale = r->end == "scale";

@@ -139,6 +139,10 @@ grep -q "'best' is unknown" "$TMP/err"; check "localize names the bad method" $?
 
 expect_exit "eval eigenspace with an unknown scenario exits 2" 2 "$MAPLESS" eval eigenspace --only nowhere --runs 1
 grep -q "'nowhere': not a scenario of suite eigenspace" "$TMP/err"; check "eval eigenspace names the unknown scenario" $?
+expect_exit "eval with an unknown switching rule exits 2" 2 "$MAPLESS" eval table1 --runs 1 --switching sideways
+grep -q "unknown switching rule 'sideways'" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "eval names the unknown switching rule in one line" $?
+expect_exit "eval potential refuses --end" 2 "$MAPLESS" eval potential --runs 1 --end switching
+grep -q "apply to table1 and funnel-scenarios, not potential" "$TMP/err"; check "eval says --end is for teach & repeat suites" $?
 
 # Teach from a recorded image folder, inspect, repeat open loop: one JSON line per frame.
 expect_exit "teach from an image folder" 0 "$MAPLESS" teach --source "$TMP/d1/frames" --out "$TMP/route"

@@ -91,6 +91,41 @@ TEST(RepeatSession, ReplayingTheTaughtFramesPassesEveryKeyframe) {
   EXPECT_GE(last_destination, static_cast<int>(route->keyframes.size()) - 2);
 }
 
+TEST(RepeatSession, TheLocalScaleDecidesTheEndOrEveryKeyframe) {
+  const auto route = Teach(TeachOptions{});
+  const int last = static_cast<int>(route->keyframes.size()) - 1;
+  const Drive& d = TaughtFrames();
+  // Counts frames with a local scale before and on the last segment, and the destination reached.
+  const auto replay = [&](const RepeatOptions& options, int* before, int* on_last) {
+    RepeatSession session(route, options);
+    *before = *on_last = 0;
+    int destination = 1;
+    for (std::size_t i = 0; i < d.frames.size() && !session.finished(); ++i) {
+      const RepeatStep step = session.Update(d.frames[i], d.t_ns[i]);
+      if (step.local_scale.ok) ++(step.destination == last ? *on_last : *before);
+      destination = step.destination;
+    }
+    return destination;
+  };
+  int before = 0, on_last = 0;
+  // Default: only the route's end.
+  EXPECT_GE(replay(RepeatOptions{}, &before, &on_last), last - 1);
+  EXPECT_EQ(before, 0);
+  EXPECT_GT(on_last, 0);
+  // Switching::kLocalScale: every segment, and the replay still passes every keyframe.
+  RepeatOptions every;
+  every.switching = Switching::kLocalScale;
+  EXPECT_GE(replay(every, &before, &on_last), last - 1);
+  EXPECT_GT(before, 20);
+  // The paper's rule everywhere: no local scale at all.
+  RepeatOptions paper;
+  paper.end_by_local_scale = false;
+  replay(paper, &before, &on_last);
+  EXPECT_EQ(before + on_last, 0);
+  EXPECT_EQ(ParseSwitching("scale"), Switching::kLocalScale);
+  EXPECT_THROW(ParseSwitching("sideways"), InputError);
+}
+
 TEST(RepeatSession, StopsOnBlackFramesSaysWhyAndResumesWhenImagesReturn) {
   const auto route = Teach(TeachOptions{});
   RepeatSession session(route, RepeatOptions{});

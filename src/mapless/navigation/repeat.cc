@@ -30,6 +30,13 @@ Controller ParseController(const std::string& name) {
   throw InputError("unknown controller '" + name + "' (known: sloped, standard)");
 }
 
+Switching ParseSwitching(const std::string& name) {
+  if (name == "stdratio") return Switching::kStdRatio;
+  if (name == "mse") return Switching::kMse;
+  if (name == "scale") return Switching::kLocalScale;
+  throw InputError("unknown switching rule '" + name + "' (known: stdratio, mse, scale)");
+}
+
 const char* ControllerName(Controller c) {
   return c == Controller::kSloped ? "sloped" : "standard";
 }
@@ -247,9 +254,9 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
   step.switching = control::CheckSwitch(pairs, options_.switch_rule);
   const bool enough = static_cast<int>(pairs.size()) >= options_.min_switch_features;
   const bool last = destination_ + 1 >= static_cast<int>(route_->keyframes.size());
-  // The route's end: the local scale instead of StdRatio (see RepeatOptions); with too few nearby
-  // pairs (a sparse view), the rule of every other keyframe.
-  if (last && options_.end_by_local_scale) {
+  // The route's end (or every keyframe with Switching::kLocalScale): the local scale instead of
+  // StdRatio (see RepeatOptions); with too few nearby pairs (a sparse view), StdRatio.
+  if ((last && options_.end_by_local_scale) || options_.switching == Switching::kLocalScale) {
     std::vector<control::FeaturePoint> points;
     points.reserve(current_px_.size());
     for (std::size_t i = 0; i < current_px_.size(); ++i) {
@@ -266,7 +273,7 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
   const bool mse_says = options_.switching == Switching::kMse && mse_.Update(pairs) && enough;
   const int confirm = last ? options_.final_confirm_frames : options_.switch_confirm_frames;
   const bool switch_now =
-      options_.switching == Switching::kStdRatio || by_scale ? switch_votes_ >= confirm : mse_says;
+      options_.switching != Switching::kMse || by_scale ? switch_votes_ >= confirm : mse_says;
   if (switch_now) {
     step.switched = true;
     ++destination_;

@@ -27,8 +27,11 @@
 namespace mapless::navigation {
 
 enum class Controller { kSloped, kStandard };
-enum class Switching { kStdRatio, kMse };
+// kLocalScale (not in the paper): every keyframe by the local scale, as the route's end is by
+// default (see RepeatOptions::end_by_local_scale).
+enum class Switching { kStdRatio, kMse, kLocalScale };
 Controller ParseController(const std::string& name);  // "sloped", "standard"
+Switching ParseSwitching(const std::string& name);    // "stdratio", "mse", "scale"
 const char* ControllerName(Controller c);
 
 struct RepeatOptions {
