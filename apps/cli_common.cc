@@ -31,6 +31,12 @@ std::vector<double> ParseNumbers(const std::string& text, const std::string& opt
   return v;
 }
 
+bool ParseEndByLocalScale(const std::string& end) {
+  if (end != "scale" && end != "switching")
+    throw InputError("--end '" + end + "': expected scale or switching");
+  return end == "scale";
+}
+
 Pose2 ParsePoseDeg(const std::string& text, const std::string& option) {
   const std::vector<double> v = ParseNumbers(text, option, 3, "X,Y,THETA_DEG");
   return Pose2{v[0], v[1], WrapAngle(DegToRad(v[2]))};

@@ -30,6 +30,9 @@ std::vector<double> ParseNumbers(const std::string& text, const std::string& opt
                                  const std::string& form);
 // Parses "X,Y,THETA_DEG"; throws InputError naming the option.
 Pose2 ParsePoseDeg(const std::string& text, const std::string& option);
+// Parses --end ("scale" or "switching") into RepeatOptions::end_by_local_scale; throws InputError
+// naming the value.
+bool ParseEndByLocalScale(const std::string& end);
 
 // A journal of JSON lines: each line is flushed as it is written, so an interrupted run keeps every
 // complete line.
@@ -44,8 +47,6 @@ class JsonLines {
  private:
   std::unique_ptr<io::JournalFile> file_;
 };
-
-
 
 // Options of a simulated run, read from --config FILE (see config/default.yaml).
 sim::DriveOptions LoadDriveOptions(const std::string& config_path);

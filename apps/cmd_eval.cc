@@ -180,11 +180,9 @@ void AddEvalCommand(CLI::App* app) {
     if (!teach_repeat && (args->switching != "stdratio" || args->end != "scale"))
       throw InputError("--switching and --end apply to table1 and funnel-scenarios, not " +
                        args->suite);
-    if (args->end != "scale" && args->end != "switching")
-      throw InputError("--end '" + args->end + "': expected scale or switching");
     eval::RepeatRunOptions base;
     base.repeat.switching = navigation::ParseSwitching(args->switching);
-    base.repeat.end_by_local_scale = args->end == "scale";
+    base.repeat.end_by_local_scale = ParseEndByLocalScale(args->end);
     if (args->suite == "potential") {
       RunPotentialSuite(args->runs, args->seed, args->json, args->jobs, args->only);
       return;

@@ -154,12 +154,8 @@ void AddTeachRepeatCommands(CLI::App* app) {
                    route->keyframes.size());
     navigation::RepeatOptions options;
     options.controller = navigation::ParseController(r->controller);
-    if (r->switching != "stdratio" && r->switching != "mse" && r->switching != "scale")
-      throw InputError("--switching '" + r->switching + "': expected stdratio, mse or scale");
     options.switching = navigation::ParseSwitching(r->switching);
-    if (r->end != "scale" && r->end != "switching")
-      throw InputError("--end '" + r->end + "': expected scale or switching");
-    options.end_by_local_scale = r->end == "scale";
+    options.end_by_local_scale = ParseEndByLocalScale(r->end);
     options.features.type = features::ParseDetectorType(route->detector);
     JsonLines log(r->log);
     int frame_index = 0;
