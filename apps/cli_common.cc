@@ -1,6 +1,7 @@
 #include "cli_common.h"
 
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
@@ -8,6 +9,8 @@
 
 #include "mapless/core/check.h"
 #include "mapless/io/atomic_file.h"
+#include "mapless/io/image_file.h"
+#include "mapless/io/limits.h"
 
 namespace mapless::app {
 
@@ -42,9 +45,57 @@ Pose2 ParsePoseDeg(const std::string& text, const std::string& option) {
   return Pose2{v[0], v[1], WrapAngle(DegToRad(v[2]))};
 }
 
-JsonLines::JsonLines(const std::string& path) {
+JsonLines::JsonLines(const std::string& path, bool in_place) {
   if (path.empty() || path == "-") return;
-  file_ = std::make_unique<io::JournalFile>(path);
+  file_ = std::make_unique<io::JournalFile>(
+      path, in_place ? io::JournalFile::Mode::kInPlace : io::JournalFile::Mode::kReplaceAtClose);
+}
+
+CLI::Validator FiniteIn(double lo, double hi) {
+  return CLI::Validator(
+      [lo, hi](const std::string& text) -> std::string {
+        double v = 0.0;
+        std::size_t used = 0;
+        try {
+          v = std::stod(text, &used);
+        } catch (const std::exception&) {
+          return "'" + text + "' is not a number";
+        }
+        if (used != text.size() || !std::isfinite(v) || v < lo || v > hi) {
+          std::ostringstream out;
+          out << "'" << text << "' is not a number in [" << lo << ", " << hi << "]";
+          return out.str();
+        }
+        return "";
+      },
+      "", "FiniteIn");
+}
+
+void RefuseOutputOverInputs(const std::string& output, const std::string& option,
+                            const std::vector<std::string>& inputs) {
+  namespace fs = std::filesystem;
+  if (output.empty() || output == "-") return;
+  std::error_code ec;
+  const fs::path out = fs::weakly_canonical(fs::absolute(output, ec), ec);
+  for (const std::string& input : inputs) {
+    if (input.empty()) continue;
+    std::error_code e2;
+    const fs::path in = fs::weakly_canonical(fs::absolute(input, e2), e2);
+    if (e2) continue;
+    const bool same = out == in || (fs::exists(out, e2) && fs::equivalent(out, in, e2));
+    // Inside an input directory (a route, an image folder)?
+    const auto within = [](const fs::path& a, const fs::path& dir) {
+      const auto rel = a.lexically_relative(dir);
+      return !rel.empty() && *rel.begin() != "..";
+    };
+    // The output inside an input directory, or an input inside the output directory.
+    const bool inside = (fs::is_directory(in, e2) && within(out, in)) ||
+                        (fs::is_directory(out, e2) && within(in, out));
+    if (same || inside) {
+      throw InputError(option + " " + output + ": would overwrite the input " + input +
+                       "; write the output elsewhere");
+    }
+  }
 }
 
 void JsonLines::Write(const nlohmann::json& j) {
@@ -58,18 +109,11 @@ void JsonLines::Write(const nlohmann::json& j) {
 
 sim::DriveOptions LoadDriveOptions(const std::string& config_path) {
   if (config_path.empty()) return sim::DriveOptions{};
-  return sim::ParseDriveOptions(io::ReadFile(config_path), config_path);
+  return sim::ParseDriveOptions(io::ReadFile(config_path, io::kMaxYamlFileBytes), config_path);
 }
 
 cv::Mat ReadImageOrThrow(const std::string& path, int flags) {
-  cv::Mat img;
-  try {
-    img = cv::imread(path, flags);
-  } catch (const cv::Exception&) {
-    img.release();
-  }
-  if (img.empty()) throw InputError(path + ": cannot read image (missing, or not an image file)");
-  return img;
+  return io::ReadImage(path, flags, io::kMinImageSide);
 }
 
 void RequireSameSize(const cv::Mat& image, const std::string& path, const cv::Mat& reference,

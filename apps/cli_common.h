@@ -40,8 +40,10 @@ bool ParseEndByLocalScale(const std::string& end);
 // (io/journal.h): a run killed at any moment leaves every line it finished, whole.
 class JsonLines {
  public:
-  // "" or "-": standard output.
-  explicit JsonLines(const std::string& path);
+  // "" or "-": standard output. A file the user names is replaced when the run ends (interrupted
+  // or not); until then it stays as it was and the lines go to PATH.partial (io::JournalFile).
+  // `in_place`: write PATH directly (files inside an output directory of the run's own).
+  explicit JsonLines(const std::string& path, bool in_place = false);
   void Write(const nlohmann::json& j);
 
  private:
@@ -51,11 +53,20 @@ class JsonLines {
 // Options of a simulated run, read from --config FILE (see config/default.yaml).
 sim::DriveOptions LoadDriveOptions(const std::string& config_path);
 
-// Drives the scenario's taught path and writes DIR/frames/NNNNNN.png, DIR/frames.csv,
+// Drives the scenario's taught path and writes into DIR (new or empty: see io::OutputDirectory)
+// DIR/frames/NNNNNN.png, DIR/frames.csv,
 // DIR/groundtruth.tum, DIR/odometry.tum, DIR/topdown.png and DIR/summary.json (each file written
 // atomically; frames as they are rendered, so an interrupted run keeps every complete frame).
 sim::DriveSummary DriveToDirectory(const sim::Scenario& scenario, const sim::DriveOptions& options,
                                    const std::string& out_dir);
+
+// A CLI11 check: a finite number in [lo, hi] (CLI::Range lets nan through).
+CLI::Validator FiniteIn(double lo, double hi);
+
+// Throws InputError naming both unless `output` is a different file from every input and lies
+// outside every input directory. `option` names the output's option ("--log").
+void RefuseOutputOverInputs(const std::string& output, const std::string& option,
+                            const std::vector<std::string>& inputs);
 
 // Registers the subcommands on the app.
 void AddSimCommands(CLI::App* app);

@@ -8,8 +8,10 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
+#include "interrupt.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/io/atomic_file.h"
+#include "mapless/io/output_dir.h"
 #include "mapless/route/route_store.h"
 #include "mapless/viz/topdown.h"
 
@@ -21,6 +23,7 @@ void AddDemoCommand(CLI::App* app) {
     std::string out = "demo_out";
     std::string config;
     std::uint64_t seed = 1;
+    bool overwrite = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* demo = app->add_subcommand("demo",
@@ -31,11 +34,22 @@ void AddDemoCommand(CLI::App* app) {
   demo->add_option("--out", args->out, "Output directory")->capture_default_str();
   demo->add_option("--seed", args->seed, "Seed of motion and image noise")->capture_default_str();
   demo->add_option("--config", args->config, "Run configuration YAML (see config/default.yaml)");
+  demo->add_flag("--overwrite", args->overwrite,
+                 "Replace what --out holds even when it is not an earlier demo's output");
   demo->callback([args] {
+    RefuseOutputOverInputs(args->out, "--out", {args->scenario, args->config});
     const sim::Scenario scenario = sim::LoadScenario(args->scenario);
     sim::DriveOptions options = LoadDriveOptions(args->config);
     options.seed = args->seed;
-    const std::filesystem::path out(args->out);
+    // An earlier demo's output is replaced (when this demo is done); anything else only with
+    // --overwrite.
+    const std::filesystem::path target(args->out);
+    const bool earlier_demo = std::filesystem::exists(target / "summary.json") &&
+                              std::filesystem::exists(target / "route" / "manifest.json") &&
+                              std::filesystem::exists(target / "teach" / "frames.csv");
+    io::OutputDirectory out_dir(args->out, args->overwrite || earlier_demo, "demo's output");
+    StopCleanlyOnInterrupt();
+    const std::filesystem::path out(out_dir.path());
     spdlog::info("demo: teaching route '{}' ({:.1f} m) on the simulator", scenario.name,
                  scenario.PathLength());
     const sim::DriveSummary summary = DriveToDirectory(scenario, options, (out / "teach").string());
@@ -47,11 +61,13 @@ void AddDemoCommand(CLI::App* app) {
     // The route store, written keyframe by keyframe as the teach goes.
     const std::string route_dir = (out / "route").string();
     route::RouteWriter writer(route_dir, "orb", scenario.camera.model.width,
-                              scenario.camera.model.height,
-                              /*overwrite=*/true);
+                              scenario.camera.model.height);
     const eval::TaughtRoute taught =
         eval::TeachOnSimulator(scenario, navigation::TeachOptions{},
-                               [&](const route::Keyframe& kf) { writer.Append(kf); });
+                               [&](const route::Keyframe& kf) {
+                                 ThrowIfInterrupted();
+                                 writer.Append(kf);
+                               });
     writer.Finish();
     spdlog::info("demo: route of {} keyframes in {}", taught.route->keyframes.size(), route_dir);
 
@@ -60,11 +76,12 @@ void AddDemoCommand(CLI::App* app) {
     run_options.seed = args->seed;
     const double speed = eval::RepeatSpeedFor(scenario, run_options.max_repeat_speed_mps);
     run_options.repeat.sloped.max_speed_mps = speed;
-    JsonLines log((out / "repeat.jsonl").string());
+    JsonLines log((out / "repeat.jsonl").string(), /*in_place=*/true);
     int frame = 0;
     const eval::RepeatRun run = eval::RepeatOnSimulator(
         scenario, taught, run_options,
         [&](const Pose2& pose, const cv::Mat&, const navigation::RepeatStep& s) {
+          ThrowIfInterrupted();
           nlohmann::json j{{"frame", frame++},
                            {"x_m", pose.x_m},
                            {"y_m", pose.y_m},
@@ -93,6 +110,7 @@ void AddDemoCommand(CLI::App* app) {
                      {"lateral_rms_m", run.lateral_rms_m},
                      {"repeat_duration_s", run.duration_s}};
     io::WriteFileAtomic((out / "summary.json").string(), j.dump(2) + "\n");
+    out_dir.Commit();
     spdlog::info("demo: repeat: {}; ended {:.2f} m from the taught end, lateral RMS {:.2f} m",
                  run.status, run.final_error_m, run.lateral_rms_m);
     spdlog::info(

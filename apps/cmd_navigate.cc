@@ -5,11 +5,19 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
+#include "interrupt.h"
 #include "mapless/core/check.h"
 #include "mapless/eval/potential.h"
 #include "mapless/io/atomic_file.h"
+#include "mapless/io/limits.h"
 
 namespace mapless::app {
+namespace {
+
+// How far beyond the scenario's objects, path and destinations a start or a destination may lie.
+constexpr double kNavigationMarginM = 5.0;
+
+}  // namespace
 
 void AddNavigateCommand(CLI::App* app) {
   struct Args {
@@ -51,9 +59,28 @@ void AddNavigateCommand(CLI::App* app) {
   cmd->add_option("--image-noise", a->image_noise, "Gaussian image noise, grey levels")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 100.0));
-  cmd->callback([a] {
+  cmd->callback([a, cmd] {
+    RefuseOutputOverInputs(a->log, "--log", {a->scenario, a->calibration});
+    RefuseOutputOverInputs(a->save_calibration, "--save-calibration",
+                           {a->scenario, a->calibration, a->log});
+    if (cmd->count("--destination-index") > 0 && a->destination_index < 0) {
+      throw InputError("--destination-index " + std::to_string(a->destination_index) +
+                       ": must be 0 or more");
+    }
     sim::Scenario scenario = sim::LoadScenario(a->scenario);
-    if (!a->start.empty()) scenario.teach_start = ParsePoseDeg(a->start, "--start");
+    // The robot must start, and its goal lie, where the world is: the scenario's area (objects,
+    // taught path, starts and destinations) with a margin. Outside it there is nothing to see.
+    const Eigen::Vector4d area = sim::ScenarioBounds(scenario, kNavigationMarginM);
+    const auto in_area = [&](double x, double y) {
+      return x >= area[0] && y >= area[1] && x <= area[2] && y <= area[3];
+    };
+    const std::string area_text = fmt::format("[{:.1f}, {:.1f}] x [{:.1f}, {:.1f}] m", area[0],
+                                              area[2], area[1], area[3]);
+    if (!a->start.empty()) {
+      scenario.teach_start = ParsePoseDeg(a->start, "--start");
+      if (!in_area(scenario.teach_start.x_m, scenario.teach_start.y_m))
+        throw InputError("--start " + a->start + ": outside the scenario's area " + area_text);
+    }
     eval::PotentialRunOptions o;
     o.seed = a->seed;
     o.motion_noise_frac = a->motion_noise;
@@ -63,6 +90,9 @@ void AddNavigateCommand(CLI::App* app) {
       throw InputError("--destination and --destination-index: give one of them");
     if (!a->destination.empty()) {
       const std::vector<double> d = ParseNumbers(a->destination, "--destination", 2, "X,Y");
+      if (!in_area(d[0], d[1]))
+        throw InputError("--destination " + a->destination + ": outside the scenario's area " +
+                         area_text);
       o.destination = Eigen::Vector2d(d[0], d[1]);
     } else if (a->destination_index >= 0) {
       if (a->destination_index >= static_cast<int>(scenario.destinations.size()))
@@ -75,7 +105,7 @@ void AddNavigateCommand(CLI::App* app) {
 
     navigation::PlanarFlowCalibration calibration;
     if (!a->calibration.empty()) {
-      calibration = navigation::CalibrationFromYaml(io::ReadFile(a->calibration), a->calibration);
+      calibration = navigation::CalibrationFromYaml(io::ReadFile(a->calibration, io::kMaxYamlFileBytes), a->calibration);
       if (calibration.width != scenario.camera.model.width ||
           calibration.height != scenario.camera.model.height)
         throw InputError(a->calibration + ": calibrated for " +
@@ -91,11 +121,13 @@ void AddNavigateCommand(CLI::App* app) {
       io::WriteFileAtomic(a->save_calibration, navigation::CalibrationToYaml(calibration));
 
     JsonLines log(a->log.empty() ? std::string() : a->log);
+    StopCleanlyOnInterrupt();
     const bool logging = !a->log.empty();
     int frame = 0;
     const eval::PotentialRun run = eval::RunPotential(
         scenario, calibration, o,
         [&](const Pose2& truth, const cv::Mat&, const navigation::PotentialStep& s) {
+          ThrowIfInterrupted();
           if (logging) {
             nlohmann::json j;
             j["frame"] = frame;

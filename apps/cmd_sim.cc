@@ -7,9 +7,11 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
+#include "interrupt.h"
 #include "mapless/core/check.h"
 #include "mapless/io/atomic_file.h"
 #include "mapless/io/journal.h"
+#include "mapless/io/output_dir.h"
 #include "mapless/io/tum.h"
 #include "mapless/sim/world.h"
 #include "mapless/viz/topdown.h"
@@ -32,6 +34,7 @@ sim::DriveSummary DriveToDirectory(const sim::Scenario& scenario, const sim::Dri
   odom_tum.Append(io::kTumHeader);
   const sim::DriveSummary summary =
       sim::DriveTaughtPath(scenario, options, [&](const sim::DriveFrame& f) {
+        ThrowIfInterrupted();
         char name[32];
         std::snprintf(name, sizeof(name), "%06d.png", f.index);
         io::WriteImageAtomic((dir / "frames" / name).string(), f.image);
@@ -99,6 +102,7 @@ void AddSimCommands(CLI::App* app) {
   render->add_flag("--repeat-variant", render_args->repeat_variant,
                    "Render the world as the repeat phase sees it (objects removed or moved)");
   render->callback([render_args] {
+    RefuseOutputOverInputs(render_args->out, "--out", {render_args->scenario});
     const sim::Scenario scenario = sim::LoadScenario(render_args->scenario);
     const Pose2 pose = ParsePoseDeg(render_args->pose, "--pose");
     const sim::World world = render_args->repeat_variant
@@ -116,6 +120,7 @@ void AddSimCommands(CLI::App* app) {
     std::string out;
     std::string config;
     std::uint64_t seed = 1;
+    bool overwrite = false;
   };
   auto drive_args = std::make_shared<DriveArgs>();
   CLI::App* drive = simcmd->add_subcommand(
@@ -126,11 +131,17 @@ void AddSimCommands(CLI::App* app) {
   drive->add_option("--seed", drive_args->seed, "Seed of motion, odometry and image noise");
   drive->add_option("--config", drive_args->config,
                     "Run configuration YAML (see config/default.yaml)");
+  drive->add_flag("--overwrite", drive_args->overwrite,
+                  "Replace what --out holds (the old content stays until the drive is done)");
   drive->callback([drive_args] {
+    RefuseOutputOverInputs(drive_args->out, "--out", {drive_args->scenario, drive_args->config});
     const sim::Scenario scenario = sim::LoadScenario(drive_args->scenario);
     sim::DriveOptions options = LoadDriveOptions(drive_args->config);
     options.seed = drive_args->seed;
-    const sim::DriveSummary summary = DriveToDirectory(scenario, options, drive_args->out);
+    io::OutputDirectory out(drive_args->out, drive_args->overwrite, "recording");
+    StopCleanlyOnInterrupt();
+    const sim::DriveSummary summary = DriveToDirectory(scenario, options, out.path());
+    out.Commit();
     spdlog::info("{}: {} frames, {:.1f} s, {:.2f} m driven: {}", scenario.name, summary.frames,
                  summary.duration_s, summary.distance_m, summary.status);
     if (!summary.completed) throw RunFailed("drive did not complete: " + summary.status);

@@ -3,14 +3,18 @@
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
+#include <filesystem>
+#include <optional>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
+#include "interrupt.h"
 #include "mapless/core/check.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/io/frame_source.h"
+#include "mapless/io/output_dir.h"
 #include "mapless/route/route_store.h"
 
 namespace mapless::app {
@@ -40,73 +44,125 @@ nlohmann::json StepJson(int frame, Timestamp t_ns, const navigation::RepeatStep&
 
 }  // namespace
 
-void AddTeachRepeatCommands(CLI::App* app) {
-  struct TeachArgs {
-    std::string source;
-    std::string out;
-    bool overwrite = false;
-    std::string detector = "orb";
-    double fps = 10.0;
+struct TeachArgs {
+  std::string source;
+  std::string out;
+  bool overwrite = false;
+  std::string detector = "orb";
+  double fps = 10.0;
+};
+
+// The input files of a source ("" for sim built-ins and cameras), for RefuseOutputOverInputs.
+std::string SourceInput(const std::string& source) {
+  if (IsSim(source)) {
+    const std::string name = source.substr(4);
+    return name.find('/') != std::string::npos || name.find(".y") != std::string::npos ? name : "";
+  }
+  return source.rfind("camera:", 0) == 0 ? "" : source;
+}
+
+bool IsLive(const std::string& source) {
+  return source.rfind("camera:", 0) == 0 || source.rfind("/dev/video", 0) == 0;
+}
+
+// Teaching writes the route keyframe by keyframe into ROUTE (a new or empty directory), or, with
+// --overwrite over an existing route, into a staging directory that replaces ROUTE when the teach
+// is done (io::OutputDirectory). Ctrl-C ends the teach cleanly: a camera teach ends there with a
+// complete route; a recording or simulator teach keeps its keyframes in ROUTE marked incomplete
+// (in place), or leaves the old route untouched (--overwrite).
+void Teach(const TeachArgs& t) {
+  navigation::TeachOptions options;
+  options.features.type = features::ParseDetectorType(t.detector);
+  options.Validate();
+  RefuseOutputOverInputs(t.out, "--out", {SourceInput(t.source)});
+  if (!t.overwrite && std::filesystem::exists(std::filesystem::path(t.out) / "manifest.json")) {
+    throw InputError(t.out + ": already holds a route (manifest.json); choose another directory, "
+                     "or --overwrite to replace it");
+  }
+  if (t.overwrite && !io::IsEmptyOrMissing(t.out) &&
+      !std::filesystem::exists(std::filesystem::path(t.out) / "manifest.json")) {
+    throw InputError(t.out + ": holds no route (no manifest.json), so --overwrite will not "
+                     "replace it; choose a new or empty directory");
+  }
+  // The source is opened before anything is written: a bad source changes nothing.
+  std::optional<sim::Scenario> scenario;
+  std::unique_ptr<io::FrameSource> source;
+  if (IsSim(t.source)) {
+    scenario = sim::LoadScenario(t.source.substr(4));
+  } else {
+    source = io::OpenFrameSource(t.source, t.fps);
+  }
+  io::OutputDirectory out(t.out, t.overwrite, "route");
+  StopCleanlyOnInterrupt();
+  navigation::TeachSession session(options);
+  std::unique_ptr<route::RouteWriter> writer;
+  int keyframes = 0;
+  int frames = 0;
+  const auto keep = [&](const std::optional<route::Keyframe>& kf) {
+    if (!kf) return;
+    writer->Append(*kf);
+    ++keyframes;
   };
+  const auto frame_in = [&](const cv::Mat& image, Timestamp t_ns) {
+    ThrowIfInterrupted();
+    if (!writer) {
+      writer = std::make_unique<route::RouteWriter>(out.path(), t.detector, image.cols, image.rows);
+    }
+    keep(session.Update(image, t_ns));
+    ++frames;
+  };
+  bool interrupted = false;
+  try {
+    if (scenario) {
+      const sim::DriveSummary summary = sim::DriveTaughtPath(
+          *scenario, sim::DriveOptions{},
+          [&](const sim::DriveFrame& f) { frame_in(f.image, f.t_ns); });
+      if (!summary.completed) {
+        throw RunFailed("teach: the drive of '" + scenario->name + "' did not complete: " +
+                        summary.status);
+      }
+    } else {
+      io::Frame frame;
+      while (source->Next(&frame)) frame_in(frame.image, frame.t_ns);
+    }
+  } catch (const Interrupted&) {
+    if (!writer || !IsLive(t.source)) throw;
+    interrupted = true;  // the end of a camera teach
+  }
+  if (!writer) throw InputError(t.source + ": no frames");
+  keep(session.Finish());
+  if (session.deferred_keyframes() > 0) {
+    spdlog::warn("teach: {} keyframes were deferred for lack of features (a weak stretch)",
+                 session.deferred_keyframes());
+  }
+  spdlog::info("teach: {} frames, {} keyframes", frames, keyframes);
+  if (keyframes < 2) {
+    throw RunFailed("teach: " + std::to_string(keyframes) + " keyframe" +
+                    (keyframes == 1 ? "" : "s") + " (too few features in the images?); a route "
+                    "needs at least 2, so none was " + (out.staged() ? "put in place of the old "
+                    "one" : "marked complete"));
+  }
+  writer->Finish();
+  out.Commit();
+  spdlog::info("teach: route of {} keyframes written to {}", keyframes, t.out);
+  if (interrupted) throw Interrupted(InterruptSignal());
+}
+
+void AddTeachRepeatCommands(CLI::App* app) {
   auto t = std::make_shared<TeachArgs>();
   CLI::App* teach = app->add_subcommand(
       "teach", "Teach a route: keyframes from a video, an image folder, a camera or sim:SCENARIO");
   teach->add_option("--source", t->source, "sim:SCENARIO, a video file, an image folder, camera:N")
       ->required();
   teach->add_option("--out", t->out, "Route directory to create")->required();
-  teach->add_flag("--overwrite", t->overwrite, "Replace a route already in --out");
+  teach->add_flag("--overwrite", t->overwrite,
+                  "Replace a route already in --out (the old one stays until the new one is done)");
   teach->add_option("--detector", t->detector, "orb, akaze, akaze_upright or sift")
       ->capture_default_str();
   teach->add_option("--fps", t->fps, "Frame rate of image folders (timestamps)")
-      ->capture_default_str();
-  teach->callback([t] {
-    navigation::TeachOptions options;
-    options.features.type = features::ParseDetectorType(t->detector);
-    options.Validate();
-    int keyframes = 0;
-    int frames = 0;
-    if (IsSim(t->source)) {
-      const sim::Scenario scenario = sim::LoadScenario(t->source.substr(4));
-      route::RouteWriter writer(t->out, t->detector, scenario.camera.model.width,
-                                scenario.camera.model.height, t->overwrite);
-      const eval::TaughtRoute taught =
-          eval::TeachOnSimulator(scenario, options, [&](const route::Keyframe& kf) {
-            writer.Append(kf);
-            ++keyframes;
-          });
-      frames = static_cast<int>(taught.path.size());
-      writer.Finish();
-    } else {
-      auto source = io::OpenFrameSource(t->source, t->fps);
-      navigation::TeachSession session(options);
-      std::unique_ptr<route::RouteWriter> writer;
-      io::Frame frame;
-      while (source->Next(&frame)) {
-        if (!writer) {
-          writer = std::make_unique<route::RouteWriter>(t->out, t->detector, frame.image.cols,
-                                                        frame.image.rows, t->overwrite);
-        }
-        if (auto kf = session.Update(frame.image, frame.t_ns)) {
-          writer->Append(*kf);
-          ++keyframes;
-        }
-        ++frames;
-      }
-      if (!writer) throw InputError(t->source + ": no frames");
-      if (auto kf = session.Finish()) {
-        writer->Append(*kf);
-        ++keyframes;
-      }
-      writer->Finish();
-      if (session.deferred_keyframes() > 0) {
-        spdlog::warn("teach: {} keyframes were deferred for lack of features (a weak stretch)",
-                     session.deferred_keyframes());
-      }
-    }
-    spdlog::info("teach: {} frames, {} keyframes written to {}", frames, keyframes, t->out);
-    if (keyframes < 2)
-      throw RunFailed("teach: fewer than 2 keyframes; the route cannot be repeated");
-  });
+      ->capture_default_str()
+      ->check(FiniteIn(io::kMinFolderFps, io::kMaxFolderFps));
+  teach->callback([t] { Teach(*t); });
 
   struct RepeatArgs {
     std::string route;
@@ -142,12 +198,16 @@ void AddTeachRepeatCommands(CLI::App* app) {
                      "Per-frame decisions as JSON lines to this file (default: stdout)");
   repeat->add_option("--seed", r->seed, "Simulator: seed of the noise")->capture_default_str();
   repeat->add_option("--motion-noise", r->motion_noise, "Simulator: fraction of the command")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteIn(0.0, 0.9));
   repeat->add_option("--image-noise", r->image_noise, "Simulator: grey levels")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteIn(0.0, 100.0));
   repeat->add_option("--fps", r->fps, "Frame rate of image folders (timestamps)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteIn(io::kMinFolderFps, io::kMaxFolderFps));
   repeat->callback([r] {
+    RefuseOutputOverInputs(r->log, "--log", {r->route, SourceInput(r->source)});
     auto route = std::make_shared<route::Route>(route::LoadRoute(r->route));
     if (!route->complete)
       spdlog::warn("repeat: {} is an interrupted teach; repeating its {} keyframes", r->route,
@@ -157,30 +217,46 @@ void AddTeachRepeatCommands(CLI::App* app) {
     options.switching = navigation::ParseSwitching(r->switching);
     options.end_by_local_scale = ParseEndByLocalScale(r->end);
     options.features.type = features::ParseDetectorType(route->detector);
-    JsonLines log(r->log);
-    int frame_index = 0;
+    std::unique_ptr<io::FrameSource> source;
+    std::optional<sim::Scenario> scenario;
     if (IsSim(r->source)) {
-      const sim::Scenario scenario = sim::LoadScenario(r->source.substr(4));
+      scenario = sim::LoadScenario(r->source.substr(4));
+    } else {
+      source = io::OpenFrameSource(r->source, r->fps);
+    }
+    JsonLines log(r->log);
+    StopCleanlyOnInterrupt();
+    int frame_index = 0;
+    if (scenario) {
+      if (scenario->camera.model.width != route->image_width ||
+          scenario->camera.model.height != route->image_height) {
+        throw InputError(r->source + ": the camera is " +
+                         std::to_string(scenario->camera.model.width) + "x" +
+                         std::to_string(scenario->camera.model.height) + ", the route " + r->route +
+                         " was taught at " + std::to_string(route->image_width) + "x" +
+                         std::to_string(route->image_height));
+      }
       eval::TaughtRoute taught;
       taught.route = route;
       sim::DriveOptions drive;
       drive.render_frames = false;
       const sim::DriveSummary summary = sim::DriveTaughtPath(
-          scenario, drive, [&](const sim::DriveFrame& f) { taught.path.push_back(f.truth); });
+          *scenario, drive, [&](const sim::DriveFrame& f) { taught.path.push_back(f.truth); });
       taught.duration_s = summary.duration_s;
       eval::RepeatRunOptions run_options;
       run_options.repeat = options;
       run_options.seed = r->seed;
       run_options.motion_noise_frac = r->motion_noise;
       run_options.image_noise_sigma = r->image_noise;
-      const double speed = eval::RepeatSpeedFor(scenario, run_options.max_repeat_speed_mps);
+      const double speed = eval::RepeatSpeedFor(*scenario, run_options.max_repeat_speed_mps);
       run_options.repeat.sloped.max_speed_mps = speed;
       run_options.repeat.standard.forward_speed_mps = speed;
       const eval::RepeatRun run = eval::RepeatOnSimulator(
-          scenario, taught, run_options,
+          *scenario, taught, run_options,
           [&](const Pose2& pose, const cv::Mat&, const navigation::RepeatStep& step) {
+            ThrowIfInterrupted();
             nlohmann::json j =
-                StepJson(frame_index, FromSeconds(frame_index / scenario.camera.rate_hz), step);
+                StepJson(frame_index, FromSeconds(frame_index / scenario->camera.rate_hz), step);
             j["x_m"] = pose.x_m;
             j["y_m"] = pose.y_m;
             j["theta_rad"] = pose.theta_rad;
@@ -188,16 +264,23 @@ void AddTeachRepeatCommands(CLI::App* app) {
             ++frame_index;
           });
       spdlog::info("repeat: {} ({}): {}; final error {:.2f} m, lateral RMS {:.2f} m, {:.1f} s",
-                   scenario.name, r->controller, run.status, run.final_error_m, run.lateral_rms_m,
+                   scenario->name, r->controller, run.status, run.final_error_m, run.lateral_rms_m,
                    run.duration_s);
       if (!run.success) throw RunFailed("repeat did not succeed: " + run.status);
       return;
     }
-    auto source = io::OpenFrameSource(r->source, r->fps);
     navigation::RepeatSession session(route, options);
     io::Frame frame;
     navigation::RepeatStep last;
     while (source->Next(&frame)) {
+      ThrowIfInterrupted();
+      if (frame.image.cols != route->image_width || frame.image.rows != route->image_height) {
+        throw InputError(r->source + ": frame " + frame.name + " is " +
+                         std::to_string(frame.image.cols) + "x" +
+                         std::to_string(frame.image.rows) + ", the route " + r->route +
+                         " was taught at " + std::to_string(route->image_width) + "x" +
+                         std::to_string(route->image_height));
+      }
       last = session.Update(frame.image, frame.t_ns);
       nlohmann::json j = StepJson(frame_index++, frame.t_ns, last);
       j["image"] = frame.name;

@@ -8,6 +8,7 @@
 #include <opencv2/core.hpp>
 
 #include "cli_common.h"
+#include "interrupt.h"
 #include "mapless/core/check.h"
 
 int main(int argc, char** argv) {
@@ -18,6 +19,7 @@ int main(int argc, char** argv) {
   spdlog::set_default_logger(spdlog::stderr_color_mt("mapless"));
   spdlog::set_pattern("%^[%l]%$ %v");
   cv::setNumThreads(1);
+  mapless::app::InstallInterruptHandlers();
   mapless::app::AddDemoCommand(&app);
   mapless::app::AddSimCommands(&app);
   mapless::app::AddTeachRepeatCommands(&app);
@@ -40,6 +42,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     std::cerr << "mapless: error: " << e.what() << " (see --help)\n";
     return mapless::app::kExitBadInput;
+  } catch (const mapless::app::Interrupted& e) {
+    std::cerr << "mapless: " << e.what() << ": stopped cleanly, every finished file kept\n";
+    return e.exit_code();
   } catch (const mapless::InputError& e) {
     std::cerr << "mapless: error: " << e.what() << "\n";
     return mapless::app::kExitBadInput;
@@ -47,7 +52,9 @@ int main(int argc, char** argv) {
     std::cerr << "mapless: " << e.what() << "\n";
     return mapless::app::kExitRunFailed;
   } catch (const cv::Exception& e) {
-    std::cerr << "mapless: error: OpenCV: " << e.err << " in " << e.func << "\n";
+    // Inputs are checked before they reach OpenCV; one that still trips it is a mapless bug.
+    std::cerr << "mapless: error: internal (OpenCV " << e.func << "): " << e.err
+              << "; please report this with the command line\n";
     return mapless::app::kExitRunFailed;
   } catch (const std::exception& e) {
     std::cerr << "mapless: error: " << e.what() << "\n";

@@ -88,7 +88,7 @@ grep -q '"dx_px":' "$TMP/out" && grep -q '"matches":' "$TMP/out" && grep -q '"ok
 dx=$(sed 's/.*"dx_px":\([-0-9.e]*\).*/\1/' "$TMP/out")
 awk -v d="$dx" 'BEGIN { exit !(d > 40.5 - 17.5 && d < 40.5 + 17.5) }'; check "shift of Stromovka place 1, session 12 vs 01 is 40.5 +- 17.5 px (got $dx)" $?
 expect_exit "shift of a missing image exits 2" 2 "$MAPLESS" shift "$S/0101.png" "$TMP/none.png"
-grep -q "none.png: cannot read image" "$TMP/err"; check "shift names the missing image" $?
+grep -q "none.png: cannot open file" "$TMP/err"; check "shift names the missing image" $?
 
 # Optical flow and the dominant plane on two simulator frames of the downward-looking corridor.
 expect_exit "render f0" 0 "$MAPLESS" sim render --scenario corridor_straight_3p5m --pose 0,0,0 --out "$TMP/f0.png"
@@ -104,7 +104,7 @@ grep -q "unknown flow method 'magic'" "$TMP/err"; check "flow names the unknown 
 expect_exit "ground --out" 0 "$MAPLESS" ground "$TMP/f0.png" "$TMP/f1.png" --out "$TMP/ground.png" --roi-top 0
 [ -s "$TMP/ground.png" ]; check "ground wrote a mask" $?
 expect_exit "ground of a missing frame exits 2" 2 "$MAPLESS" ground "$TMP/f0.png" "$TMP/none.png" --out "$TMP/g.png"
-grep -q "none.png: cannot read image" "$TMP/err"; check "ground names the missing frame" $?
+grep -q "none.png: cannot open file" "$TMP/err"; check "ground names the missing frame" $?
 
 # Visual-potential navigation: reach a destination, keep the calibration, log every frame.
 expect_exit "navigate to a destination" 0 "$MAPLESS" navigate --scenario obstacle_field --destination-index 1 --save-calibration "$TMP/cal.yaml" --log "$TMP/nav.jsonl"

@@ -19,6 +19,19 @@ constexpr TypeName kTypeNames[] = {{DetectorType::kOrb, "orb"},
 
 }  // namespace
 
+DescriptorLayout DescriptorLayoutOf(DetectorType type) {
+  switch (type) {
+    case DetectorType::kOrb:
+      return {CV_8U, 32};
+    case DetectorType::kAkaze:
+    case DetectorType::kAkazeUpright:
+      return {CV_8U, 61};  // MLDB, full size: 486 bits
+    case DetectorType::kSift:
+      return {CV_32F, 128};
+  }
+  return {};
+}
+
 DetectorType ParseDetectorType(const std::string& name) {
   for (const auto& t : kTypeNames) {
     if (name == t.name) return t.type;

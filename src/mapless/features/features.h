@@ -17,6 +17,14 @@ enum class DetectorType { kOrb, kAkaze, kAkazeUpright, kSift };
 DetectorType ParseDetectorType(const std::string& name);
 const char* DetectorTypeName(DetectorType type);
 
+// The descriptors a detector writes: OpenCV element type and length per keypoint (ORB 32 bytes,
+// AKAZE and upright AKAZE 61 bytes, SIFT 128 floats). Routes are checked against it on loading.
+struct DescriptorLayout {
+  int type = 0;  // CV_8U or CV_32F
+  int length = 0;
+};
+DescriptorLayout DescriptorLayoutOf(DetectorType type);
+
 struct FeatureOptions {
   DetectorType type = DetectorType::kOrb;
   int max_features = 500;           // ORB and SIFT: keep at most this many (strongest first)

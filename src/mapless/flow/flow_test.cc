@@ -119,7 +119,7 @@ TEST(FloFile, RoundTripsAndRejectsBadFiles) {
   ASSERT_EQ(back.size(), flow.size());
   EXPECT_EQ(cv::norm(back, flow, cv::NORM_INF), 0.0);
   // Truncated: one error naming the file.
-  const std::string bytes = io::ReadFile(dir + "/a.flo");
+  const std::string bytes = io::ReadFile(dir + "/a.flo", 1 << 20);
   std::ofstream(dir + "/short.flo", std::ios::binary) << bytes.substr(0, bytes.size() - 5);
   EXPECT_THAT(mapless::testing::InputErrorOf([&] { io::ReadFlo(dir + "/short.flo"); }),
               ::testing::HasSubstr("short.flo: truncated"));

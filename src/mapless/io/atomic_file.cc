@@ -1,9 +1,12 @@
 #include "mapless/io/atomic_file.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -58,12 +61,45 @@ void WriteImageAtomic(const std::string& path, const cv::Mat& image) {
                   std::string_view(reinterpret_cast<const char*>(buffer.data()), buffer.size()));
 }
 
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
+std::string ReadFile(const std::string& path, std::size_t max_bytes) {
+  // O_NONBLOCK: opening a FIFO must not wait for a writer; regular files ignore it.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
+  if (fd < 0) throw InputError(path + ": cannot open file: " + std::strerror(errno));
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    throw InputError(path + ": not a regular file (a directory, a device or a pipe)");
+  }
+  if (static_cast<std::uint64_t>(st.st_size) > max_bytes) {
+    ::close(fd);
+    throw InputError(path + ": " + std::to_string(st.st_size) + " bytes; the limit for this kind "
+                     "of file is " + std::to_string(max_bytes) + " bytes");
+  }
+  // Read at most max_bytes + 1: a file that grows while it is read is still caught.
+  std::string bytes(static_cast<std::size_t>(st.st_size), '\0');
+  std::size_t done = 0;
+  while (true) {
+    if (done == bytes.size()) {
+      if (bytes.size() > max_bytes) break;
+      bytes.resize(std::min(max_bytes + 1, bytes.size() + 65536));
+    }
+    const ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const std::string why = std::strerror(errno);
+      ::close(fd);
+      throw InputError(path + ": cannot read: " + why);
+    }
+    if (n == 0) break;
+    done += static_cast<std::size_t>(n);
+  }
+  ::close(fd);
+  if (done > max_bytes) {
+    throw InputError(path + ": more than " + std::to_string(max_bytes) +
+                     " bytes; the limit for this kind of file");
+  }
+  bytes.resize(done);
+  return bytes;
 }
 
 void MakeDirectories(const std::string& path) {

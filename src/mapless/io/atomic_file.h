@@ -3,6 +3,7 @@
 #pragma once
 
 #include <opencv2/core.hpp>
+#include <cstddef>
 #include <string>
 #include <string_view>
 
@@ -14,8 +15,10 @@ void WriteFileAtomic(const std::string& path, std::string_view bytes);
 // Encodes an image by the extension of `path` (.png, .jpg, ...) and writes it atomically.
 void WriteImageAtomic(const std::string& path, const cv::Mat& image);
 
-// Reads a whole file; throws InputError naming the path if it cannot be read.
-std::string ReadFile(const std::string& path);
+// Reads a whole regular file of at most `max_bytes`; throws InputError naming the path when it
+// cannot be read, is not a regular file (a directory, a device such as /dev/zero, a FIFO) or is
+// larger than `max_bytes` (io/limits.h has the limit of each kind of file).
+std::string ReadFile(const std::string& path, std::size_t max_bytes);
 
 // Creates a directory and its parents; throws InputError naming the path on failure.
 void MakeDirectories(const std::string& path);

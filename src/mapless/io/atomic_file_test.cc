@@ -18,7 +18,7 @@ TEST(AtomicFile, WritesThenReadsBackAndLeavesNoTemporary) {
   const std::string path = (dir / "a.txt").string();
   WriteFileAtomic(path, "first");
   WriteFileAtomic(path, "second");
-  EXPECT_EQ(ReadFile(path), "second");
+  EXPECT_EQ(ReadFile(path, 1 << 20), "second");
   int files = 0;
   for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++files;
   EXPECT_EQ(files, 1);

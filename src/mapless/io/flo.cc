@@ -7,12 +7,13 @@
 
 #include "mapless/core/check.h"
 #include "mapless/io/atomic_file.h"
+#include "mapless/io/image_file.h"
+#include "mapless/io/limits.h"
 
 namespace mapless::io {
 namespace {
 
 constexpr float kFloMagic = 202021.25f;
-constexpr int kMaxSide = 1 << 15;
 
 bool EndsWith(const std::string& s, std::string_view suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
@@ -20,7 +21,7 @@ bool EndsWith(const std::string& s, std::string_view suffix) {
 
 }  // namespace
 
-cv::Mat ReadFlo(const std::string& path) { return ParseFlo(ReadFile(path), path); }
+cv::Mat ReadFlo(const std::string& path) { return ParseFlo(ReadFile(path, 12 + 8 * static_cast<std::size_t>(kMaxImagePixels)), path); }
 
 cv::Mat ParseFlo(const std::string& bytes, const std::string& path) {
   if (bytes.size() < 12) throw InputError(path + ": not a .flo file (shorter than its header)");
@@ -32,9 +33,11 @@ cv::Mat ParseFlo(const std::string& bytes, const std::string& path) {
   std::memcpy(&height, bytes.data() + 8, 4);
   if (magic != kFloMagic)
     throw InputError(path + ": not a .flo file (magic number is not 202021.25)");
-  if (width <= 0 || height <= 0 || width > kMaxSide || height > kMaxSide) {
+  if (width <= 0 || height <= 0 || width > kMaxImageSide || height > kMaxImageSide ||
+      static_cast<std::int64_t>(width) * height > kMaxImagePixels) {
     throw InputError(path + ": .flo size " + std::to_string(width) + "x" + std::to_string(height) +
-                     " is not valid");
+                     " is not valid (at most " + std::to_string(kMaxImagePixels / 1'000'000) +
+                     " megapixels, " + std::to_string(kMaxImageSide) + " a side)");
   }
   const std::size_t need = 12 + static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 8;
   if (bytes.size() < need) {
@@ -66,13 +69,7 @@ void WriteFlo(const std::string& path, const cv::Mat& flow) {
 }
 
 cv::Mat ReadKittiFlow(const std::string& path, cv::Mat* valid) {
-  cv::Mat png;
-  try {
-    png = cv::imread(path, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception&) {
-    png.release();
-  }
-  if (png.empty()) throw InputError(path + ": cannot read the KITTI flow PNG");
+  const cv::Mat png = ReadImage(path, cv::IMREAD_UNCHANGED);
   if (png.type() != CV_16UC3)
     throw InputError(path + ": not a KITTI flow PNG (expected 16-bit, 3 channels)");
   cv::Mat flow(png.size(), CV_32FC2);

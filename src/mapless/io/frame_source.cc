@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "mapless/core/check.h"
+#include "mapless/io/image_file.h"
+#include "mapless/io/limits.h"
 
 namespace mapless::io {
 namespace {
@@ -39,13 +41,7 @@ class FolderSource : public FrameSource {
   bool Next(Frame* frame) override {
     if (next_ >= files_.size()) return false;
     const std::string& path = files_[next_];
-    cv::Mat img;
-    try {
-      img = cv::imread(path, cv::IMREAD_GRAYSCALE);
-    } catch (const cv::Exception&) {
-      img.release();
-    }
-    if (img.empty()) throw InputError(path + ": cannot read image");
+    const cv::Mat img = ReadImage(path, cv::IMREAD_GRAYSCALE, kMinImageSide);
     if (!size_.empty() && img.size() != size_) {
       throw InputError(path + ": image is " + std::to_string(img.cols) + "x" +
                        std::to_string(img.rows) + " but the folder's first image is " +
@@ -80,10 +76,31 @@ class VideoSource : public FrameSource {
     }
     fps_ = capture_.get(cv::CAP_PROP_FPS);
     if (!(fps_ > 0.0 && fps_ < 1000.0)) fps_ = 30.0;
+    // The container's declared size, checked before the first frame is decoded.
+    const double width = capture_.get(cv::CAP_PROP_FRAME_WIDTH);
+    const double height = capture_.get(cv::CAP_PROP_FRAME_HEIGHT);
+    if (width > 0.0 && height > 0.0 && width < 1e9 && height < 1e9) {
+      CheckFrameSize(static_cast<int>(width), static_cast<int>(height), spec);
+    }
   }
   bool Next(Frame* frame) override {
     cv::Mat img;
-    if (!capture_.read(img) || img.empty()) return false;
+    try {
+      if (!capture_.read(img) || img.empty()) return false;
+    } catch (const cv::Exception&) {
+      throw InputError(spec_ + ": frame " + std::to_string(index_) + " does not decode");
+    }
+    const std::string name = spec_ + " frame " + std::to_string(index_);
+    CheckFrameSize(img.cols, img.rows, name);
+    if (!size_.empty() && img.size() != size_) {
+      throw InputError(name + ": image is " + std::to_string(img.cols) + "x" +
+                       std::to_string(img.rows) + " but the first frame is " +
+                       std::to_string(size_.width) + "x" + std::to_string(size_.height));
+    }
+    size_ = img.size();
+    if (img.depth() != CV_8U) {
+      throw InputError(name + ": frames must have 8-bit channels");
+    }
     frame->image = ToGrey(img);
     frame->t_ns = FromSeconds(static_cast<double>(index_) / fps_);
     frame->name = std::to_string(index_);
@@ -97,18 +114,26 @@ class VideoSource : public FrameSource {
   cv::VideoCapture capture_;
   double fps_ = 30.0;
   long index_ = 0;
+  cv::Size size_;
 };
 
 }  // namespace
 
 std::unique_ptr<FrameSource> OpenFrameSource(const std::string& spec, double folder_fps) {
-  MAPLESS_CHECK(folder_fps > 0.0, "folder fps = " << folder_fps << "; must be > 0");
+  MAPLESS_CHECK(folder_fps >= kMinFolderFps && folder_fps <= kMaxFolderFps,
+                "--fps " << folder_fps << ": must be in [" << kMinFolderFps << ", "
+                         << kMaxFolderFps << "] frames per second");
   if (spec.rfind("camera:", 0) == 0) {
     int device = 0;
+    const std::string number = spec.substr(7);
+    std::size_t used = 0;
     try {
-      device = std::stoi(spec.substr(7));
+      device = std::stoi(number, &used);
     } catch (const std::exception&) {
-      throw InputError(spec + ": expected camera:N with a device number");
+      used = 0;
+    }
+    if (number.empty() || used != number.size() || device < 0 || device > 63) {
+      throw InputError(spec + ": expected camera:N with a device number 0..63");
     }
     return std::make_unique<VideoSource>(spec, true, device);
   }

@@ -24,9 +24,15 @@ class FrameSource {
   virtual std::string Describe() const = 0;
 };
 
+// Frame rates accepted for image folders (timestamps are index / fps).
+inline constexpr double kMinFolderFps = 0.01;
+inline constexpr double kMaxFolderFps = 1000.0;
+
 // Opens `spec`: "camera:N" or "/dev/videoN" for a camera, a directory for an image folder
 // (.png .jpg .jpeg .bmp .pgm .ppm .tif .tiff), anything else as a video file. `folder_fps` gives
 // the timestamps of folder frames. Throws InputError naming the source when it cannot be opened.
+// Every frame is checked against the limits of io/limits.h (size, pixels; folder images are read
+// with their header checked first) and must have the size of the first one.
 std::unique_ptr<FrameSource> OpenFrameSource(const std::string& spec, double folder_fps = 10.0);
 
 }  // namespace mapless::io

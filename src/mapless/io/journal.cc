@@ -4,19 +4,36 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 
 #include "mapless/core/check.h"
 
 namespace mapless::io {
 
-JournalFile::JournalFile(const std::string& path) : path_(path) {
-  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0644);
+JournalFile::JournalFile(const std::string& path, Mode mode)
+    : path_(path), write_path_(mode == Mode::kReplaceAtClose ? path + ".partial" : path) {
+  fd_ = ::open(write_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0644);
   if (fd_ < 0) throw InputError(path + ": cannot write: " + std::strerror(errno));
 }
 
 JournalFile::~JournalFile() {
-  if (fd_ >= 0) ::close(fd_);
+  try {
+    Close();
+  } catch (const InputError&) {
+    // Destruction during unwinding: the records written so far stay where they are.
+  }
+}
+
+void JournalFile::Close() {
+  if (fd_ < 0) return;
+  const bool synced = ::fsync(fd_) == 0;
+  ::close(fd_);
+  fd_ = -1;
+  if (!synced) throw InputError(path_ + ": cannot write: " + std::strerror(errno));
+  if (write_path_ != path_ && std::rename(write_path_.c_str(), path_.c_str()) != 0) {
+    throw InputError(path_ + ": cannot write: " + std::strerror(errno));
+  }
 }
 
 void JournalFile::Append(std::string_view record) {

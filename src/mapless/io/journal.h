@@ -11,8 +11,15 @@ namespace mapless::io {
 
 class JournalFile {
  public:
-  // Creates (or truncates) `path`; throws InputError naming it when it cannot be written.
-  explicit JournalFile(const std::string& path);
+  enum class Mode {
+    kInPlace,  // create (or truncate) `path` and append to it
+    // Append to `path`.partial and rename it over `path` on Close() or destruction: a file that was
+    // at `path` stays whole until the new one is done; a process killed mid-run leaves the records
+    // it finished in `path`.partial. For files the user names (decision logs).
+    kReplaceAtClose,
+  };
+  // Throws InputError naming the file when it cannot be written.
+  explicit JournalFile(const std::string& path, Mode mode = Mode::kInPlace);
   ~JournalFile();
   JournalFile(const JournalFile&) = delete;
   JournalFile& operator=(const JournalFile&) = delete;
@@ -22,10 +29,13 @@ class JournalFile {
   // Flushes the records to the disk (fsync): for power loss; a killed process loses nothing
   // appended without it.
   void Sync();
+  // Syncs, closes and (kReplaceAtClose) puts the file in place. Throws InputError on failure.
+  void Close();
   const std::string& path() const { return path_; }
 
  private:
   std::string path_;
+  std::string write_path_;
   int fd_ = -1;
 };
 

@@ -31,9 +31,9 @@ TEST(JournalFile, AppendsWholeLines) {
     j.Append("b\n");
     j.Sync();
   }
-  EXPECT_EQ(ReadFile(path), "a\nb\n");
+  EXPECT_EQ(ReadFile(path, 1 << 20), "a\nb\n");
   JournalFile again(path);  // truncates
-  EXPECT_EQ(ReadFile(path), "");
+  EXPECT_EQ(ReadFile(path, 1 << 20), "");
 }
 
 TEST(JournalFile, UnwritablePathIsNamed) {
@@ -67,7 +67,7 @@ TEST(JournalFile, AProcessKilledMidRunLeavesOnlyWholeRecords) {
   int status = 0;
   ::waitpid(child, &status, 0);
   ASSERT_TRUE(WIFSIGNALED(status));
-  const std::string text = ReadFile(path);
+  const std::string text = ReadFile(path, 1 << 20);
   ASSERT_FALSE(text.empty());
   const std::vector<StampedPose> poses = ParseTum(text, path);
   ASSERT_GT(poses.size(), 100U);

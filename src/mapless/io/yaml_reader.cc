@@ -6,6 +6,8 @@
 #include <sstream>
 
 #include "mapless/core/check.h"
+#include "mapless/io/atomic_file.h"
+#include "mapless/io/limits.h"
 
 namespace mapless::io {
 namespace {
@@ -20,11 +22,7 @@ std::string ShortValue(const YAML::Node& node) {
 }  // namespace
 
 YamlMap YamlMap::LoadFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return LoadString(buffer.str(), path);
+  return LoadString(ReadFile(path, kMaxYamlFileBytes), path);
 }
 
 YamlMap YamlMap::LoadString(const std::string& text, const std::string& name) {

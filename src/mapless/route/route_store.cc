@@ -10,7 +10,10 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "mapless/core/check.h"
+#include "mapless/features/features.h"
 #include "mapless/io/atomic_file.h"
+#include "mapless/io/image_file.h"
+#include "mapless/io/limits.h"
 #include "mapless/io/yaml_reader.h"
 
 namespace mapless::route {
@@ -71,10 +74,47 @@ bool IsInt(double v) {
          v <= static_cast<double>(std::numeric_limits<int>::max());
 }
 
+// What a repeat relies on in one keyframe, checked where the file is known: descriptors as the
+// route's detector writes them, keypoints and tracks inside the image, the manifest's time.
+void CheckKeyframe(const Keyframe& kf, const ManifestEntry& entry, const Manifest& manifest,
+                   const features::DescriptorLayout& layout, const std::string& name) {
+  if (kf.descriptors.rows > 0 &&
+      (kf.descriptors.depth() != layout.type || kf.descriptors.cols != layout.length)) {
+    throw InputError(name + ": descriptors of " + std::to_string(kf.descriptors.cols) + " " +
+                     (kf.descriptors.depth() == CV_8U ? "bytes" : "floats") +
+                     " do not match the route's detector '" + manifest.detector + "' (" +
+                     std::to_string(layout.length) + " " +
+                     (layout.type == CV_8U ? "bytes" : "floats") + ")");
+  }
+  const auto inside = [&](float x, float y) {
+    return x >= -1.f && y >= -1.f && x <= static_cast<float>(manifest.image_width) + 1.f &&
+           y <= static_cast<float>(manifest.image_height) + 1.f;
+  };
+  for (const cv::KeyPoint& k : kf.keypoints) {
+    if (!inside(k.pt.x, k.pt.y)) {
+      throw InputError(name + ": keypoint (" + std::to_string(k.pt.x) + ", " +
+                       std::to_string(k.pt.y) + ") is outside the route's " +
+                       std::to_string(manifest.image_width) + "x" +
+                       std::to_string(manifest.image_height) + " image");
+    }
+  }
+  for (const auto* track : {&kf.segment_start_px, &kf.segment_end_px}) {
+    for (const cv::Point2f& p : *track) {
+      if (!inside(p.x, p.y)) {
+        throw InputError(name + ": a segment track point (" + std::to_string(p.x) + ", " +
+                         std::to_string(p.y) + ") is outside the route's image");
+      }
+    }
+  }
+  if (std::abs(ToSeconds(kf.t_ns) - entry.t_s) > 1e-3) {
+    throw InputError(name + ": t_ns says " + std::to_string(ToSeconds(kf.t_ns)) +
+                     " s, the manifest says " + std::to_string(entry.t_s) + " s");
+  }
+}
+
 }  // namespace
 
-RouteWriter::RouteWriter(std::string dir, std::string detector, int image_width, int image_height,
-                         bool overwrite)
+RouteWriter::RouteWriter(std::string dir, std::string detector, int image_width, int image_height)
     : dir_(std::move(dir)),
       detector_(std::move(detector)),
       width_(image_width),
@@ -83,11 +123,8 @@ RouteWriter::RouteWriter(std::string dir, std::string detector, int image_width,
                                                          << image_width << "x" << image_height
                                                          << " must be positive");
   const std::filesystem::path manifest = std::filesystem::path(dir_) / "manifest.json";
-  if (std::filesystem::exists(manifest) && !overwrite) {
+  if (std::filesystem::exists(manifest)) {
     throw InputError(dir_ + ": already holds a route (manifest.json); choose another directory");
-  }
-  if (overwrite && std::filesystem::exists(std::filesystem::path(dir_) / "keyframes")) {
-    std::filesystem::remove_all(std::filesystem::path(dir_) / "keyframes");
   }
   io::MakeDirectories((std::filesystem::path(dir_) / "keyframes").string());
   WriteManifest();
@@ -152,7 +189,12 @@ Keyframe ParseKeyframe(const std::string& text, const std::string& name) {
       root.Fail("t_ns", "expected a whole number of nanoseconds");
     }
     if (root.Has("keypoints")) {
-      for (const io::YamlMap& k : root.GetList("keypoints")) {
+      const std::vector<io::YamlMap> keypoints = root.GetList("keypoints");
+      if (keypoints.size() > static_cast<std::size_t>(io::kMaxKeypoints)) {
+        root.Fail("keypoints", std::to_string(keypoints.size()) + " keypoints; the limit is " +
+                                   std::to_string(io::kMaxKeypoints));
+      }
+      for (const io::YamlMap& k : keypoints) {
         const std::vector<double> v = k.AsDoubles(7);  // x, y, size, angle, response, octave, id
         for (int i = 0; i < 5; ++i) {
           if (!FitsFloat(v[static_cast<std::size_t>(i)])) k.Fail("", "a value is out of range");
@@ -170,7 +212,7 @@ Keyframe ParseKeyframe(const std::string& text, const std::string& name) {
       const int cols = d.GetInt("cols");
       const std::string dt = d.GetString("dt");
       if (dt != "u" && dt != "f") d.Fail("dt", "expected u (ORB) or f (float descriptors)");
-      if (rows < 0 || cols < 0 || rows > 100'000 || cols > 4096) {  // rows * cols fits an int
+      if (rows < 0 || cols < 0 || rows > io::kMaxKeypoints || cols > 4096) {  // rows * cols fits
         d.Fail("", "implausible size " + std::to_string(rows) + "x" + std::to_string(cols));
       }
       const std::vector<double> data = d.GetDoubles("data", rows * cols);
@@ -230,9 +272,21 @@ Manifest ParseManifest(const std::string& text, const std::string& name) {
     m.image_width = ManifestInt(j, "image_width", name);
     m.image_height = ManifestInt(j, "image_height", name);
     m.complete = j.at("complete").get<bool>();
-    for (const auto& entry : j.at("keyframes")) {
+    const nlohmann::json& keyframes = j.at("keyframes");
+    if (!keyframes.is_array()) throw InputError(name + ": corrupt manifest (keyframes is not a list)");
+    if (keyframes.size() > static_cast<std::size_t>(io::kMaxKeyframes)) {
+      throw InputError(name + ": " + std::to_string(keyframes.size()) +
+                       " keyframes; the limit is " + std::to_string(io::kMaxKeyframes));
+    }
+    for (const auto& entry : keyframes) {
       ManifestEntry e;
       e.index = ManifestInt(entry, "index", name);
+      const nlohmann::json& t_s = entry.at("t_s");
+      if (!t_s.is_number() || !std::isfinite(t_s.get<double>())) {
+        throw InputError(name + ": keyframe " + std::to_string(e.index) +
+                         ": t_s is not a number of seconds");
+      }
+      e.t_s = t_s.get<double>();
       e.data = entry.at("data").get<std::string>();
       e.thumbnail = entry.at("thumbnail").get<std::string>();
       if (e.index != static_cast<int>(m.keyframes.size())) {
@@ -248,10 +302,13 @@ Manifest ParseManifest(const std::string& text, const std::string& name) {
   } catch (const nlohmann::json::exception& e) {
     throw InputError(name + ": corrupt manifest (" + std::string(e.what()) + ")");
   }
-  if (m.image_width <= 0 || m.image_height <= 0 || m.image_width > 1 << 15 ||
-      m.image_height > 1 << 15) {
-    throw InputError(name + ": corrupt manifest (image size " + std::to_string(m.image_width) +
-                     "x" + std::to_string(m.image_height) + ")");
+  if (m.image_width < io::kMinImageSide || m.image_height < io::kMinImageSide ||
+      m.image_width > io::kMaxImageSide || m.image_height > io::kMaxImageSide ||
+      static_cast<std::int64_t>(m.image_width) * m.image_height > io::kMaxImagePixels) {
+    throw InputError(name + ": image size " + std::to_string(m.image_width) + "x" +
+                     std::to_string(m.image_height) + " is out of range (" +
+                     std::to_string(io::kMinImageSide) + " to " +
+                     std::to_string(io::kMaxImageSide) + " a side)");
   }
   return m;
 }
@@ -261,7 +318,19 @@ Route LoadRoute(const std::string& dir) {
   if (!std::filesystem::exists(manifest_path)) {
     throw InputError(manifest_path + ": no route here (manifest.json is missing)");
   }
-  const Manifest manifest = ParseManifest(io::ReadFile(manifest_path), manifest_path);
+  const Manifest manifest = ParseManifest(io::ReadFile(manifest_path, io::kMaxManifestBytes), manifest_path);
+  features::DetectorType detector = features::DetectorType::kOrb;
+  try {
+    detector = features::ParseDetectorType(manifest.detector);
+  } catch (const InputError& e) {
+    throw InputError(manifest_path + ": detector: " + e.what());
+  }
+  const features::DescriptorLayout layout = features::DescriptorLayoutOf(detector);
+  if (manifest.keyframes.size() < 2) {
+    throw InputError(manifest_path + ": the route has " + std::to_string(manifest.keyframes.size()) +
+                     " keyframe" + (manifest.keyframes.size() == 1 ? "" : "s") +
+                     "; a route needs at least 2 to be repeated");
+  }
   Route route;
   route.detector = manifest.detector;
   route.image_width = manifest.image_width;
@@ -271,17 +340,19 @@ Route LoadRoute(const std::string& dir) {
     const std::string data = (std::filesystem::path(dir) / entry.data).string();
     const std::string thumb = (std::filesystem::path(dir) / entry.thumbnail).string();
     if (!std::filesystem::exists(data)) throw InputError(data + ": keyframe file is missing");
-    Keyframe kf = ParseKeyframe(io::ReadFile(data), data);
+    Keyframe kf = ParseKeyframe(io::ReadFile(data, io::kMaxKeyframeFileBytes), data);
     if (kf.index != entry.index) {
       throw InputError(data + ": keyframe index " + std::to_string(kf.index) +
                        " does not match the manifest");
     }
-    try {
-      kf.thumbnail = cv::imread(thumb, cv::IMREAD_GRAYSCALE);
-    } catch (const cv::Exception&) {
-      kf.thumbnail.release();
+    CheckKeyframe(kf, entry, manifest, layout, data);
+    if (!route.keyframes.empty() && kf.t_ns <= route.keyframes.back().t_ns) {
+      throw InputError(data + ": t_ns " + std::to_string(kf.t_ns) +
+                       " is not after the previous keyframe's (" +
+                       std::to_string(route.keyframes.back().t_ns) + "): time goes backwards");
     }
-    if (kf.thumbnail.empty()) throw InputError(thumb + ": missing or corrupt keyframe image");
+    if (!std::filesystem::exists(thumb)) throw InputError(thumb + ": keyframe image is missing");
+    kf.thumbnail = io::ReadImage(thumb, cv::IMREAD_GRAYSCALE);
     route.keyframes.push_back(std::move(kf));
   }
   return route;

@@ -24,9 +24,9 @@ inline constexpr int kRouteFormatVersion = 1;
 class RouteWriter {
  public:
   // Creates DIR (and DIR/keyframes) and writes an empty manifest. Throws InputError when DIR
-  // already holds a route and `overwrite` is false.
-  RouteWriter(std::string dir, std::string detector, int image_width, int image_height,
-              bool overwrite = false);
+  // already holds a route: replacing a route is io::OutputDirectory's business (the old one stays
+  // whole until the new one is done).
+  RouteWriter(std::string dir, std::string detector, int image_width, int image_height);
   // Writes one keyframe, then the manifest that lists it.
   void Append(const Keyframe& keyframe);
   // Marks the route complete.
@@ -48,13 +48,17 @@ class RouteWriter {
 };
 
 // Loads a route; throws InputError naming the file and what is wrong (missing, truncated,
-// corrupt, wrong version, inconsistent).
+// corrupt, wrong version, over a limit of io/limits.h, or inconsistent: an unknown detector,
+// descriptors another detector wrote, fewer than 2 keyframes, time going backwards, keypoints
+// outside the image). Whatever a repeat relies on is checked here, so `mapless route info`
+// catches it.
 Route LoadRoute(const std::string& dir);
 
 // The parsers behind LoadRoute, on bytes already read (`name` stands for the file in errors).
 // Fuzzed by fuzz/fuzz_route_manifest.cc and fuzz/fuzz_route_keyframe.cc.
 struct ManifestEntry {
   int index = 0;
+  double t_s = 0.0;       // the keyframe's time, as its file says
   std::string data;       // relative to the route directory; never absolute, never ".."
   std::string thumbnail;  // likewise
 };

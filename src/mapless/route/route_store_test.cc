@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <functional>
 #include <fstream>
 
 #include "mapless/core/check.h"
@@ -84,7 +85,6 @@ TEST(RouteStore, RefusesToOverwriteAnExistingRoute) {
               RouteWriter again(dir, "orb", 320, 240);
             }).find("already holds a route"),
             std::string::npos);
-  EXPECT_NO_THROW(RouteWriter(dir, "orb", 320, 240, /*overwrite=*/true));
 }
 
 TEST(RouteStore, TruncatedKeyframeFileIsNamedInTheError) {
@@ -93,7 +93,7 @@ TEST(RouteStore, TruncatedKeyframeFileIsNamedInTheError) {
   writer.Append(MakeKeyframe(0));
   writer.Append(MakeKeyframe(1));
   const std::string path = dir + "/keyframes/000001.yml";
-  const std::string text = io::ReadFile(path);
+  const std::string text = io::ReadFile(path, 1 << 24);
   io::WriteFileAtomic(path, text.substr(0, text.size() / 2));
   const std::string err = testing::InputErrorOf([&] { LoadRoute(dir); });
   EXPECT_NE(err.find("000001.yml"), std::string::npos) << err;
@@ -103,13 +103,15 @@ TEST(RouteStore, CorruptOrMissingFilesGiveOneClearError) {
   const std::string dir = FreshDir("corrupt");
   RouteWriter writer(dir, "orb", 320, 240);
   writer.Append(MakeKeyframe(0));
+  writer.Append(MakeKeyframe(1));
+  const std::string good = io::ReadFile(dir + "/keyframes/000000.yml", 1 << 24);
   // Garbage keyframe data.
   io::WriteFileAtomic(dir + "/keyframes/000000.yml", std::string("\x01\x02garbage\xff", 11));
   EXPECT_NE(testing::InputErrorOf([&] { LoadRoute(dir); }).find("000000.yml"), std::string::npos);
+  io::WriteFileAtomic(dir + "/keyframes/000000.yml", good);
   // Missing thumbnail.
-  writer.Append(MakeKeyframe(1));
   std::filesystem::remove(dir + "/keyframes/000001.png");
-  io::WriteFileAtomic(dir + "/keyframes/000000.yml", io::ReadFile(dir + "/keyframes/000000.yml"));
+  EXPECT_NE(testing::InputErrorOf([&] { LoadRoute(dir); }).find("000001.png"), std::string::npos);
   // Corrupt manifest.
   io::WriteFileAtomic(dir + "/manifest.json", "{\"format\": \"mapless-route\", \"vers");
   EXPECT_NE(testing::InputErrorOf([&] { LoadRoute(dir); }).find("manifest.json: corrupt manifest"),
@@ -135,13 +137,49 @@ TEST(RouteStore, AManifestCannotPointOutsideTheRoute) {
 TEST(RouteStore, NewerFormatVersionIsRefusedByName) {
   const std::string dir = FreshDir("version");
   { RouteWriter writer(dir, "orb", 320, 240); }
-  std::string manifest = io::ReadFile(dir + "/manifest.json");
+  std::string manifest = io::ReadFile(dir + "/manifest.json", 1 << 24);
   manifest.replace(manifest.find("\"version\": 1"), 12, "\"version\": 9");
   io::WriteFileAtomic(dir + "/manifest.json", manifest);
   EXPECT_NE(testing::InputErrorOf([&] {
               LoadRoute(dir);
             }).find("route format version 9 is not supported"),
             std::string::npos);
+}
+
+// Everything a repeat relies on is checked on loading, naming the file.
+TEST(RouteStore, LoadingCatchesWhatARepeatWouldTripOn) {
+  const auto route_with = [](const std::string& name, const std::string& detector,
+                             const std::function<void(Keyframe*)>& edit) {
+    const std::string dir = FreshDir(name);
+    RouteWriter writer(dir, detector, 320, 240);
+    for (int i = 0; i < 3; ++i) {
+      Keyframe kf = MakeKeyframe(i);
+      if (i == 2) edit(&kf);
+      writer.Append(kf);
+    }
+    writer.Finish();
+    return testing::InputErrorOf([&] { LoadRoute(dir); });
+  };
+  const auto none = [](Keyframe*) {};
+  EXPECT_NE(route_with("unknown_detector", "surf", none).find("manifest.json: detector: unknown"),
+            std::string::npos);
+  EXPECT_NE(route_with("sift_with_orb", "sift", none).find("000000.yml: descriptors of 32 bytes"),
+            std::string::npos);
+  EXPECT_NE(route_with("backwards", "orb", [](Keyframe* kf) { kf->t_ns = 50'000'000; })
+                .find("000002.yml: t_ns 50000000 is not after"),
+            std::string::npos);
+  EXPECT_NE(route_with("outside", "orb", [](Keyframe* kf) { kf->keypoints[3].pt.x = 900.f; })
+                .find("000002.yml: keypoint (900"),
+            std::string::npos);
+  EXPECT_EQ(route_with("fine", "orb", none), "");
+  {
+    const std::string dir = FreshDir("one_keyframe");
+    RouteWriter writer(dir, "orb", 320, 240);
+    writer.Append(MakeKeyframe(0));
+    writer.Finish();
+    EXPECT_NE(testing::InputErrorOf([&] { LoadRoute(dir); }).find("at least 2"),
+              std::string::npos);
+  }
 }
 
 }  // namespace

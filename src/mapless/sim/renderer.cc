@@ -415,12 +415,9 @@ Renderer::Renderer(const World& world, RenderOptions options) : options_(options
   sky_top_ = world.sky_top;
   sky_horizon_ = world.sky_horizon;
   // Objects with identical texture specs share one texture (repeating doors and posters).
-  std::map<std::tuple<int, std::uint64_t, double, bool, double, double, int, std::string>,
-           std::shared_ptr<const Texture>>
-      cache;
+  std::map<TextureKey, std::shared_ptr<const Texture>> cache;
   auto texture_for = [&](const TextureSpec& spec) {
-    const auto key = std::make_tuple(static_cast<int>(spec.type), spec.seed, spec.texel_m, spec.fit,
-                                     spec.mean, spec.contrast, spec.size_px, spec.file);
+    const TextureKey key = TextureKeyOf(spec);
     auto it = cache.find(key);
     if (it == cache.end()) it = cache.emplace(key, GenerateTexture(spec)).first;
     return it->second;

@@ -15,22 +15,28 @@ double Ramp(double current, double target, double max_step) {
 }  // namespace
 
 void RobotOptions::Validate() const {
-  MAPLESS_CHECK(radius_m > 0.0, "RobotOptions.radius_m = " << radius_m << "; must be > 0");
-  MAPLESS_CHECK(max_v_mps > 0.0, "RobotOptions.max_v_mps = " << max_v_mps << "; must be > 0");
-  MAPLESS_CHECK(max_omega_radps > 0.0,
-                "RobotOptions.max_omega_radps = " << max_omega_radps << "; must be > 0");
-  MAPLESS_CHECK(max_accel_mps2 > 0.0,
-                "RobotOptions.max_accel_mps2 = " << max_accel_mps2 << "; must be > 0");
-  MAPLESS_CHECK(max_alpha_radps2 > 0.0,
-                "RobotOptions.max_alpha_radps2 = " << max_alpha_radps2 << "; must be > 0");
+  const auto in = [](double v, double lo, double hi) { return v >= lo && v <= hi; };
+  MAPLESS_CHECK(in(radius_m, 0.01, 10.0),
+                "RobotOptions.radius_m = " << radius_m << "; must be in [0.01, 10]");
+  MAPLESS_CHECK(in(max_v_mps, 1e-3, 20.0),
+                "RobotOptions.max_v_mps = " << max_v_mps << "; must be in [0.001, 20]");
+  MAPLESS_CHECK(in(max_omega_radps, 1e-3, 20.0),
+                "RobotOptions.max_omega_radps = " << max_omega_radps << "; must be in [0.001, 20]");
+  MAPLESS_CHECK(in(max_accel_mps2, 1e-3, 1e6),
+                "RobotOptions.max_accel_mps2 = " << max_accel_mps2 << "; must be in [0.001, 1e6]");
+  MAPLESS_CHECK(in(max_alpha_radps2, 1e-3, 1e6), "RobotOptions.max_alpha_radps2 = "
+                                                       << max_alpha_radps2
+                                                       << "; must be in [0.001, 1e6]");
   MAPLESS_CHECK(
-      motion_noise_v_frac >= 0.0 && motion_noise_v_frac <= 1.0,
+      in(motion_noise_v_frac, 0.0, 1.0),
       "RobotOptions.motion_noise_v_frac = " << motion_noise_v_frac << "; must be in [0, 1]");
-  MAPLESS_CHECK(motion_noise_omega_frac >= 0.0 && motion_noise_omega_frac <= 1.0,
+  MAPLESS_CHECK(in(motion_noise_omega_frac, 0.0, 1.0),
                 "RobotOptions.motion_noise_omega_frac = " << motion_noise_omega_frac
                                                           << "; must be in [0, 1]");
-  MAPLESS_CHECK(odom_noise_v_mps >= 0.0 && odom_noise_omega_radps >= 0.0,
-                "RobotOptions.odom_noise_*: must be >= 0");
+  MAPLESS_CHECK(in(odom_scale_error, -0.5, 0.5),
+                "RobotOptions.odom_scale_error = " << odom_scale_error << "; must be in [-0.5, 0.5]");
+  MAPLESS_CHECK(in(odom_noise_v_mps, 0.0, 10.0) && in(odom_noise_omega_radps, 0.0, 10.0),
+                "RobotOptions.odom_noise_*: must be in [0, 10]");
 }
 
 DiffDriveRobot::DiffDriveRobot(const Pose2& start, RobotOptions options, std::uint64_t seed)

@@ -7,6 +7,7 @@
 
 #include "mapless/core/check.h"
 #include "mapless/io/atomic_file.h"
+#include "mapless/io/limits.h"
 #include "mapless/io/yaml_reader.h"
 #include "mapless/sim/builtin_scenarios.h"
 
@@ -246,7 +247,12 @@ RobotOptions ParseRobot(const YamlMap& m) {
 
 std::vector<PathStep> ParsePath(const YamlMap& teach) {
   std::vector<PathStep> path;
-  for (const YamlMap& item : teach.GetList("path")) {
+  const std::vector<YamlMap> items = teach.GetList("path");
+  if (items.size() > kMaxPathSteps) {
+    teach.Fail("path", std::to_string(items.size()) + " steps; the limit is " +
+                           std::to_string(kMaxPathSteps));
+  }
+  for (const YamlMap& item : items) {
     PathStep step;
     if (item.node().IsSequence()) {
       const std::size_t n = item.node().size();
@@ -282,17 +288,74 @@ void CameraSpec::Validate() const {
   model.Validate();
   mount.Validate();
   effects.Validate();
-  MAPLESS_CHECK(rate_hz > 0.0 && rate_hz <= 200.0,
-                "CameraSpec.rate_hz = " << rate_hz << "; must be in (0, 200]");
+  MAPLESS_CHECK(rate_hz >= 1.0 && rate_hz <= 200.0,
+                "CameraSpec.rate_hz = " << rate_hz << "; must be in [1, 200]");
 }
 
 void Scenario::Validate() const {
   world.Validate();
   camera.Validate();
   robot.Validate();
-  MAPLESS_CHECK(teach_speed_mps > 0.0,
-                "Scenario.teach.speed_mps = " << teach_speed_mps << "; must be > 0");
+  const auto speed_ok = [](double v) {
+    return std::isfinite(v) && v >= kMinPathSpeedMps && v <= kMaxPathSpeedMps;
+  };
+  MAPLESS_CHECK(speed_ok(teach_speed_mps), "Scenario.teach.speed_mps = "
+                                               << teach_speed_mps << "; must be in ["
+                                               << kMinPathSpeedMps << ", " << kMaxPathSpeedMps
+                                               << "]");
   MAPLESS_CHECK(!teach_path.empty(), "Scenario.teach.path is empty");
+  MAPLESS_CHECK(teach_path.size() <= kMaxPathSteps, "Scenario.teach.path: " << teach_path.size()
+                                                        << " steps; the limit is "
+                                                        << kMaxPathSteps);
+  const auto where_ok = [](double x, double y) {
+    return std::isfinite(x) && std::isfinite(y) && std::abs(x) <= kMaxWorldCoordinateM &&
+           std::abs(y) <= kMaxWorldCoordinateM;
+  };
+  MAPLESS_CHECK(where_ok(teach_start.x_m, teach_start.y_m) && std::isfinite(teach_start.theta_rad),
+                "Scenario.teach.start: beyond " << kMaxWorldCoordinateM << " m from the origin");
+  MAPLESS_CHECK(
+      where_ok(repeat_start.x_m, repeat_start.y_m) && std::isfinite(repeat_start.theta_rad),
+      "Scenario.repeat.start: beyond " << kMaxWorldCoordinateM << " m from the origin");
+  for (std::size_t i = 0; i < teach_path.size(); ++i) {
+    const PathStep& step = teach_path[i];
+    MAPLESS_CHECK(where_ok(step.target.x(), step.target.y()),
+                  "Scenario.teach.path[" << i << "]: beyond " << kMaxWorldCoordinateM
+                                         << " m from the origin");
+    MAPLESS_CHECK(step.speed_mps == 0.0 || speed_ok(step.speed_mps),
+                  "Scenario.teach.path[" << i << "]: speed " << step.speed_mps << " m/s; must be in ["
+                                         << kMinPathSpeedMps << ", " << kMaxPathSpeedMps << "]");
+    MAPLESS_CHECK(std::isfinite(step.rotate_rad) && std::abs(step.rotate_rad) <= kMaxRotateRad,
+                  "Scenario.teach.path[" << i << "]: rotation of " << RadToDeg(step.rotate_rad)
+                                         << " degrees; at most " << RadToDeg(kMaxRotateRad));
+  }
+  MAPLESS_CHECK(PathLength() <= kMaxPathLengthM, "Scenario.teach.path is "
+                                                     << PathLength() << " m long; the limit is "
+                                                     << kMaxPathLengthM << " m");
+  MAPLESS_CHECK(destinations.size() <= kMaxDestinations,
+                "Scenario.destinations: " << destinations.size() << "; the limit is "
+                                          << kMaxDestinations);
+  for (std::size_t i = 0; i < destinations.size(); ++i) {
+    MAPLESS_CHECK(where_ok(destinations[i].x(), destinations[i].y()),
+                  "Scenario.destinations[" << i << "]: beyond " << kMaxWorldCoordinateM
+                                           << " m from the origin");
+  }
+}
+
+Eigen::Vector4d ScenarioBounds(const Scenario& scenario, double margin_m) {
+  Eigen::Vector4d b = FootprintBounds(scenario.world);
+  const auto add = [&](double x, double y) {
+    b[0] = std::min(b[0], x);
+    b[1] = std::min(b[1], y);
+    b[2] = std::max(b[2], x);
+    b[3] = std::max(b[3], y);
+  };
+  add(scenario.teach_start.x_m, scenario.teach_start.y_m);
+  add(scenario.repeat_start.x_m, scenario.repeat_start.y_m);
+  for (const PathStep& step : scenario.teach_path) {
+    if (step.kind == PathStep::Kind::kGoTo) add(step.target.x(), step.target.y());
+  }
+  for (const Eigen::Vector2d& d : scenario.destinations) add(d.x(), d.y());
+  return b + Eigen::Vector4d(-margin_m, -margin_m, margin_m, margin_m);
 }
 
 double Scenario::PathLength() const {
@@ -399,7 +462,7 @@ Scenario LoadScenario(const std::string& name_or_path) {
     }
     return ParseScenario(text, "builtin:" + name_or_path, "");
   }
-  const std::string text = io::ReadFile(name_or_path);
+  const std::string text = io::ReadFile(name_or_path, io::kMaxYamlFileBytes);
   return ParseScenario(text, name_or_path,
                        std::filesystem::path(name_or_path).parent_path().string());
 }

@@ -16,6 +16,14 @@
 
 namespace mapless::sim {
 
+// Limits on a scenario beyond those of its world (docs/hardening.md).
+inline constexpr double kMinPathSpeedMps = 0.01;
+inline constexpr double kMaxPathSpeedMps = 10.0;
+inline constexpr std::size_t kMaxPathSteps = 10'000;
+inline constexpr double kMaxPathLengthM = 20'000.0;
+inline constexpr double kMaxRotateRad = 20.0 * 3.141592653589793;  // ten turns
+inline constexpr std::size_t kMaxDestinations = 1'000;
+
 struct CameraSpec {
   CameraModel model = CameraModel::FromFov(320, 240, DegToRad(60.0));
   CameraMount mount;
@@ -52,6 +60,10 @@ struct Scenario {
   // Length of the taught path (sum of straight legs), metres.
   double PathLength() const;
 };
+
+// The scenario's area: object footprints, starts, taught path and destinations, with a margin:
+// (min_x, min_y, max_x, max_y), metres.
+Eigen::Vector4d ScenarioBounds(const Scenario& scenario, double margin_m);
 
 // Parses a scenario from YAML text; errors name `source` (file), line and field.
 Scenario ParseScenario(const std::string& yaml_text, const std::string& source,

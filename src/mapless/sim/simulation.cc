@@ -9,16 +9,19 @@
 namespace mapless::sim {
 
 void SimulationOptions::Validate() const {
-  MAPLESS_CHECK(physics_dt_s > 0.0 && physics_dt_s <= 0.1,
-                "SimulationOptions.physics_dt_s = " << physics_dt_s << "; must be in (0, 0.1]");
+  MAPLESS_CHECK(physics_dt_s >= 1e-4 && physics_dt_s <= 0.1,
+                "SimulationOptions.physics_dt_s = " << physics_dt_s << "; must be in [1e-4, 0.1]");
+  MAPLESS_CHECK(robot_body_height_m > 0.0 && robot_body_height_m <= 10.0,
+                "SimulationOptions.robot_body_height_m = " << robot_body_height_m
+                                                           << "; must be in (0, 10]");
   MAPLESS_CHECK(robot_body_height_m > 0.0, "SimulationOptions.robot_body_height_m = "
                                                << robot_body_height_m << "; must be > 0");
   render.Validate();
 }
 
 void DriveOptions::Validate() const {
-  MAPLESS_CHECK(timeout_factor >= 1.0,
-                "DriveOptions.timeout_factor = " << timeout_factor << "; must be >= 1");
+  MAPLESS_CHECK(timeout_factor >= 1.0 && timeout_factor <= 100.0,
+                "DriveOptions.timeout_factor = " << timeout_factor << "; must be in [1, 100]");
   sim.Validate();
 }
 
@@ -72,6 +75,8 @@ bool Simulation::collided(int robot) const {
 }
 
 void Simulation::Advance(double dt_s) {
+  MAPLESS_CHECK(dt_s >= 0.0 && dt_s <= 60.0, "Simulation::Advance: dt = " << dt_s
+                                                 << " s; must be in [0, 60]");
   const int steps = std::max(1, static_cast<int>(std::lround(dt_s / options_.physics_dt_s)));
   for (int k = 0; k < steps; ++k) {
     for (std::size_t i = 0; i < robots_.size(); ++i) {

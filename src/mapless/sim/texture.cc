@@ -7,6 +7,7 @@
 
 #include "mapless/core/check.h"
 #include "mapless/core/rng.h"
+#include "mapless/io/image_file.h"
 
 namespace mapless::sim {
 namespace {
@@ -240,8 +241,14 @@ const char* TextureTypeName(TextureType type) {
   return "?";
 }
 
+TextureKey TextureKeyOf(const TextureSpec& spec) {
+  return std::make_tuple(static_cast<int>(spec.type), spec.seed, spec.texel_m, spec.fit, spec.mean,
+                         spec.contrast, spec.size_px, spec.file);
+}
+
 void TextureSpec::Validate() const {
-  MAPLESS_CHECK(texel_m > 0.0, "TextureSpec.texel_m = " << texel_m << "; must be > 0");
+  MAPLESS_CHECK(texel_m >= 1e-5 && texel_m <= 100.0,
+                "TextureSpec.texel_m = " << texel_m << "; must be in [1e-5, 100]");
   MAPLESS_CHECK(mean >= 0.0 && mean <= 255.0,
                 "TextureSpec.mean = " << mean << "; must be in [0, 255]");
   MAPLESS_CHECK(contrast >= 0.0 && contrast <= 4.0,
@@ -257,8 +264,7 @@ cv::Mat GenerateTextureImage(const TextureSpec& spec) {
   Rng rng(spec.seed * 0x9E3779B97F4A7C15ULL + static_cast<std::uint64_t>(spec.type));
   const int size = spec.size_px;
   if (spec.type == TextureType::kImage) {
-    cv::Mat img = cv::imread(spec.file, cv::IMREAD_GRAYSCALE);
-    if (img.empty()) throw InputError(spec.file + ": cannot read texture image");
+    const cv::Mat img = io::ReadImage(spec.file, cv::IMREAD_GRAYSCALE);
     cv::Mat out;
     cv::resize(img, out, cv::Size(size, size), 0, 0, cv::INTER_AREA);
     return out;

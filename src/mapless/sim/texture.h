@@ -8,6 +8,7 @@
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace mapless::sim {
@@ -31,6 +32,12 @@ struct TextureSpec {
 
   void Validate() const;  // throws InputError naming the field and value
 };
+
+// What makes two texture specs the same texture (the renderer generates each distinct one once):
+// type, seed, texel_m, fit, mean, contrast, size_px, file.
+using TextureKey =
+    std::tuple<int, std::uint64_t, double, bool, double, double, int, std::string>;
+TextureKey TextureKeyOf(const TextureSpec& spec);
 
 // A tileable texture with its mip pyramid: levels[0] is size_px x size_px, each next level half.
 struct Texture {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <set>
 
 #include "mapless/core/check.h"
 
@@ -49,15 +50,49 @@ void World::Validate() const {
   ground.Validate();
   if (ceiling) {
     ceiling->Validate();
-    MAPLESS_CHECK(ceiling_height_m > 0.0,
-                  "World.ceiling_height_m = " << ceiling_height_m << "; must be > 0");
+    MAPLESS_CHECK(ceiling_height_m > 0.0 && ceiling_height_m <= kMaxObjectSizeM,
+                  "World.ceiling_height_m = " << ceiling_height_m << "; must be in (0, "
+                                              << kMaxObjectSizeM << "]");
   }
+  MAPLESS_CHECK(sky_top >= 0.0 && sky_top <= 255.0 && sky_horizon >= 0.0 && sky_horizon <= 255.0,
+                "World.sky: top " << sky_top << ", horizon " << sky_horizon
+                                  << "; grey levels in [0, 255]");
+  MAPLESS_CHECK(objects.size() <= kMaxWorldObjects,
+                "World.objects: " << objects.size() << " objects (after rooms and repeats); the "
+                                  << "limit is " << kMaxWorldObjects);
+  std::set<TextureKey> textures = {TextureKeyOf(ground)};
+  if (ceiling) textures.insert(TextureKeyOf(*ceiling));
+  for (const WorldObject& o : objects) textures.insert(TextureKeyOf(o.texture));
+  double texels = 0.0;
+  for (const TextureKey& key : textures) texels += std::pow(std::get<6>(key), 2.0);
+  MAPLESS_CHECK(texels <= kMaxTextureTexels,
+                "World: " << textures.size() << " distinct textures of " << texels / (1 << 20)
+                          << " M texels in all; the limit is " << kMaxTextureTexels / (1 << 20)
+                          << " M (give repeated objects one texture seed, or a smaller size_px)");
+  const auto coordinate_ok = [](const Eigen::Vector2d& p) {
+    return p.allFinite() && p.cwiseAbs().maxCoeff() <= kMaxWorldCoordinateM;
+  };
+  const auto size_ok = [](double v) { return std::isfinite(v) && v > 0.0 && v <= kMaxObjectSizeM; };
   for (std::size_t i = 0; i < objects.size(); ++i) {
     const WorldObject& o = objects[i];
     const std::string name =
         std::string("World.objects[") + std::to_string(i) + "] (" + KindName(o.kind) + ")";
     o.texture.Validate();
-    MAPLESS_CHECK(o.height_m > 0.0, name << ".height_m = " << o.height_m << "; must be > 0");
+    MAPLESS_CHECK(size_ok(o.height_m), name << ".height_m = " << o.height_m << "; must be in (0, "
+                                            << kMaxObjectSizeM << "]");
+    MAPLESS_CHECK(coordinate_ok(o.a) && coordinate_ok(o.b) && coordinate_ok(o.center),
+                  name << ": a coordinate is beyond " << kMaxWorldCoordinateM
+                       << " m from the origin");
+    MAPLESS_CHECK(std::isfinite(o.yaw_rad) && std::isfinite(o.z_m) &&
+                      std::abs(o.z_m) <= kMaxObjectSizeM,
+                  name << ": yaw or height above the ground out of range");
+    MAPLESS_CHECK(o.kind == ObjectKind::kWall || o.kind == ObjectKind::kCylinder ||
+                      (size_ok(o.size_m.x()) && size_ok(o.size_m.y())),
+                  name << ".size = [" << o.size_m.x() << ", " << o.size_m.y()
+                       << "]; each must be in (0, " << kMaxObjectSizeM << "] m");
+    MAPLESS_CHECK(o.kind != ObjectKind::kCylinder || size_ok(o.radius_m),
+                  name << ".radius_m = " << o.radius_m << "; must be in (0, " << kMaxObjectSizeM
+                       << "]");
     switch (o.kind) {
       case ObjectKind::kWall:
         MAPLESS_CHECK((o.b - o.a).norm() > 1e-6, name << ": wall ends must differ");

@@ -14,6 +14,13 @@
 
 namespace mapless::sim {
 
+// Limits on a world, checked by World::Validate() (docs/hardening.md says why each is where it is).
+inline constexpr double kMaxWorldCoordinateM = 10'000.0;  // |x|, |y| of every point, metres
+inline constexpr double kMaxObjectSizeM = 1'000.0;        // sizes, radii, heights, metres
+inline constexpr std::size_t kMaxWorldObjects = 2'000;    // after `room` and `repeat` expansion
+// Distinct textures are generated and kept for rendering: the sum of their size_px^2.
+inline constexpr double kMaxTextureTexels = 128.0 * 1024 * 1024;
+
 enum class ObjectKind { kWall, kBox, kCylinder, kPoster };
 
 struct WorldObject {

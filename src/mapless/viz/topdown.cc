@@ -37,11 +37,13 @@ cv::Mat DrawTopDown(const sim::World& world, const std::vector<TopDownPath>& pat
     return cv::Point(static_cast<int>(std::lround((x - b[0]) * ppm)),
                      static_cast<int>(std::lround((b[3] - y) * ppm)));
   };
-  // Metre grid.
-  for (double x = std::ceil(b[0]); x <= b[2]; x += 1.0) {
+  // Grid: every metre, or every 10^k metres so that there are at most 100 lines each way.
+  double grid_m = 1.0;
+  while (span / grid_m > 100.0) grid_m *= 10.0;
+  for (double x = std::ceil(b[0] / grid_m) * grid_m; x <= b[2]; x += grid_m) {
     cv::line(img, px(x, b[1]), px(x, b[3]), cv::Scalar(232, 232, 232), 1);
   }
-  for (double y = std::ceil(b[1]); y <= b[3]; y += 1.0) {
+  for (double y = std::ceil(b[1] / grid_m) * grid_m; y <= b[3]; y += grid_m) {
     cv::line(img, px(b[0], y), px(b[2], y), cv::Scalar(232, 232, 232), 1);
   }
   for (const sim::WorldObject& o : world.objects) {

@@ -1,0 +1,52 @@
+#include "interrupt.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <csignal>
+#include <cstring>
+
+namespace mapless::app {
+namespace {
+
+std::atomic<int> g_signal{0};
+std::atomic<bool> g_cooperative{false};
+
+void Write(const char* text) {
+  // write(2) is async-signal-safe; the result does not matter on the way out.
+  const ssize_t unused = ::write(STDERR_FILENO, text, std::strlen(text));
+  (void)unused;
+}
+
+extern "C" void OnSignal(int signal) {
+  const bool first = g_signal.exchange(signal) == 0;
+  if (first && g_cooperative.load()) return;  // the run stops at its next frame
+  Write(signal == SIGTERM ? "mapless: terminated (SIGTERM)\n" : "mapless: interrupted (SIGINT)\n");
+  ::_exit(128 + signal);
+}
+
+}  // namespace
+
+Interrupted::Interrupted(int signal)
+    : std::runtime_error(signal == SIGTERM ? "terminated (SIGTERM)" : "interrupted (SIGINT)"),
+      signal_(signal) {}
+
+void InstallInterruptHandlers() {
+  struct sigaction action {};
+  action.sa_handler = OnSignal;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESTART;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+
+void StopCleanlyOnInterrupt() { g_cooperative.store(true); }
+
+void ThrowIfInterrupted() {
+  const int signal = g_signal.load();
+  if (signal != 0 && g_cooperative.load()) throw Interrupted(signal);
+}
+
+int InterruptSignal() { return g_signal.load(); }
+
+}  // namespace mapless::app
