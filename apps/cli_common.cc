@@ -51,6 +51,19 @@ JsonLines::JsonLines(const std::string& path, bool in_place) {
       path, in_place ? io::JournalFile::Mode::kInPlace : io::JournalFile::Mode::kReplaceAtClose);
 }
 
+CLI::Validator SeedCheck() {
+  return CLI::Validator(
+      [](const std::string& text) -> std::string {
+        const bool digits = !text.empty() && text.size() <= 20 &&
+                            text.find_first_not_of("0123456789") == std::string::npos;
+        if (!digits || (text.size() == 20 && text > "18446744073709551615")) {
+          return "'" + text + "' is not a seed (a whole number from 0 to 2^64 - 1)";
+        }
+        return "";
+      },
+      "", "Seed");
+}
+
 CLI::Validator FiniteIn(double lo, double hi) {
   return CLI::Validator(
       [lo, hi](const std::string& text) -> std::string {

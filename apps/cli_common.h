@@ -60,6 +60,8 @@ sim::DriveOptions LoadDriveOptions(const std::string& config_path);
 sim::DriveSummary DriveToDirectory(const sim::Scenario& scenario, const sim::DriveOptions& options,
                                    const std::string& out_dir);
 
+// A CLI11 check for seeds: a whole number 0 .. 2^64 - 1 (CLI11 would wrap "-1" round).
+CLI::Validator SeedCheck();
 // A CLI11 check: a finite number in [lo, hi] (CLI::Range lets nan through).
 CLI::Validator FiniteIn(double lo, double hi);
 

@@ -32,7 +32,9 @@ void AddDemoCommand(CLI::App* app) {
   demo->add_option("--scenario", args->scenario, "Built-in scenario name or YAML file")
       ->capture_default_str();
   demo->add_option("--out", args->out, "Output directory")->capture_default_str();
-  demo->add_option("--seed", args->seed, "Seed of motion and image noise")->capture_default_str();
+  demo->add_option("--seed", args->seed, "Seed of motion and image noise")
+      ->capture_default_str()
+      ->check(SeedCheck());
   demo->add_option("--config", args->config, "Run configuration YAML (see config/default.yaml)");
   demo->add_flag("--overwrite", args->overwrite,
                  "Replace what --out holds even when it is not an earlier demo's output");

@@ -162,7 +162,9 @@ void AddEvalCommand(CLI::App* app) {
   cmd->add_option("--runs", args->runs, "Repeats per scenario and controller")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
-  cmd->add_option("--seed", args->seed, "First seed; run i uses seed + i")->capture_default_str();
+  cmd->add_option("--seed", args->seed, "First seed; run i uses seed + i")
+      ->capture_default_str()
+      ->check(SeedCheck());
   cmd->add_flag("--json", args->json, "Print one JSON object (the table goes to stderr)");
   cmd->add_option("--jobs", args->jobs, "Scenarios evaluated in parallel")
       ->capture_default_str()

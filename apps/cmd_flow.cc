@@ -32,6 +32,7 @@ void AddFlowCommand(CLI::App* app) {
   cmd->add_option("--gt", args->truth,
                   "Ground truth (.flo, or KITTI .png): print the end-point error as JSON");
   cmd->callback([args] {
+    RefuseOutputOverInputs(args->out, "--out", {args->first, args->second, args->truth});
     flow::FlowOptions options;
     options.method = flow::ParseFlowMethod(args->method);
     const cv::Mat a = ReadImageOrThrow(args->first, cv::IMREAD_GRAYSCALE);

@@ -39,21 +39,27 @@ void AddGroundCommand(CLI::App* app) {
   cmd->add_option("--model", args->model, "Planar flow model: homography or affine (the paper's)")
       ->capture_default_str();
   cmd->add_option("--epsilon", args->epsilon_px, "Tolerance |u - u_hat| in pixels (Eq. 5)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteIn(1e-3, 100.0));
   cmd->add_option("--epsilon-relative", args->epsilon_relative,
                   "Tolerance grows by this fraction of |u_hat| (0: the paper's fixed epsilon)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteIn(0.0, 10.0));
   cmd->add_option("--roi-top", args->roi_top,
                   "Region of interest: rows below this fraction of the height (0: whole image)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteIn(0.0, 0.95));
   cmd->add_option("--fit-bottom", args->fit_bottom,
                   "RANSAC draws from the bottom fraction of the region of interest only (1: all)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteIn(0.01, 1.0));
   cmd->add_option("--gt", args->truth, "Labelled ground mask (255 = ground): print IoU as JSON");
   cmd->add_option("--iou-top", args->iou_top,
                   "IoU over the rows below this fraction of the height")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteIn(0.0, 0.99));
   cmd->callback([args] {
+    RefuseOutputOverInputs(args->out, "--out", {args->first, args->second, args->truth});
     flow::FlowOptions flow_options;
     flow_options.method = flow::ParseFlowMethod(args->method);
     ground::DominantPlaneOptions options;

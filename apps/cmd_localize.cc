@@ -15,6 +15,9 @@
 namespace mapless::app {
 namespace {
 
+// All images of a folder are kept while the eigenspace is built: 512 megapixels of grey at most.
+constexpr double kMaxFolderPixels = 512e6;
+
 struct Folder {
   std::vector<cv::Mat> images;
   std::vector<std::string> names;
@@ -26,7 +29,13 @@ Folder ReadFolder(const std::string& dir, const std::string& option) {
   Folder folder;
   const std::unique_ptr<io::FrameSource> source = io::OpenFrameSource(dir);
   io::Frame frame;
+  double pixels = 0.0;
   while (source->Next(&frame)) {
+    pixels += static_cast<double>(frame.image.total());
+    MAPLESS_CHECK(pixels <= kMaxFolderPixels,
+                  option << " " << dir << ": its images hold more than "
+                         << kMaxFolderPixels / 1e6 << " megapixels in all (frame "
+                         << frame.name << "); use fewer or smaller images");
     folder.images.push_back(frame.image.clone());
     folder.names.push_back(frame.name);
   }
@@ -58,15 +67,23 @@ void AddLocalizeCommand(CLI::App* app) {
       ->required();
   cmd->add_option("--method", args->method, "nn (nearest projection) or markov")->capture_default_str();
   cmd->add_option("--pca", args->pca, "incremental or batch")->capture_default_str();
-  cmd->add_option("--dimensions", args->dimensions, "Eigenspace dimensions K")->capture_default_str();
-  cmd->add_option("--width", args->width, "Low-resolution image width, px")->capture_default_str();
-  cmd->add_option("--height", args->height, "Low-resolution image height, px")->capture_default_str();
+  cmd->add_option("--dimensions", args->dimensions, "Eigenspace dimensions K")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1024));
+  cmd->add_option("--width", args->width, "Low-resolution image width, px")
+      ->capture_default_str()
+      ->check(CLI::Range(8, 1024));
+  cmd->add_option("--height", args->height, "Low-resolution image height, px")
+      ->capture_default_str()
+      ->check(CLI::Range(8, 1024));
   cmd->add_option("--advance", args->advance,
                   "Markov motion model: database images per query image")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteIn(0.0, 1000.0));
   cmd->add_option("--advance-sigma", args->advance_sigma,
                   "Markov motion model: its standard deviation per query, database images")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteIn(0.01, 1000.0));
   cmd->add_flag("--json", args->json, "One JSON object per query (the only output format)");
   cmd->callback([args] {
     localization::SequenceLocalizationOptions options;

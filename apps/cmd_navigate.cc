@@ -52,13 +52,15 @@ void AddNavigateCommand(CLI::App* app) {
   cmd->add_option("--save-calibration", a->save_calibration,
                   "Write the calibration used to this file (YAML)");
   cmd->add_option("--log", a->log, "Per-frame decisions as JSON lines (- for stdout)");
-  cmd->add_option("--seed", a->seed, "Noise seed")->capture_default_str();
+  cmd->add_option("--seed", a->seed, "Noise seed")
+      ->capture_default_str()
+      ->check(SeedCheck());
   cmd->add_option("--motion-noise", a->motion_noise, "Fraction of T and R")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 0.9));
+      ->check(FiniteIn(0.0, 0.9));
   cmd->add_option("--image-noise", a->image_noise, "Gaussian image noise, grey levels")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 100.0));
+      ->check(FiniteIn(0.0, 100.0));
   cmd->callback([a, cmd] {
     RefuseOutputOverInputs(a->log, "--log", {a->scenario, a->calibration});
     RefuseOutputOverInputs(a->save_calibration, "--save-calibration",

@@ -1,5 +1,7 @@
 // `mapless shift REFERENCE CURRENT`: horizontal image displacement of CURRENT relative to
 // REFERENCE, dx = x_in_current - x_in_reference for the same scene point.
+#include <spdlog/spdlog.h>
+
 #include <cstdio>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -29,14 +31,20 @@ void AddShiftCommand(CLI::App* app) {
                 "Print {\"dx_px\", \"matches\", \"inliers\", \"ok\"} as JSON");
   cmd->add_option("--detector", args->detector, "orb, akaze, akaze_upright or sift")
       ->capture_default_str();
-  cmd->add_option("--ratio", args->ratio, "Ratio-test threshold")->capture_default_str();
+  cmd->add_option("--ratio", args->ratio, "Ratio-test threshold")
+      ->capture_default_str()
+      ->check(FiniteIn(0.01, 1.0));
   cmd->callback([args] {
     features::ShiftOptions options;
     options.features.type = features::ParseDetectorType(args->detector);
     options.matching.ratio = args->ratio;
     options.Validate();
-    const features::ShiftEstimate e =
-        features::EstimateShift(ReadImageOrThrow(args->reference, cv::IMREAD_GRAYSCALE), ReadImageOrThrow(args->current, cv::IMREAD_GRAYSCALE), options);
+    const cv::Mat reference = ReadImageOrThrow(args->reference, cv::IMREAD_GRAYSCALE);
+    const cv::Mat current = ReadImageOrThrow(args->current, cv::IMREAD_GRAYSCALE);
+    // A shift in pixels compares the same image grid: different sizes have no common one.
+    RequireSameSize(current, args->current, reference, args->reference);
+    const features::ShiftEstimate e = features::EstimateShift(reference, current, options);
+    if (!e.ok) spdlog::warn("shift: not ok: too few consistent matches ({})", e.matches);
     if (args->json) {
       nlohmann::json j;
       j["dx_px"] = e.dx_px;

@@ -1,6 +1,7 @@
 // `mapless sim list | render | drive`: the built-in simulator from the command line.
 #include <spdlog/spdlog.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -98,13 +99,20 @@ void AddSimCommands(CLI::App* app) {
       ->required();
   render->add_option("--out", render_args->out, "Output image file (.png)")->required();
   render->add_option("--seed", render_args->seed,
-                     "Seed of the image noise (when the scenario has any)");
+                     "Seed of the image noise (when the scenario has any)")
+      ->check(SeedCheck());
   render->add_flag("--repeat-variant", render_args->repeat_variant,
                    "Render the world as the repeat phase sees it (objects removed or moved)");
   render->callback([render_args] {
     RefuseOutputOverInputs(render_args->out, "--out", {render_args->scenario});
     const sim::Scenario scenario = sim::LoadScenario(render_args->scenario);
     const Pose2 pose = ParsePoseDeg(render_args->pose, "--pose");
+    if (std::abs(pose.x_m) > sim::kMaxWorldCoordinateM ||
+        std::abs(pose.y_m) > sim::kMaxWorldCoordinateM) {
+      throw InputError("--pose " + render_args->pose + ": beyond " +
+                       std::to_string(static_cast<int>(sim::kMaxWorldCoordinateM)) +
+                       " m from the origin");
+    }
     const sim::World world = render_args->repeat_variant
                                  ? sim::ApplyVariant(scenario.world, scenario.repeat_variant)
                                  : scenario.world;
@@ -128,7 +136,8 @@ void AddSimCommands(CLI::App* app) {
   drive->add_option("--scenario", drive_args->scenario, "Built-in scenario name or YAML file")
       ->required();
   drive->add_option("--out", drive_args->out, "Output directory")->required();
-  drive->add_option("--seed", drive_args->seed, "Seed of motion, odometry and image noise");
+  drive->add_option("--seed", drive_args->seed, "Seed of motion, odometry and image noise")
+      ->check(SeedCheck());
   drive->add_option("--config", drive_args->config,
                     "Run configuration YAML (see config/default.yaml)");
   drive->add_flag("--overwrite", drive_args->overwrite,

@@ -59,20 +59,21 @@ void AddSoakCommand(CLI::App* app) {
       "soak", "Repeat a taught route lap after lap for a simulated hour; check memory and cost");
   cmd->add_option("--minutes", args->minutes, "Simulated minutes of repeating")
       ->capture_default_str()
-      ->check(CLI::Range(0.1, 24.0 * 60.0));
+      ->check(FiniteIn(0.1, 24.0 * 60.0));
   cmd->add_option("--scenario", args->scenario, "Built-in scenario or YAML file")
       ->capture_default_str();
   cmd->add_option("--seed", args->seed, "Seed of the noise and the start offsets")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(SeedCheck());
   cmd->add_option("--max-rss-growth", args->max_rss_growth,
                   "Allowed growth of peak RSS from the end of lap 1 to the end (fraction)")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 10.0));
+      ->check(FiniteIn(0.0, 10.0));
   cmd->add_option("--max-cost-drift", args->max_cost_drift,
                   "Allowed growth of the median frame cost, last 3 laps over first 3 (fraction; "
                   "0 turns the check off, e.g. on a loaded machine)")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 10.0));
+      ->check(FiniteIn(0.0, 10.0));
   cmd->add_flag("--json", args->json, "Print one JSON object at the end (laps go to stderr)");
   cmd->callback([args] {
     eval::SoakOptions options;

@@ -196,7 +196,9 @@ void AddTeachRepeatCommands(CLI::App* app) {
       ->capture_default_str();
   repeat->add_option("--log", r->log,
                      "Per-frame decisions as JSON lines to this file (default: stdout)");
-  repeat->add_option("--seed", r->seed, "Simulator: seed of the noise")->capture_default_str();
+  repeat->add_option("--seed", r->seed, "Simulator: seed of the noise")
+      ->capture_default_str()
+      ->check(SeedCheck());
   repeat->add_option("--motion-noise", r->motion_noise, "Simulator: fraction of the command")
       ->capture_default_str()
       ->check(FiniteIn(0.0, 0.9));

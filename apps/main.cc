@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <opencv2/core.hpp>
+#include <opencv2/core/utils/logger.hpp>
 
 #include "cli_common.h"
 #include "interrupt.h"
@@ -19,6 +20,9 @@ int main(int argc, char** argv) {
   spdlog::set_default_logger(spdlog::stderr_color_mt("mapless"));
   spdlog::set_pattern("%^[%l]%$ %v");
   cv::setNumThreads(1);
+  // OpenCV's own log lines (video back ends probing a file) would break "one error line": every
+  // failure reaches the user as mapless's own message instead.
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
   mapless::app::InstallInterruptHandlers();
   mapless::app::AddDemoCommand(&app);
   mapless::app::AddSimCommands(&app);

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdarg>
 #include <filesystem>
+#include <mutex>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -12,8 +14,21 @@
 #include "mapless/io/image_file.h"
 #include "mapless/io/limits.h"
 
+extern "C" {
+#include <libavutil/log.h>
+}
+
 namespace mapless::io {
 namespace {
+
+// FFmpeg prints its own messages ("moov atom not found") to stderr; a source that cannot be read
+// is reported as an InputError instead, so they are dropped.
+extern "C" void QuietFfmpegLog(void*, int, const char*, va_list) {}
+
+void SilenceFfmpeg() {
+  static std::once_flag once;
+  std::call_once(once, [] { av_log_set_callback(QuietFfmpegLog); });
+}
 
 cv::Mat ToGrey(const cv::Mat& in) {
   if (in.channels() == 1) return in;
@@ -69,7 +84,15 @@ class FolderSource : public FrameSource {
 class VideoSource : public FrameSource {
  public:
   VideoSource(const std::string& spec, bool camera, int device) : spec_(spec) {
-    const bool ok = camera ? capture_.open(device) : capture_.open(spec);
+    SilenceFfmpeg();
+    // Files through FFmpeg only: other back ends (GStreamer) probe a file noisily and slowly.
+    const bool is_file = !camera && spec.rfind("/dev/video", 0) != 0;
+    bool ok = false;
+    try {
+      ok = camera ? capture_.open(device) : capture_.open(spec, is_file ? cv::CAP_FFMPEG : cv::CAP_ANY);
+    } catch (const cv::Exception&) {
+      ok = false;
+    }
     if (!ok || !capture_.isOpened()) {
       throw InputError(spec + (camera ? ": cannot open camera"
                                       : ": cannot open video (missing file or unknown format)"));

@@ -148,6 +148,32 @@ void CheckFrameSize(int width, int height, const std::string& name) {
   }
 }
 
+namespace {
+
+// A PNG cut short (a write killed half-way) or with a broken chunk structure; checked before the
+// decoder, which would print libpng's own message. Walks the chunks to IEND.
+bool PngChunksWhole(std::string_view b) {
+  std::size_t i = 8;
+  while (i + 12 <= b.size()) {
+    const std::size_t length = Be32(b, i);
+    if (length > b.size() - i - 12) return false;
+    if (b.substr(i + 4, 4) == "IEND") return true;
+    i += 12 + length;
+  }
+  return false;
+}
+
+// A JPEG ends with EOI (FF D9); a cut one would be decoded half grey, with a warning.
+bool JpegEnds(std::string_view b) {
+  const std::size_t from = b.size() > 64 ? b.size() - 64 : 0;
+  for (std::size_t i = b.size(); i >= from + 2; --i) {
+    if (Byte(b, i - 2) == 0xFF && Byte(b, i - 1) == 0xD9) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 cv::Mat DecodeImage(std::string_view bytes, const std::string& name, int flags, int min_side) {
   const std::optional<ImageHeader> header = ReadImageHeader(bytes);
   if (!header) {
@@ -169,6 +195,10 @@ cv::Mat DecodeImage(std::string_view bytes, const std::string& name, int flags, 
                      std::to_string(header->height) + " pixels; the limit is " +
                      std::to_string(kMaxImagePixels / 1'000'000) + " megapixels and " +
                      std::to_string(kMaxImageSide) + " pixels a side");
+  }
+  if ((header->format == "PNG" && !PngChunksWhole(bytes)) ||
+      (header->format == "JPEG" && !JpegEnds(bytes))) {
+    throw InputError(what + ": corrupt image (cut short, or its structure is broken)");
   }
   cv::Mat image;
   try {

@@ -14,9 +14,9 @@ namespace mapless::io {
 namespace fs = std::filesystem;
 
 DirectoryLock::DirectoryLock(const std::string& dir) {
-  const std::string path = (fs::path(dir) / kLockFileName).string();
-  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd_ < 0) throw InputError(dir + ": cannot create the lock file: " + std::strerror(errno));
+  // The lock is on the directory itself: nothing is added to it.
+  fd_ = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd_ < 0) throw InputError(dir + ": cannot open the directory: " + std::strerror(errno));
   if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
     ::close(fd_);
     fd_ = -1;
@@ -32,10 +32,7 @@ bool IsEmptyOrMissing(const std::string& dir) {
   std::error_code ec;
   if (!fs::exists(dir, ec)) return true;
   if (!fs::is_directory(dir, ec)) return false;
-  for (const auto& entry : fs::directory_iterator(dir, ec)) {
-    if (entry.path().filename() != kLockFileName) return false;
-  }
-  return !ec;
+  return fs::directory_iterator(dir, ec) == fs::directory_iterator() && !ec;
 }
 
 OutputDirectory::OutputDirectory(std::string target, bool replace, std::string what)

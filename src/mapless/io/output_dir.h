@@ -18,8 +18,7 @@ namespace mapless::io {
 // An exclusive advisory lock on a directory, held while the object lives.
 class DirectoryLock {
  public:
-  // Throws InputError naming `dir` when another process holds the lock or the lock file cannot be
-  // created. `dir` must exist.
+  // Throws InputError naming `dir` when another process holds the lock. `dir` must exist.
   explicit DirectoryLock(const std::string& dir);
   ~DirectoryLock();
   DirectoryLock(const DirectoryLock&) = delete;
@@ -29,11 +28,7 @@ class DirectoryLock {
   int fd_ = -1;
 };
 
-// The lock file's name inside a locked directory (ignored when a directory is checked for
-// emptiness).
-inline constexpr const char* kLockFileName = ".mapless.lock";
-
-// True when `dir` does not exist or holds nothing but a lock file.
+// True when `dir` does not exist or is an empty directory.
 bool IsEmptyOrMissing(const std::string& dir);
 
 class OutputDirectory {

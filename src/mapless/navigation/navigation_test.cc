@@ -75,6 +75,15 @@ TEST(TeachSession, FeaturelessFramesNeverBecomeKeyframes) {
   // Every tracked feature is lost on a blank frame, but it has nothing to offer as a keyframe.
   EXPECT_FALSE(teach.Update(blank, 100).has_value());
   EXPECT_EQ(teach.deferred_keyframes(), 1);
+  // Nor does a featureless last frame, nor a featureless first one.
+  EXPECT_FALSE(teach.Finish().has_value());
+  EXPECT_EQ(teach.deferred_keyframes(), 2);
+  TeachSession blank_start(TeachOptions{});
+  EXPECT_FALSE(blank_start.Update(blank, 0).has_value());
+  EXPECT_FALSE(blank_start.Update(blank, 100).has_value());
+  EXPECT_FALSE(blank_start.Finish().has_value());
+  EXPECT_EQ(blank_start.keyframe_count(), 0);
+  ASSERT_TRUE(blank_start.Update(d.frames[0], 200).has_value());
 }
 
 TEST(RepeatSession, ReplayingTheTaughtFramesPassesEveryKeyframe) {

@@ -30,13 +30,19 @@ double TeachSession::tracked_fraction() const {
              : static_cast<double>(current_.size()) / static_cast<double>(initial_count_);
 }
 
-route::Keyframe TeachSession::MakeKeyframe(const cv::Mat& grey, Timestamp t_ns) {
+std::optional<route::Keyframe> TeachSession::MakeKeyframe(const cv::Mat& grey, Timestamp t_ns) {
+  // A keyframe without enough features could not be matched in the repeat: the keyframe is
+  // deferred to the next frame that has them, and the deferral counted.
+  const features::Features f = extractor_.Extract(grey);
+  if (static_cast<int>(f.keypoints.size()) < options_.min_keyframe_features) {
+    ++deferred_;
+    return std::nullopt;
+  }
   route::Keyframe kf;
   kf.index = next_index_++;
   kf.t_ns = t_ns;
   const double scale = static_cast<double>(options_.thumbnail_width_px) / grey.cols;
   cv::resize(grey, kf.thumbnail, cv::Size(), scale, scale, cv::INTER_AREA);
-  const features::Features f = extractor_.Extract(grey);
   kf.keypoints = f.keypoints;
   kf.descriptors = f.descriptors;
   kf.segment_start_px = start_;
@@ -54,8 +60,8 @@ std::optional<route::Keyframe> TeachSession::Update(const cv::Mat& image, Timest
   cv::Mat grey = image;
   if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
   std::optional<route::Keyframe> out;
-  if (previous_.empty()) {
-    out = MakeKeyframe(grey, t_ns);
+  if (next_index_ == 0) {
+    out = MakeKeyframe(grey, t_ns);  // the first keyframe: the first frame with features
   } else {
     MAPLESS_CHECK(grey.size() == previous_.size(), "TeachSession: frame size changed from "
                                                        << previous_.cols << "x" << previous_.rows
@@ -81,12 +87,7 @@ std::optional<route::Keyframe> TeachSession::Update(const cv::Mat& image, Timest
       spread_grew = s0 > 1e-9 && control::StdDev(xs1) / s0 > options_.max_spread_growth;
     }
     if (tracked_fraction() < options_.keyframe_tracked_fraction || spread_grew) {
-      const features::Features f = extractor_.Extract(grey);
-      if (static_cast<int>(f.keypoints.size()) >= options_.min_keyframe_features) {
-        out = MakeKeyframe(grey, t_ns);
-      } else {
-        ++deferred_;
-      }
+      out = MakeKeyframe(grey, t_ns);
     }
   }
   previous_is_keyframe_ = out.has_value();
@@ -97,8 +98,9 @@ std::optional<route::Keyframe> TeachSession::Update(const cv::Mat& image, Timest
 
 std::optional<route::Keyframe> TeachSession::Finish() {
   if (previous_.empty() || previous_is_keyframe_) return std::nullopt;
-  previous_is_keyframe_ = true;
-  return MakeKeyframe(previous_, previous_t_ns_);
+  std::optional<route::Keyframe> last = MakeKeyframe(previous_, previous_t_ns_);
+  previous_is_keyframe_ = last.has_value();
+  return last;
 }
 
 }  // namespace mapless::navigation

@@ -41,7 +41,8 @@ class TeachSession {
 
   // Feeds one frame; returns the keyframe this frame became, if it did.
   std::optional<route::Keyframe> Update(const cv::Mat& image, Timestamp t_ns);
-  // Ends the teach: the last frame becomes the final keyframe unless it already is one.
+  // Ends the teach: the last frame becomes the final keyframe unless it already is one or has too
+  // few features. Like every keyframe, the first is the first frame with enough features.
   std::optional<route::Keyframe> Finish();
 
   int keyframe_count() const { return next_index_; }
@@ -51,7 +52,8 @@ class TeachSession {
   double tracked_fraction() const;
 
  private:
-  route::Keyframe MakeKeyframe(const cv::Mat& grey, Timestamp t_ns);
+  // The keyframe `grey` becomes, or nullopt (counted as deferred) with too few features.
+  std::optional<route::Keyframe> MakeKeyframe(const cv::Mat& grey, Timestamp t_ns);
 
   TeachOptions options_;
   features::FeatureExtractor extractor_;
