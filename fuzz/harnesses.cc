@@ -1,6 +1,16 @@
 #include "harnesses.h"
 
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <opencv2/core/utils/logger.hpp>
+
 #include "mapless/core/check.h"
+#include "mapless/io/frame_source.h"
+#include "mapless/sim/driver.h"
+#include "mapless/sim/renderer.h"
+#include "mapless/viz/topdown.h"
 #include "mapless/io/flo.h"
 #include "mapless/io/tum.h"
 #include "mapless/navigation/potential.h"
@@ -51,6 +61,92 @@ void Tum(const std::string& input) {
   AcceptInputError([&] { io::ParseTum(input, "fuzz.txt"); });
 }
 
+namespace {
+
+// A scratch directory of this process's own, emptied for each input.
+std::filesystem::path Scratch(const char* what) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("mapless-fuzz-" + std::to_string(::getpid()) + "-" + what);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+void WriteBytes(const std::filesystem::path& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+void ReadAll(io::FrameSource* source, int max_frames) {
+  io::Frame frame;
+  for (int i = 0; i < max_frames && source->Next(&frame); ++i) {
+    if (frame.image.empty() || frame.image.type() != CV_8UC1) std::abort();  // never garbage
+  }
+}
+
+}  // namespace
+
+void ImageFolder(const std::string& input) {
+  const std::filesystem::path dir = Scratch("folder");
+  static const std::string kMarker = "\xffNXT";
+  std::size_t from = 0;
+  for (int i = 0; i < 3; ++i) {
+    const std::size_t at = input.find(kMarker, from);
+    const std::size_t end = at == std::string::npos || i == 2 ? input.size() : at;
+    WriteBytes(dir / ("frame" + std::to_string(i) + ".png"), input.substr(from, end - from));
+    if (end == input.size()) break;
+    from = end + kMarker.size();
+  }
+  AcceptInputError([&] {
+    const auto source = io::OpenFrameSource(dir.string(), 10.0);
+    ReadAll(source.get(), 3);
+  });
+  std::filesystem::remove_all(dir);
+}
+
+void VideoFile(const std::string& input) {
+  // As in the command line: OpenCV's own log lines are off (they would flood the fuzzer's output).
+  static const bool quiet = [] {
+    cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+    return true;
+  }();
+  (void)quiet;
+  const std::filesystem::path dir = Scratch("video");
+  const std::filesystem::path file = dir / "video.avi";
+  WriteBytes(file, input);
+  AcceptInputError([&] {
+    const auto source = io::OpenFrameSource(file.string(), 10.0);
+    ReadAll(source.get(), 8);
+  });
+  std::filesystem::remove_all(dir);
+}
+
+void ScenarioWorld(const std::string& input) {
+  AcceptInputError([&] {
+    const sim::Scenario scenario =
+        sim::ParseScenario(input, "fuzz.yaml", "/nonexistent-mapless-fuzz");
+    for (const sim::WorldObject& o : scenario.world.objects) {
+      std::vector<sim::Surface> surfaces;
+      sim::AppendObjectSurfaces(o, nullptr, &surfaces);
+    }
+    sim::Simulation simulation(scenario.world, scenario.camera, sim::SimulationOptions{},
+                               scenario.seed);
+    const int robot = simulation.AddRobot(scenario.teach_start, scenario.robot);
+    sim::ScriptedDriver driver(scenario.teach_start, scenario.teach_path,
+                               scenario.teach_speed_mps);
+    for (int frame = 0; frame < 30 && !driver.done(); ++frame) {
+      simulation.SetCommand(robot, driver.Update(simulation.robot(robot).pose()));
+      simulation.Advance(1.0 / scenario.camera.rate_hz);
+    }
+    const Eigen::Vector4d area = sim::ScenarioBounds(scenario, 5.0);
+    (void)sim::ClearanceTo(scenario.world, area[0], area[1]);
+    viz::TopDownOptions small;
+    small.max_side_px = 200;
+    (void)viz::DrawTopDown(scenario.world, {}, scenario.destinations, small);
+    (void)scenario.PathLength();
+  });
+}
+
 const std::vector<NamedHarness>& Harnesses() {
   static const std::vector<NamedHarness> harnesses = {{"route_manifest", RouteManifest},
                                                       {"route_keyframe", RouteKeyframe},
@@ -58,7 +154,10 @@ const std::vector<NamedHarness>& Harnesses() {
                                                       {"config", Config},
                                                       {"calibration", Calibration},
                                                       {"flo", Flo},
-                                                      {"tum", Tum}};
+                                                      {"tum", Tum},
+                                                      {"image_folder", ImageFolder},
+                                                      {"video_file", VideoFile},
+                                                      {"scenario_world", ScenarioWorld}};
   return harnesses;
 }
 

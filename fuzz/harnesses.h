@@ -24,6 +24,16 @@ void Config(const std::string& input);         // run configuration YAML (--conf
 void Calibration(const std::string& input);    // planar-flow calibration YAML (navigate)
 void Flo(const std::string& input);            // Middlebury .flo
 void Tum(const std::string& input);            // TUM trajectory text
+// The image-folder front end: the input as one to three image files of a folder (split at the
+// marker "\xffNXT"), opened and read to the end by io::OpenFrameSource, limits included.
+void ImageFolder(const std::string& input);
+// The video front end: the input as a video file, opened by io::OpenFrameSource (FFmpeg), read
+// for up to 8 frames.
+void VideoFile(const std::string& input);
+// The scenario-to-world path: a scenario parsed with the world limits, then its world used the way
+// the simulator uses it without rendering: object surfaces, collisions and clearance, a driven
+// robot for 30 frames, the scenario's area, and the top-down picture.
+void ScenarioWorld(const std::string& input);
 
 const std::vector<NamedHarness>& Harnesses();
 

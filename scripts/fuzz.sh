@@ -5,7 +5,8 @@
 #   scripts/fuzz.sh [-r RUNS] [-t SECONDS] [TARGET ...]
 #     -r RUNS     executions per target (default 1000000)
 #     -t SECONDS  time limit per target (default 600)
-#     TARGET      route_manifest route_keyframe scenario config calibration flo tum (default: all)
+#     TARGET      route_manifest route_keyframe scenario config calibration flo tum image_folder
+#                 video_file scenario_world (default: all)
 #
 # Each target starts from fuzz/corpus/<target>/ (kept inputs) and grows a working corpus in
 # build/fuzz/corpus/<target>/. A crash, sanitizer report, leak or hang stops that target; its input is
@@ -28,7 +29,8 @@ done
 shift $((OPTIND - 1))
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-  targets=(route_manifest route_keyframe scenario config calibration flo tum)
+  targets=(route_manifest route_keyframe scenario config calibration flo tum image_folder video_file
+           scenario_world)
 fi
 
 bash scripts/setup.sh
@@ -46,8 +48,9 @@ for t in "${targets[@]}"; do
   log="$out/fuzz_$t.log"
   echo "fuzz.sh: $t (up to $runs executions or $seconds s)"
   set +e
-  # Leak checks stay on; -timeout flags a single input that takes over 10 s (a hang).
-  "$bin" -runs="$runs" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+  # Leak checks stay on; -timeout flags a single input that takes over 10 s (a hang);
+  # -malloc_limit_mb flags any single allocation over 1 GB, -rss_limit_mb a process over 1 GB.
+  "$bin" -runs="$runs" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=1024 -malloc_limit_mb=1024 \
     -max_len=65536 -print_final_stats=1 -artifact_prefix="$out/artifacts/$t/" \
     "$out/corpus/$t" "fuzz/corpus/$t" >"$log" 2>&1
   rc=$?

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <filesystem>
 
 #include "mapless/core/check.h"
@@ -22,6 +24,32 @@ TEST(AtomicFile, WritesThenReadsBackAndLeavesNoTemporary) {
   int files = 0;
   for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++files;
   EXPECT_EQ(files, 1);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ReadFile, RefusesDevicesPipesDirectoriesAndFilesOverTheLimit) {
+  const auto dir = std::filesystem::temp_directory_path() / "mapless_readfile_test";
+  std::filesystem::remove_all(dir);
+  MakeDirectories(dir.string());
+  EXPECT_NE(testing::InputErrorOf([] { ReadFile("/dev/zero", 1 << 20); })
+                .find("/dev/zero: not a regular file"),
+            std::string::npos);
+  const std::string fifo = (dir / "fifo").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+  EXPECT_NE(testing::InputErrorOf([&] { ReadFile(fifo, 1 << 20); }).find("not a regular file"),
+            std::string::npos);
+  EXPECT_NE(testing::InputErrorOf([&] { ReadFile(dir.string(), 1 << 20); })
+                .find("not a regular file"),
+            std::string::npos);
+  const std::string path = (dir / "ten.txt").string();
+  WriteFileAtomic(path, "0123456789");
+  EXPECT_EQ(ReadFile(path, 10), "0123456789");
+  EXPECT_NE(testing::InputErrorOf([&] { ReadFile(path, 9); })
+                .find("ten.txt: 10 bytes; the limit for this kind of file is 9 bytes"),
+            std::string::npos);
+  EXPECT_NE(testing::InputErrorOf([&] { ReadFile((dir / "none").string(), 9); })
+                .find("none: cannot open file"),
+            std::string::npos);
   std::filesystem::remove_all(dir);
 }
 

@@ -36,6 +36,20 @@ TEST(JournalFile, AppendsWholeLines) {
   EXPECT_EQ(ReadFile(path, 1 << 20), "");
 }
 
+TEST(JournalFile, ReplaceAtCloseKeepsTheOldFileWholeUntilTheNewOneIsDone) {
+  const std::string path = ::testing::TempDir() + "mapless_journal_replace.jsonl";
+  WriteFileAtomic(path, "old\n");
+  {
+    JournalFile j(path, JournalFile::Mode::kReplaceAtClose);
+    j.Append("new 1");
+    EXPECT_EQ(ReadFile(path, 1 << 20), "old\n");
+    EXPECT_EQ(ReadFile(path + ".partial", 1 << 20), "new 1\n");
+    j.Append("new 2");
+  }  // destruction closes and replaces, as on unwinding after an error
+  EXPECT_EQ(ReadFile(path, 1 << 20), "new 1\nnew 2\n");
+  EXPECT_FALSE(std::filesystem::exists(path + ".partial"));
+}
+
 TEST(JournalFile, UnwritablePathIsNamed) {
   EXPECT_NE(testing::InputErrorOf([] {
               JournalFile("/nonexistent-dir/x.txt");

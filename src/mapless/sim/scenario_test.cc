@@ -97,6 +97,39 @@ TEST(Scenario, UnknownFieldAndUnknownTagAreErrors) {
             std::string::npos);
 }
 
+// The limits of docs/hardening.md, each named in its error; the built-in scenarios are far inside.
+TEST(Scenario, ValuesThatWouldHangOrExhaustTheSimulatorAreRefusedByName) {
+  const auto error_of = [](const std::string& from, const std::string& to) {
+    std::string text = kMinimal;
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+    return testing::InputErrorOf([&] { ParseScenario(text, "s.yaml", ""); });
+  };
+  EXPECT_NE(error_of("size_m: [1, 1, 1]", "size_m: [1e9, 1, 1]").find("(box).size"),
+            std::string::npos);
+  EXPECT_NE(error_of("center: [3, 1]", "center: [3e5, 1]").find("beyond 10000 m"),
+            std::string::npos);
+  EXPECT_NE(error_of("size_m: [1, 1, 1]}", "size_m: [0.1, 0.1, 1], repeat: {count: 1000, "
+                                           "step: [0.2, 0]}}\n    - {type: box, center: [3, 5], "
+                                           "size_m: [0.1, 0.1, 1], repeat: {count: 1000, step: "
+                                           "[0.2, 0]}}\n    - {type: box, center: [3, 9], "
+                                           "size_m: [0.1, 0.1, 1]}")
+                .find("2001 objects"),
+            std::string::npos);
+  EXPECT_NE(error_of("path: [[2, 0]]", "speed_mps: 1e-300\n  path: [[2, 0]]").find("speed_mps"),
+            std::string::npos);
+  EXPECT_NE(error_of("path: [[2, 0]]", "path: [[2, 0], {rotate_deg: 1e300}]").find("rotation"),
+            std::string::npos);
+  EXPECT_NE(error_of("name: tiny", "name: tiny\ncamera: {rate_hz: 1e-300}").find("rate_hz"),
+            std::string::npos);
+  EXPECT_NE(error_of("size_m: [1, 1, 1]}", "size_m: [1, 1, 1], texture: {size_px: 2048}, repeat: "
+                                           "{count: 40, step: [2, 0]}}")
+                .find("distinct textures"),
+            std::string::npos);
+  for (const auto& name : BuiltinScenarioNames()) EXPECT_NO_THROW(LoadScenario(name)) << name;
+}
+
 TEST(Scenario, UnknownBuiltinNameSaysSo) {
   EXPECT_NE(testing::InputErrorOf([] {
               LoadScenario("no_such_scenario");
