@@ -96,6 +96,10 @@ printf 'II*\x00\x08\x00\x00\x00\x02\x00\x00\x01\x04\x00\x01\x00\x00\x00\x30\x75\
 cp "$FX/huge.png" "$FX/huge_frames/000.png"
 printf 'PIEH\x30\x75\x00\x00\x30\x75\x00\x00' >"$FX/huge.flo"
 head -c 120 "$FX/f0.png" >"$FX/truncated.png"
+# A whole PNG structure whose image data is not deflate (libpng would print its own error), and a
+# BMP whose header names an impossible compression (OpenCV would print its own).
+printf '\x89PNG\r\n\x1a\n\x00\x00\x00\x0dIHDR\x00\x00\x00\x20\x00\x00\x00\x20\x08\x00\x00\x00\x00\x12\x34\x56\x78\x00\x00\x00\x05IDATxxxxx\x00\x00\x00\x00\x00\x00\x00\x00IEND\x00\x00\x00\x00' >"$FX/baddata.png"
+printf 'BM\x00\x00\x00\x00\x00\x00\x00\x00\x36\x00\x00\x00\x28\x00\x00\x00\x20\x00\x00\x00\x20\x00\x00\x00\x01\x00\x08\x00\x63\x00\x00\x00' >"$FX/badheader.bmp"
 echo "this is not an image" >"$FX/notimage.png"
 echo "not a video either" >"$FX/garbage.mp4"
 echo "notes" >"$FX/notroute/notes.txt"
@@ -203,6 +207,8 @@ probe "localize 4x4 frames" 2 "0.pgm (PNM): image is 4x4" -- "$MAPLESS" localize
 probe "repeat on frames of another size" 2 "frame 0.pgm is 64x48, the route" -- "$MAPLESS" repeat --route "$FX/route" --source "$FX/small_frames"
 probe "a video file that is not one" 2 "garbage.mp4: cannot open video" -- "$MAPLESS" teach --source "$FX/garbage.mp4" --out "$NEW/t5"
 probe "a truncated PNG" 2 "truncated.png (PNG): corrupt image" -- "$MAPLESS" flow "$FX/truncated.png" "$FX/f0.png" --out "$NEW/x.flo"
+probe "a PNG whose data does not decode" 2 "baddata.png (PNG): corrupt image" -- "$MAPLESS" shift "$FX/baddata.png" "$FX/f0.png"
+probe "a BMP with an impossible header" 2 "badheader.bmp (BMP): corrupt image" -- "$MAPLESS" flow "$FX/f0.png" "$FX/badheader.bmp" --out "$NEW/x.flo"
 probe "a text file named .png" 2 "notimage.png: not an image mapless reads" -- "$MAPLESS" ground "$FX/notimage.png" "$FX/f0.png" --out "$NEW/g.png"
 probe "camera:N that is not a number" 2 "camera:abc: expected camera:N" -- "$MAPLESS" teach --source camera:abc --out "$NEW/t6"
 

@@ -1,6 +1,12 @@
 #include "mapless/io/image_file.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <cctype>
+#include <cstdio>
+#include <iostream>
+#include <mutex>
 #include <cstdint>
 #include <opencv2/imgcodecs.hpp>
 
@@ -150,6 +156,38 @@ void CheckFrameSize(int width, int height, const std::string& name) {
 
 namespace {
 
+// Points the process's standard error (the descriptor and std::cerr's buffer) at /dev/null while
+// it lives; one at a time.
+class QuietStderr {
+ public:
+  QuietStderr() : lock_(Mutex()) {
+    std::fflush(stderr);
+    std::cerr.flush();
+    saved_ = ::dup(STDERR_FILENO);
+    const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+    if (saved_ >= 0 && null >= 0) ::dup2(null, STDERR_FILENO);
+    if (null >= 0) ::close(null);
+  }
+  ~QuietStderr() {
+    std::fflush(stderr);
+    std::cerr.flush();
+    if (saved_ >= 0) {
+      ::dup2(saved_, STDERR_FILENO);
+      ::close(saved_);
+    }
+  }
+  QuietStderr(const QuietStderr&) = delete;
+  QuietStderr& operator=(const QuietStderr&) = delete;
+
+ private:
+  static std::mutex& Mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::lock_guard<std::mutex> lock_;
+  int saved_ = -1;
+};
+
 // A PNG cut short (a write killed half-way) or with a broken chunk structure; checked before the
 // decoder, which would print libpng's own message. Walks the chunks to IEND.
 bool PngChunksWhole(std::string_view b) {
@@ -201,13 +239,21 @@ cv::Mat DecodeImage(std::string_view bytes, const std::string& name, int flags, 
     throw InputError(what + ": corrupt image (cut short, or its structure is broken)");
   }
   cv::Mat image;
-  try {
-    // imdecode does not write to its input.
-    const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8UC1,
-                         const_cast<char*>(bytes.data()));
-    image = cv::imdecode(buffer, flags);
-  } catch (const cv::Exception&) {
-    image.release();
+  {
+    // The decoders print their own diagnostics to stderr (OpenCV's imdecode on std::cerr, libpng
+    // and libjpeg with fprintf): a corrupt file must come out as one mapless error line, so the
+    // standard error stream is pointed at /dev/null for the decoder's call. Decoding is serialised
+    // for this; another thread's write to stderr during a decode would be lost (mapless decodes
+    // files on the thread that reads them, and logs nothing meanwhile).
+    const QuietStderr quiet;
+    try {
+      // imdecode does not write to its input.
+      const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8UC1,
+                           const_cast<char*>(bytes.data()));
+      image = cv::imdecode(buffer, flags);
+    } catch (const cv::Exception&) {
+      image.release();
+    }
   }
   if (image.empty()) throw InputError(what + ": corrupt image (it does not decode)");
   // JPEG's EXIF orientation may turn the image by 90 degrees while decoding.

@@ -21,8 +21,9 @@ struct ImageHeader {
 // formats above or the header is cut short.
 std::optional<ImageHeader> ReadImageHeader(std::string_view bytes);
 
-// Decodes image bytes (cv::IMREAD_* `flags`); throws InputError naming `name` when the format is
-// not supported, the declared size is over kMaxImagePixels / kMaxImageSide or below `min_side`
+// Decodes image bytes (cv::IMREAD_* `flags`); the decoders' own messages are silenced (standard
+// error points at /dev/null during the call, one decode at a time). Throws InputError naming
+// `name` when the format is not supported, the declared size is over kMaxImagePixels / kMaxImageSide or below `min_side`
 // on either side, or the bytes do not decode.
 cv::Mat DecodeImage(std::string_view bytes, const std::string& name, int flags,
                     int min_side = 1);
