@@ -64,12 +64,11 @@ void AddDemoCommand(CLI::App* app) {
     const std::string route_dir = (out / "route").string();
     route::RouteWriter writer(route_dir, "orb", scenario.camera.model.width,
                               scenario.camera.model.height);
-    const eval::TaughtRoute taught =
-        eval::TeachOnSimulator(scenario, navigation::TeachOptions{},
-                               [&](const route::Keyframe& kf) {
-                                 ThrowIfInterrupted();
-                                 writer.Append(kf);
-                               });
+    const eval::TaughtRoute taught = eval::TeachOnSimulator(scenario, navigation::TeachOptions{},
+                                                            [&](const route::Keyframe& kf) {
+                                                              ThrowIfInterrupted();
+                                                              writer.Append(kf);
+                                                            });
     writer.Finish();
     spdlog::info("demo: route of {} keyframes in {}", taught.route->keyframes.size(), route_dir);
 

@@ -54,8 +54,7 @@ void AddGroundCommand(CLI::App* app) {
       ->capture_default_str()
       ->check(FiniteIn(0.01, 1.0));
   cmd->add_option("--gt", args->truth, "Labelled ground mask (255 = ground): print IoU as JSON");
-  cmd->add_option("--iou-top", args->iou_top,
-                  "IoU over the rows below this fraction of the height")
+  cmd->add_option("--iou-top", args->iou_top, "IoU over the rows below this fraction of the height")
       ->capture_default_str()
       ->check(FiniteIn(0.0, 0.99));
   cmd->callback([args] {

@@ -32,10 +32,10 @@ Folder ReadFolder(const std::string& dir, const std::string& option) {
   double pixels = 0.0;
   while (source->Next(&frame)) {
     pixels += static_cast<double>(frame.image.total());
-    MAPLESS_CHECK(pixels <= kMaxFolderPixels,
-                  option << " " << dir << ": its images hold more than "
-                         << kMaxFolderPixels / 1e6 << " megapixels in all (frame "
-                         << frame.name << "); use fewer or smaller images");
+    MAPLESS_CHECK(pixels <= kMaxFolderPixels, option << " " << dir << ": its images hold more than "
+                                                     << kMaxFolderPixels / 1e6
+                                                     << " megapixels in all (frame " << frame.name
+                                                     << "); use fewer or smaller images");
     folder.images.push_back(frame.image.clone());
     folder.names.push_back(frame.name);
   }
@@ -61,11 +61,13 @@ void AddLocalizeCommand(CLI::App* app) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app->add_subcommand(
       "localize", "Localize query images on the route formed by database images (incremental PCA)");
-  cmd->add_option("--database", args->database, "Folder of route images, in route (file-name) order")
+  cmd->add_option("--database", args->database,
+                  "Folder of route images, in route (file-name) order")
       ->required();
   cmd->add_option("--query", args->query, "Folder of query images (a traversal of the same route)")
       ->required();
-  cmd->add_option("--method", args->method, "nn (nearest projection) or markov")->capture_default_str();
+  cmd->add_option("--method", args->method, "nn (nearest projection) or markov")
+      ->capture_default_str();
   cmd->add_option("--pca", args->pca, "incremental or batch")->capture_default_str();
   cmd->add_option("--dimensions", args->dimensions, "Eigenspace dimensions K")
       ->capture_default_str()
@@ -99,7 +101,8 @@ void AddLocalizeCommand(CLI::App* app) {
     options.Validate();
     const Folder database = ReadFolder(args->database, "--database");
     const Folder query = ReadFolder(args->query, "--query");
-    const appearance::Eigenspace route = localization::BuildRouteEigenspace(database.images, options);
+    const appearance::Eigenspace route =
+        localization::BuildRouteEigenspace(database.images, options);
     spdlog::info("localize: {} route images, eigenspace of {} dimensions ({} PCA); {} queries ({})",
                  database.images.size(), route.dimensions(), args->pca, query.images.size(),
                  args->method);

@@ -52,9 +52,7 @@ void AddNavigateCommand(CLI::App* app) {
   cmd->add_option("--save-calibration", a->save_calibration,
                   "Write the calibration used to this file (YAML)");
   cmd->add_option("--log", a->log, "Per-frame decisions as JSON lines (- for stdout)");
-  cmd->add_option("--seed", a->seed, "Noise seed")
-      ->capture_default_str()
-      ->check(SeedCheck());
+  cmd->add_option("--seed", a->seed, "Noise seed")->capture_default_str()->check(SeedCheck());
   cmd->add_option("--motion-noise", a->motion_noise, "Fraction of T and R")
       ->capture_default_str()
       ->check(FiniteIn(0.0, 0.9));
@@ -76,8 +74,8 @@ void AddNavigateCommand(CLI::App* app) {
     const auto in_area = [&](double x, double y) {
       return x >= area[0] && y >= area[1] && x <= area[2] && y <= area[3];
     };
-    const std::string area_text = fmt::format("[{:.1f}, {:.1f}] x [{:.1f}, {:.1f}] m", area[0],
-                                              area[2], area[1], area[3]);
+    const std::string area_text =
+        fmt::format("[{:.1f}, {:.1f}] x [{:.1f}, {:.1f}] m", area[0], area[2], area[1], area[3]);
     if (!a->start.empty()) {
       scenario.teach_start = ParsePoseDeg(a->start, "--start");
       if (!in_area(scenario.teach_start.x_m, scenario.teach_start.y_m))
@@ -107,12 +105,12 @@ void AddNavigateCommand(CLI::App* app) {
 
     navigation::PlanarFlowCalibration calibration;
     if (!a->calibration.empty()) {
-      calibration = navigation::CalibrationFromYaml(io::ReadFile(a->calibration, io::kMaxYamlFileBytes), a->calibration);
+      calibration = navigation::CalibrationFromYaml(
+          io::ReadFile(a->calibration, io::kMaxYamlFileBytes), a->calibration);
       if (calibration.width != scenario.camera.model.width ||
           calibration.height != scenario.camera.model.height)
-        throw InputError(a->calibration + ": calibrated for " +
-                         std::to_string(calibration.width) + "x" +
-                         std::to_string(calibration.height) + ", the camera is " +
+        throw InputError(a->calibration + ": calibrated for " + std::to_string(calibration.width) +
+                         "x" + std::to_string(calibration.height) + ", the camera is " +
                          std::to_string(scenario.camera.model.width) + "x" +
                          std::to_string(scenario.camera.model.height));
     } else {

@@ -98,8 +98,9 @@ void AddSimCommands(CLI::App* app) {
   render->add_option("--pose", render_args->pose, "Robot pose X,Y,THETA_DEG (metres, degrees)")
       ->required();
   render->add_option("--out", render_args->out, "Output image file (.png)")->required();
-  render->add_option("--seed", render_args->seed,
-                     "Seed of the image noise (when the scenario has any)")
+  render
+      ->add_option("--seed", render_args->seed,
+                   "Seed of the image noise (when the scenario has any)")
       ->check(SeedCheck());
   render->add_flag("--repeat-variant", render_args->repeat_variant,
                    "Render the world as the repeat phase sees it (objects removed or moved)");

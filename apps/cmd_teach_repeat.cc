@@ -4,10 +4,10 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <optional>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "cli_common.h"
 #include "interrupt.h"
@@ -76,12 +76,14 @@ void Teach(const TeachArgs& t) {
   options.Validate();
   RefuseOutputOverInputs(t.out, "--out", {SourceInput(t.source)});
   if (!t.overwrite && std::filesystem::exists(std::filesystem::path(t.out) / "manifest.json")) {
-    throw InputError(t.out + ": already holds a route (manifest.json); choose another directory, "
+    throw InputError(t.out +
+                     ": already holds a route (manifest.json); choose another directory, "
                      "or --overwrite to replace it");
   }
   if (t.overwrite && !io::IsEmptyOrMissing(t.out) &&
       !std::filesystem::exists(std::filesystem::path(t.out) / "manifest.json")) {
-    throw InputError(t.out + ": holds no route (no manifest.json), so --overwrite will not "
+    throw InputError(t.out +
+                     ": holds no route (no manifest.json), so --overwrite will not "
                      "replace it; choose a new or empty directory");
   }
   // The source is opened before anything is written: a bad source changes nothing.
@@ -114,12 +116,12 @@ void Teach(const TeachArgs& t) {
   bool interrupted = false;
   try {
     if (scenario) {
-      const sim::DriveSummary summary = sim::DriveTaughtPath(
-          *scenario, sim::DriveOptions{},
-          [&](const sim::DriveFrame& f) { frame_in(f.image, f.t_ns); });
+      const sim::DriveSummary summary =
+          sim::DriveTaughtPath(*scenario, sim::DriveOptions{},
+                               [&](const sim::DriveFrame& f) { frame_in(f.image, f.t_ns); });
       if (!summary.completed) {
-        throw RunFailed("teach: the drive of '" + scenario->name + "' did not complete: " +
-                        summary.status);
+        throw RunFailed("teach: the drive of '" + scenario->name +
+                        "' did not complete: " + summary.status);
       }
     } else {
       io::Frame frame;
@@ -138,9 +140,12 @@ void Teach(const TeachArgs& t) {
   spdlog::info("teach: {} frames, {} keyframes", frames, keyframes);
   if (keyframes < 2) {
     throw RunFailed("teach: " + std::to_string(keyframes) + " keyframe" +
-                    (keyframes == 1 ? "" : "s") + " (too few features in the images?); a route "
-                    "needs at least 2, so none was " + (out.staged() ? "put in place of the old "
-                    "one" : "marked complete"));
+                    (keyframes == 1 ? "" : "s") +
+                    " (too few features in the images?); a route "
+                    "needs at least 2, so none was " +
+                    (out.staged() ? "put in place of the old "
+                                    "one"
+                                  : "marked complete"));
   }
   writer->Finish();
   out.Commit();
@@ -277,11 +282,10 @@ void AddTeachRepeatCommands(CLI::App* app) {
     while (source->Next(&frame)) {
       ThrowIfInterrupted();
       if (frame.image.cols != route->image_width || frame.image.rows != route->image_height) {
-        throw InputError(r->source + ": frame " + frame.name + " is " +
-                         std::to_string(frame.image.cols) + "x" +
-                         std::to_string(frame.image.rows) + ", the route " + r->route +
-                         " was taught at " + std::to_string(route->image_width) + "x" +
-                         std::to_string(route->image_height));
+        throw InputError(
+            r->source + ": frame " + frame.name + " is " + std::to_string(frame.image.cols) + "x" +
+            std::to_string(frame.image.rows) + ", the route " + r->route + " was taught at " +
+            std::to_string(route->image_width) + "x" + std::to_string(route->image_height));
       }
       last = session.Update(frame.image, frame.t_ns);
       nlohmann::json j = StepJson(frame_index++, frame.t_ns, last);

@@ -7,16 +7,16 @@
 #include <opencv2/core/utils/logger.hpp>
 
 #include "mapless/core/check.h"
-#include "mapless/io/frame_source.h"
-#include "mapless/sim/driver.h"
-#include "mapless/sim/renderer.h"
-#include "mapless/viz/topdown.h"
 #include "mapless/io/flo.h"
+#include "mapless/io/frame_source.h"
 #include "mapless/io/tum.h"
 #include "mapless/navigation/potential.h"
 #include "mapless/route/route_store.h"
+#include "mapless/sim/driver.h"
+#include "mapless/sim/renderer.h"
 #include "mapless/sim/scenario.h"
 #include "mapless/sim/simulation.h"
+#include "mapless/viz/topdown.h"
 
 namespace mapless::fuzz {
 namespace {
@@ -132,8 +132,7 @@ void ScenarioWorld(const std::string& input) {
     sim::Simulation simulation(scenario.world, scenario.camera, sim::SimulationOptions{},
                                scenario.seed);
     const int robot = simulation.AddRobot(scenario.teach_start, scenario.robot);
-    sim::ScriptedDriver driver(scenario.teach_start, scenario.teach_path,
-                               scenario.teach_speed_mps);
+    sim::ScriptedDriver driver(scenario.teach_start, scenario.teach_path, scenario.teach_speed_mps);
     for (int frame = 0; frame < 30 && !driver.done(); ++frame) {
       simulation.SetCommand(robot, driver.Update(simulation.robot(robot).pose()));
       simulation.Advance(1.0 / scenario.camera.rate_hz);

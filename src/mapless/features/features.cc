@@ -123,7 +123,8 @@ std::vector<cv::DMatch> MatchFeatures(const Features& query, const Features& tra
   std::vector<int> best_query_for_train;
   if (options.mutual) {
     std::vector<cv::DMatch> back;
-    matcher.match(train.descriptors, query.descriptors, back, guided ? cv::Mat(mask.t()) : cv::Mat());
+    matcher.match(train.descriptors, query.descriptors, back,
+                  guided ? cv::Mat(mask.t()) : cv::Mat());
     best_query_for_train.assign(train.keypoints.size(), -1);
     for (const auto& m : back)
       best_query_for_train[static_cast<std::size_t>(m.queryIdx)] = m.trainIdx;

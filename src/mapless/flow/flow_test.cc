@@ -157,8 +157,8 @@ TEST(DenseLucasKanade, RubberWhaleEndPointError) {
   const double pyrlk_epe = EndPointError(pyrlk, truth).mean_epe_px;
   std::printf("RubberWhale EPE: DIS fast %.3f, dense LK %.3f, per-pixel PyrLK %.3f px\n", dis_epe,
               lk_epe, pyrlk_epe);
-  EXPECT_LT(dis_epe, 0.6);        // stock DIS fast: about 0.45 px
-  EXPECT_LT(lk_epe, pyrlk_epe);   // no worse than per-pixel PyrLK (5.1 px in the issue)
+  EXPECT_LT(dis_epe, 0.6);       // stock DIS fast: about 0.45 px
+  EXPECT_LT(lk_epe, pyrlk_epe);  // no worse than per-pixel PyrLK (5.1 px in the issue)
 }
 
 }  // namespace

@@ -72,8 +72,10 @@ std::string ReadFile(const std::string& path, std::size_t max_bytes) {
   }
   if (static_cast<std::uint64_t>(st.st_size) > max_bytes) {
     ::close(fd);
-    throw InputError(path + ": " + std::to_string(st.st_size) + " bytes; the limit for this kind "
-                     "of file is " + std::to_string(max_bytes) + " bytes");
+    throw InputError(path + ": " + std::to_string(st.st_size) +
+                     " bytes; the limit for this kind "
+                     "of file is " +
+                     std::to_string(max_bytes) + " bytes");
   }
   // Read at most max_bytes + 1: a file that grows while it is read is still caught.
   std::string bytes(static_cast<std::size_t>(st.st_size), '\0');

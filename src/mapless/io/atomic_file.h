@@ -2,8 +2,8 @@
 // rename over the target. A reader sees either the old file or the complete new one, never half.
 #pragma once
 
-#include <opencv2/core.hpp>
 #include <cstddef>
+#include <opencv2/core.hpp>
 #include <string>
 #include <string_view>
 

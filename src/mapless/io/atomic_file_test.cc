@@ -1,7 +1,6 @@
 #include "mapless/io/atomic_file.h"
 
 #include <gtest/gtest.h>
-
 #include <sys/stat.h>
 
 #include <filesystem>
@@ -31,24 +30,27 @@ TEST(ReadFile, RefusesDevicesPipesDirectoriesAndFilesOverTheLimit) {
   const auto dir = std::filesystem::temp_directory_path() / "mapless_readfile_test";
   std::filesystem::remove_all(dir);
   MakeDirectories(dir.string());
-  EXPECT_NE(testing::InputErrorOf([] { ReadFile("/dev/zero", 1 << 20); })
-                .find("/dev/zero: not a regular file"),
+  EXPECT_NE(testing::InputErrorOf([] {
+              ReadFile("/dev/zero", 1 << 20);
+            }).find("/dev/zero: not a regular file"),
             std::string::npos);
   const std::string fifo = (dir / "fifo").string();
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
   EXPECT_NE(testing::InputErrorOf([&] { ReadFile(fifo, 1 << 20); }).find("not a regular file"),
             std::string::npos);
-  EXPECT_NE(testing::InputErrorOf([&] { ReadFile(dir.string(), 1 << 20); })
-                .find("not a regular file"),
-            std::string::npos);
+  EXPECT_NE(
+      testing::InputErrorOf([&] { ReadFile(dir.string(), 1 << 20); }).find("not a regular file"),
+      std::string::npos);
   const std::string path = (dir / "ten.txt").string();
   WriteFileAtomic(path, "0123456789");
   EXPECT_EQ(ReadFile(path, 10), "0123456789");
-  EXPECT_NE(testing::InputErrorOf([&] { ReadFile(path, 9); })
-                .find("ten.txt: 10 bytes; the limit for this kind of file is 9 bytes"),
+  EXPECT_NE(testing::InputErrorOf([&] {
+              ReadFile(path, 9);
+            }).find("ten.txt: 10 bytes; the limit for this kind of file is 9 bytes"),
             std::string::npos);
-  EXPECT_NE(testing::InputErrorOf([&] { ReadFile((dir / "none").string(), 9); })
-                .find("none: cannot open file"),
+  EXPECT_NE(testing::InputErrorOf([&] {
+              ReadFile((dir / "none").string(), 9);
+            }).find("none: cannot open file"),
             std::string::npos);
   std::filesystem::remove_all(dir);
 }
@@ -77,8 +79,9 @@ TEST(Tum, RoundTripsPlanarPoses) {
 TEST(Tum, ACutLastRecordIsDroppedAMalformedLineElsewhereIsAnError) {
   const std::string whole = FormatTum({{0, Pose2{1, 2, 0.5}}, {100'000'000, Pose2{3, 4, 0.0}}});
   EXPECT_EQ(ParseTum(whole + "0.2 5.0 6", "t").size(), 2U);  // killed mid-record
-  EXPECT_NE(testing::InputErrorOf([&] { ParseTum(whole + "0.2 5.0 6\n", "t.tum"); })
-                .find("t.tum:4: expected 8 numbers"),
+  EXPECT_NE(testing::InputErrorOf([&] {
+              ParseTum(whole + "0.2 5.0 6\n", "t.tum");
+            }).find("t.tum:4: expected 8 numbers"),
             std::string::npos);
   EXPECT_NE(testing::InputErrorOf([&] { ParseTum("x\n" + whole, "t.tum"); }).find("t.tum:1:"),
             std::string::npos);

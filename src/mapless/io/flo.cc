@@ -16,12 +16,15 @@ namespace {
 constexpr float kFloMagic = 202021.25f;
 
 bool EndsWith(const std::string& s, std::string_view suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 }  // namespace
 
-cv::Mat ReadFlo(const std::string& path) { return ParseFlo(ReadFile(path, 12 + 8 * static_cast<std::size_t>(kMaxImagePixels)), path); }
+cv::Mat ReadFlo(const std::string& path) {
+  return ParseFlo(ReadFile(path, 12 + 8 * static_cast<std::size_t>(kMaxImagePixels)), path);
+}
 
 cv::Mat ParseFlo(const std::string& bytes, const std::string& path) {
   if (bytes.size() < 12) throw InputError(path + ": not a .flo file (shorter than its header)");
@@ -39,7 +42,8 @@ cv::Mat ParseFlo(const std::string& bytes, const std::string& path) {
                      " is not valid (at most " + std::to_string(kMaxImagePixels / 1'000'000) +
                      " megapixels, " + std::to_string(kMaxImageSide) + " a side)");
   }
-  const std::size_t need = 12 + static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 8;
+  const std::size_t need =
+      12 + static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 8;
   if (bytes.size() < need) {
     throw InputError(path + ": truncated .flo file (" + std::to_string(bytes.size()) + " bytes, " +
                      std::to_string(need) + " expected for " + std::to_string(width) + "x" +

@@ -89,7 +89,8 @@ class VideoSource : public FrameSource {
     const bool is_file = !camera && spec.rfind("/dev/video", 0) != 0;
     bool ok = false;
     try {
-      ok = camera ? capture_.open(device) : capture_.open(spec, is_file ? cv::CAP_FFMPEG : cv::CAP_ANY);
+      ok = camera ? capture_.open(device)
+                  : capture_.open(spec, is_file ? cv::CAP_FFMPEG : cv::CAP_ANY);
     } catch (const cv::Exception&) {
       ok = false;
     }
@@ -144,8 +145,8 @@ class VideoSource : public FrameSource {
 
 std::unique_ptr<FrameSource> OpenFrameSource(const std::string& spec, double folder_fps) {
   MAPLESS_CHECK(folder_fps >= kMinFolderFps && folder_fps <= kMaxFolderFps,
-                "--fps " << folder_fps << ": must be in [" << kMinFolderFps << ", "
-                         << kMaxFolderFps << "] frames per second");
+                "--fps " << folder_fps << ": must be in [" << kMinFolderFps << ", " << kMaxFolderFps
+                         << "] frames per second");
   if (spec.rfind("camera:", 0) == 0) {
     int device = 0;
     const std::string number = spec.substr(7);

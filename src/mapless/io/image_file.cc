@@ -4,10 +4,10 @@
 #include <unistd.h>
 
 #include <cctype>
+#include <cstdint>
 #include <cstdio>
 #include <iostream>
 #include <mutex>
-#include <cstdint>
 #include <opencv2/imgcodecs.hpp>
 
 #include "mapless/core/check.h"
@@ -54,8 +54,8 @@ std::optional<ImageHeader> Jpeg(std::string_view b) {
     if (marker == 0xD9 || marker == 0xDA) return std::nullopt;  // end, or scan before a frame
     const std::size_t length = Be16(b, i + 2);
     if (length < 2) return std::nullopt;
-    const bool sof = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 &&
-                     marker != 0xCC;
+    const bool sof =
+        marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
     if (sof) {
       if (i + 9 > b.size()) return std::nullopt;
       return Make("JPEG", Be16(b, i + 7), Be16(b, i + 5));
@@ -116,9 +116,12 @@ std::optional<ImageHeader> Tiff(std::string_view b) {
     if (tag != 256 && tag != 257) continue;
     const std::uint32_t type = u16(e + 2);
     std::int64_t value = -1;
-    if (type == 3) value = u16(e + 8);       // SHORT
-    else if (type == 4) value = u32(e + 8);  // LONG
-    else return std::nullopt;
+    if (type == 3)
+      value = u16(e + 8);  // SHORT
+    else if (type == 4)
+      value = u32(e + 8);  // LONG
+    else
+      return std::nullopt;
     (tag == 256 ? width : height) = value;
   }
   if (width < 0 || height < 0) return std::nullopt;
@@ -129,7 +132,8 @@ std::optional<ImageHeader> Tiff(std::string_view b) {
 
 std::optional<ImageHeader> ReadImageHeader(std::string_view b) {
   if (b.size() >= 8 && b.substr(0, 8) == std::string_view("\x89PNG\r\n\x1a\n", 8)) return Png(b);
-  if (b.size() >= 3 && Byte(b, 0) == 0xFF && Byte(b, 1) == 0xD8 && Byte(b, 2) == 0xFF) return Jpeg(b);
+  if (b.size() >= 3 && Byte(b, 0) == 0xFF && Byte(b, 1) == 0xD8 && Byte(b, 2) == 0xFF)
+    return Jpeg(b);
   if (b.size() >= 2 && b[0] == 'B' && b[1] == 'M') return Bmp(b);
   if (b.size() >= 3 && b[0] == 'P' && b[1] >= '1' && b[1] <= '6' &&
       std::isspace(static_cast<unsigned char>(b[2])))
@@ -215,7 +219,8 @@ bool JpegEnds(std::string_view b) {
 cv::Mat DecodeImage(std::string_view bytes, const std::string& name, int flags, int min_side) {
   const std::optional<ImageHeader> header = ReadImageHeader(bytes);
   if (!header) {
-    throw InputError(name + ": not an image mapless reads (PNG, JPEG, BMP, PGM/PPM or TIFF), "
+    throw InputError(name +
+                     ": not an image mapless reads (PNG, JPEG, BMP, PGM/PPM or TIFF), "
                      "or its header is cut short");
   }
   const std::string what = name + " (" + header->format + ")";

@@ -23,10 +23,9 @@ std::optional<ImageHeader> ReadImageHeader(std::string_view bytes);
 
 // Decodes image bytes (cv::IMREAD_* `flags`); the decoders' own messages are silenced (standard
 // error points at /dev/null during the call, one decode at a time). Throws InputError naming
-// `name` when the format is not supported, the declared size is over kMaxImagePixels / kMaxImageSide or below `min_side`
-// on either side, or the bytes do not decode.
-cv::Mat DecodeImage(std::string_view bytes, const std::string& name, int flags,
-                    int min_side = 1);
+// `name` when the format is not supported, the declared size is over kMaxImagePixels /
+// kMaxImageSide or below `min_side` on either side, or the bytes do not decode.
+cv::Mat DecodeImage(std::string_view bytes, const std::string& name, int flags, int min_side = 1);
 
 // Reads and decodes an image file (at most kMaxImageFileBytes); errors as DecodeImage.
 cv::Mat ReadImage(const std::string& path, int flags, int min_side = 1);

@@ -53,19 +53,23 @@ TEST(ImageHeader, AHugeDeclaredSizeIsRefusedBeforeDecoding) {
 
 TEST(ImageHeader, SmallCutAndForeignImagesAreRefusedByName) {
   const std::string png = Encode(".png", Pattern(8, 8));
-  EXPECT_NE(testing::InputErrorOf([&] { DecodeImage(png, "s.png", 0, kMinImageSide); })
-                .find("s.png (PNG): image is 8x8; at least 16x16"),
+  EXPECT_NE(testing::InputErrorOf([&] {
+              DecodeImage(png, "s.png", 0, kMinImageSide);
+            }).find("s.png (PNG): image is 8x8; at least 16x16"),
             std::string::npos);
   const std::string whole = Encode(".png", Pattern(40, 30));
-  EXPECT_NE(testing::InputErrorOf([&] { DecodeImage(whole.substr(0, whole.size() - 20), "c.png", 0); })
-                .find("c.png (PNG): corrupt image"),
+  EXPECT_NE(testing::InputErrorOf([&] {
+              DecodeImage(whole.substr(0, whole.size() - 20), "c.png", 0);
+            }).find("c.png (PNG): corrupt image"),
             std::string::npos);
   const std::string jpeg = Encode(".jpg", Pattern(40, 30));
-  EXPECT_NE(testing::InputErrorOf([&] { DecodeImage(jpeg.substr(0, jpeg.size() / 2), "c.jpg", 0); })
-                .find("c.jpg (JPEG): corrupt image"),
+  EXPECT_NE(testing::InputErrorOf([&] {
+              DecodeImage(jpeg.substr(0, jpeg.size() / 2), "c.jpg", 0);
+            }).find("c.jpg (JPEG): corrupt image"),
             std::string::npos);
-  EXPECT_NE(testing::InputErrorOf([&] { DecodeImage("GIF89a......", "a.gif", 0); })
-                .find("a.gif: not an image mapless reads"),
+  EXPECT_NE(testing::InputErrorOf([&] {
+              DecodeImage("GIF89a......", "a.gif", 0);
+            }).find("a.gif: not an image mapless reads"),
             std::string::npos);
 }
 

@@ -66,8 +66,9 @@ TEST(OutputDirectory, ASecondWriterIsRefusedWhileTheFirstHoldsTheDirectory) {
   const std::string dir = Fresh("locked");
   OutputDirectory first(dir, false, "route");
   WriteFileAtomic(dir + "/a.txt", "a");
-  EXPECT_NE(testing::InputErrorOf([&] { OutputDirectory(dir, true, "route"); })
-                .find("another mapless process is writing"),
+  EXPECT_NE(testing::InputErrorOf([&] {
+              OutputDirectory(dir, true, "route");
+            }).find("another mapless process is writing"),
             std::string::npos);
 }
 

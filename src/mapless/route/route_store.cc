@@ -2,12 +2,12 @@
 
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <filesystem>
-#include <string_view>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <opencv2/core/persistence.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <string_view>
 
 #include "mapless/core/check.h"
 #include "mapless/features/features.h"
@@ -171,7 +171,8 @@ Keyframe ParseKeyframe(const std::string& text, const std::string& name) {
   // the file with the non-standard directive "%YAML:1.0", which is dropped first.
   std::string yaml = text;
   constexpr std::string_view kOpenCvHeader = "%YAML:1.0\n";
-  if (yaml.compare(0, kOpenCvHeader.size(), kOpenCvHeader) == 0) yaml.erase(0, kOpenCvHeader.size());
+  if (yaml.compare(0, kOpenCvHeader.size(), kOpenCvHeader) == 0)
+    yaml.erase(0, kOpenCvHeader.size());
   return io::WithYamlErrors(name, [&] {
     const io::YamlMap root = io::YamlMap::LoadString(yaml, name);
     if (root.GetString("format", "") != "mapless-keyframe") {
@@ -273,7 +274,8 @@ Manifest ParseManifest(const std::string& text, const std::string& name) {
     m.image_height = ManifestInt(j, "image_height", name);
     m.complete = j.at("complete").get<bool>();
     const nlohmann::json& keyframes = j.at("keyframes");
-    if (!keyframes.is_array()) throw InputError(name + ": corrupt manifest (keyframes is not a list)");
+    if (!keyframes.is_array())
+      throw InputError(name + ": corrupt manifest (keyframes is not a list)");
     if (keyframes.size() > static_cast<std::size_t>(io::kMaxKeyframes)) {
       throw InputError(name + ": " + std::to_string(keyframes.size()) +
                        " keyframes; the limit is " + std::to_string(io::kMaxKeyframes));
@@ -290,8 +292,8 @@ Manifest ParseManifest(const std::string& text, const std::string& name) {
       e.data = entry.at("data").get<std::string>();
       e.thumbnail = entry.at("thumbnail").get<std::string>();
       if (e.index != static_cast<int>(m.keyframes.size())) {
-        throw InputError(name + ": keyframe " + std::to_string(m.keyframes.size()) +
-                         " has index " + std::to_string(e.index));
+        throw InputError(name + ": keyframe " + std::to_string(m.keyframes.size()) + " has index " +
+                         std::to_string(e.index));
       }
       if (!InsideRoute(e.data) || !InsideRoute(e.thumbnail)) {
         throw InputError(name + ": keyframe " + std::to_string(e.index) +
@@ -318,7 +320,8 @@ Route LoadRoute(const std::string& dir) {
   if (!std::filesystem::exists(manifest_path)) {
     throw InputError(manifest_path + ": no route here (manifest.json is missing)");
   }
-  const Manifest manifest = ParseManifest(io::ReadFile(manifest_path, io::kMaxManifestBytes), manifest_path);
+  const Manifest manifest =
+      ParseManifest(io::ReadFile(manifest_path, io::kMaxManifestBytes), manifest_path);
   features::DetectorType detector = features::DetectorType::kOrb;
   try {
     detector = features::ParseDetectorType(manifest.detector);
@@ -327,8 +330,9 @@ Route LoadRoute(const std::string& dir) {
   }
   const features::DescriptorLayout layout = features::DescriptorLayoutOf(detector);
   if (manifest.keyframes.size() < 2) {
-    throw InputError(manifest_path + ": the route has " + std::to_string(manifest.keyframes.size()) +
-                     " keyframe" + (manifest.keyframes.size() == 1 ? "" : "s") +
+    throw InputError(manifest_path + ": the route has " +
+                     std::to_string(manifest.keyframes.size()) + " keyframe" +
+                     (manifest.keyframes.size() == 1 ? "" : "s") +
                      "; a route needs at least 2 to be repeated");
   }
   Route route;

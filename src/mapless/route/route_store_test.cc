@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 
 #include "mapless/core/check.h"
 #include "mapless/core/rng.h"
@@ -127,8 +127,9 @@ TEST(RouteStore, AManifestCannotPointOutsideTheRoute) {
       R"({"format": "mapless-route", "version": 1, "detector": "orb", "image_width": 320,
           "image_height": 240, "complete": true, "keyframes": [{"index": 0, "t_s": 0.0,
           "data": "../../secret.yml", "thumbnail": "keyframes/000000.png"}]})";
-  EXPECT_NE(testing::InputErrorOf([&] { ParseManifest(manifest, "m.json"); })
-                .find("m.json: keyframe 0 names a file outside the route directory"),
+  EXPECT_NE(testing::InputErrorOf([&] {
+              ParseManifest(manifest, "m.json");
+            }).find("m.json: keyframe 0 names a file outside the route directory"),
             std::string::npos);
   EXPECT_NE(testing::InputErrorOf([&] { ParseManifest("[1, 2]", "m.json"); }).find("m.json"),
             std::string::npos);
@@ -177,8 +178,7 @@ TEST(RouteStore, LoadingCatchesWhatARepeatWouldTripOn) {
     RouteWriter writer(dir, "orb", 320, 240);
     writer.Append(MakeKeyframe(0));
     writer.Finish();
-    EXPECT_NE(testing::InputErrorOf([&] { LoadRoute(dir); }).find("at least 2"),
-              std::string::npos);
+    EXPECT_NE(testing::InputErrorOf([&] { LoadRoute(dir); }).find("at least 2"), std::string::npos);
   }
 }
 

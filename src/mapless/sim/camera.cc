@@ -34,8 +34,8 @@ std::optional<Eigen::Vector2d> CameraModel::Project(const Eigen::Vector3d& p_cam
 void CameraMount::Validate() const {
   MAPLESS_CHECK(height_m > 0.0 && height_m <= 100.0,
                 "CameraMount.height_m = " << height_m << "; must be in (0, 100]");
-  MAPLESS_CHECK(std::isfinite(forward_m) && std::isfinite(lateral_m) && std::abs(forward_m) <= 10.0 &&
-                    std::abs(lateral_m) <= 10.0,
+  MAPLESS_CHECK(std::isfinite(forward_m) && std::isfinite(lateral_m) &&
+                    std::abs(forward_m) <= 10.0 && std::abs(lateral_m) <= 10.0,
                 "CameraMount.forward_m, lateral_m = " << forward_m << ", " << lateral_m
                                                       << "; each must be in [-10, 10]");
   MAPLESS_CHECK(std::abs(pitch_rad) < DegToRad(89.0),

@@ -11,7 +11,8 @@ void ImageEffects::Validate() const {
                 "ImageEffects.noise_sigma = " << noise_sigma << "; must be in [0, 255]");
   MAPLESS_CHECK(invert_fraction >= 0.0 && invert_fraction <= 1.0,
                 "ImageEffects.invert_fraction = " << invert_fraction << "; must be in [0, 1]");
-  MAPLESS_CHECK(gain >= 0.0 && gain <= 100.0, "ImageEffects.gain = " << gain << "; must be in [0, 100]");
+  MAPLESS_CHECK(gain >= 0.0 && gain <= 100.0,
+                "ImageEffects.gain = " << gain << "; must be in [0, 100]");
   MAPLESS_CHECK(bias >= -255.0 && bias <= 255.0,
                 "ImageEffects.bias = " << bias << "; must be in [-255, 255]");
   MAPLESS_CHECK(blur_sigma_px >= 0.0 && blur_sigma_px <= 20.0,

@@ -24,17 +24,18 @@ void RobotOptions::Validate() const {
                 "RobotOptions.max_omega_radps = " << max_omega_radps << "; must be in [0.001, 20]");
   MAPLESS_CHECK(in(max_accel_mps2, 1e-3, 1e6),
                 "RobotOptions.max_accel_mps2 = " << max_accel_mps2 << "; must be in [0.001, 1e6]");
-  MAPLESS_CHECK(in(max_alpha_radps2, 1e-3, 1e6), "RobotOptions.max_alpha_radps2 = "
-                                                       << max_alpha_radps2
-                                                       << "; must be in [0.001, 1e6]");
+  MAPLESS_CHECK(
+      in(max_alpha_radps2, 1e-3, 1e6),
+      "RobotOptions.max_alpha_radps2 = " << max_alpha_radps2 << "; must be in [0.001, 1e6]");
   MAPLESS_CHECK(
       in(motion_noise_v_frac, 0.0, 1.0),
       "RobotOptions.motion_noise_v_frac = " << motion_noise_v_frac << "; must be in [0, 1]");
   MAPLESS_CHECK(in(motion_noise_omega_frac, 0.0, 1.0),
                 "RobotOptions.motion_noise_omega_frac = " << motion_noise_omega_frac
                                                           << "; must be in [0, 1]");
-  MAPLESS_CHECK(in(odom_scale_error, -0.5, 0.5),
-                "RobotOptions.odom_scale_error = " << odom_scale_error << "; must be in [-0.5, 0.5]");
+  MAPLESS_CHECK(
+      in(odom_scale_error, -0.5, 0.5),
+      "RobotOptions.odom_scale_error = " << odom_scale_error << "; must be in [-0.5, 0.5]");
   MAPLESS_CHECK(in(odom_noise_v_mps, 0.0, 10.0) && in(odom_noise_omega_radps, 0.0, 10.0),
                 "RobotOptions.odom_noise_*: must be in [0, 10]");
 }

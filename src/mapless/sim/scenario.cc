@@ -299,14 +299,14 @@ void Scenario::Validate() const {
   const auto speed_ok = [](double v) {
     return std::isfinite(v) && v >= kMinPathSpeedMps && v <= kMaxPathSpeedMps;
   };
-  MAPLESS_CHECK(speed_ok(teach_speed_mps), "Scenario.teach.speed_mps = "
-                                               << teach_speed_mps << "; must be in ["
-                                               << kMinPathSpeedMps << ", " << kMaxPathSpeedMps
-                                               << "]");
+  MAPLESS_CHECK(speed_ok(teach_speed_mps),
+                "Scenario.teach.speed_mps = " << teach_speed_mps << "; must be in ["
+                                              << kMinPathSpeedMps << ", " << kMaxPathSpeedMps
+                                              << "]");
   MAPLESS_CHECK(!teach_path.empty(), "Scenario.teach.path is empty");
-  MAPLESS_CHECK(teach_path.size() <= kMaxPathSteps, "Scenario.teach.path: " << teach_path.size()
-                                                        << " steps; the limit is "
-                                                        << kMaxPathSteps);
+  MAPLESS_CHECK(
+      teach_path.size() <= kMaxPathSteps,
+      "Scenario.teach.path: " << teach_path.size() << " steps; the limit is " << kMaxPathSteps);
   const auto where_ok = [](double x, double y) {
     return std::isfinite(x) && std::isfinite(y) && std::abs(x) <= kMaxWorldCoordinateM &&
            std::abs(y) <= kMaxWorldCoordinateM;
@@ -322,8 +322,9 @@ void Scenario::Validate() const {
                   "Scenario.teach.path[" << i << "]: beyond " << kMaxWorldCoordinateM
                                          << " m from the origin");
     MAPLESS_CHECK(step.speed_mps == 0.0 || speed_ok(step.speed_mps),
-                  "Scenario.teach.path[" << i << "]: speed " << step.speed_mps << " m/s; must be in ["
-                                         << kMinPathSpeedMps << ", " << kMaxPathSpeedMps << "]");
+                  "Scenario.teach.path[" << i << "]: speed " << step.speed_mps
+                                         << " m/s; must be in [" << kMinPathSpeedMps << ", "
+                                         << kMaxPathSpeedMps << "]");
     MAPLESS_CHECK(std::isfinite(step.rotate_rad) && std::abs(step.rotate_rad) <= kMaxRotateRad,
                   "Scenario.teach.path[" << i << "]: rotation of " << RadToDeg(step.rotate_rad)
                                          << " degrees; at most " << RadToDeg(kMaxRotateRad));
@@ -331,9 +332,9 @@ void Scenario::Validate() const {
   MAPLESS_CHECK(PathLength() <= kMaxPathLengthM, "Scenario.teach.path is "
                                                      << PathLength() << " m long; the limit is "
                                                      << kMaxPathLengthM << " m");
-  MAPLESS_CHECK(destinations.size() <= kMaxDestinations,
-                "Scenario.destinations: " << destinations.size() << "; the limit is "
-                                          << kMaxDestinations);
+  MAPLESS_CHECK(
+      destinations.size() <= kMaxDestinations,
+      "Scenario.destinations: " << destinations.size() << "; the limit is " << kMaxDestinations);
   for (std::size_t i = 0; i < destinations.size(); ++i) {
     MAPLESS_CHECK(where_ok(destinations[i].x(), destinations[i].y()),
                   "Scenario.destinations[" << i << "]: beyond " << kMaxWorldCoordinateM
@@ -432,7 +433,8 @@ static Scenario ParseScenarioUnchecked(const std::string& yaml_text, const std::
 
 Scenario ParseScenario(const std::string& yaml_text, const std::string& source,
                        const std::string& base_dir) {
-  return io::WithYamlErrors(source, [&] { return ParseScenarioUnchecked(yaml_text, source, base_dir); });
+  return io::WithYamlErrors(source,
+                            [&] { return ParseScenarioUnchecked(yaml_text, source, base_dir); });
 }
 
 std::vector<std::string> BuiltinScenarioNames() {

@@ -110,11 +110,12 @@ TEST(Scenario, ValuesThatWouldHangOrExhaustTheSimulatorAreRefusedByName) {
             std::string::npos);
   EXPECT_NE(error_of("center: [3, 1]", "center: [3e5, 1]").find("beyond 10000 m"),
             std::string::npos);
-  EXPECT_NE(error_of("size_m: [1, 1, 1]}", "size_m: [0.1, 0.1, 1], repeat: {count: 1000, "
-                                           "step: [0.2, 0]}}\n    - {type: box, center: [3, 5], "
-                                           "size_m: [0.1, 0.1, 1], repeat: {count: 1000, step: "
-                                           "[0.2, 0]}}\n    - {type: box, center: [3, 9], "
-                                           "size_m: [0.1, 0.1, 1]}")
+  EXPECT_NE(error_of("size_m: [1, 1, 1]}",
+                     "size_m: [0.1, 0.1, 1], repeat: {count: 1000, "
+                     "step: [0.2, 0]}}\n    - {type: box, center: [3, 5], "
+                     "size_m: [0.1, 0.1, 1], repeat: {count: 1000, step: "
+                     "[0.2, 0]}}\n    - {type: box, center: [3, 9], "
+                     "size_m: [0.1, 0.1, 1]}")
                 .find("2001 objects"),
             std::string::npos);
   EXPECT_NE(error_of("path: [[2, 0]]", "speed_mps: 1e-300\n  path: [[2, 0]]").find("speed_mps"),
@@ -123,8 +124,9 @@ TEST(Scenario, ValuesThatWouldHangOrExhaustTheSimulatorAreRefusedByName) {
             std::string::npos);
   EXPECT_NE(error_of("name: tiny", "name: tiny\ncamera: {rate_hz: 1e-300}").find("rate_hz"),
             std::string::npos);
-  EXPECT_NE(error_of("size_m: [1, 1, 1]}", "size_m: [1, 1, 1], texture: {size_px: 2048}, repeat: "
-                                           "{count: 40, step: [2, 0]}}")
+  EXPECT_NE(error_of("size_m: [1, 1, 1]}",
+                     "size_m: [1, 1, 1], texture: {size_px: 2048}, repeat: "
+                     "{count: 40, step: [2, 0]}}")
                 .find("distinct textures"),
             std::string::npos);
   for (const auto& name : BuiltinScenarioNames()) EXPECT_NO_THROW(LoadScenario(name)) << name;

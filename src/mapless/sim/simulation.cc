@@ -11,9 +11,9 @@ namespace mapless::sim {
 void SimulationOptions::Validate() const {
   MAPLESS_CHECK(physics_dt_s >= 1e-4 && physics_dt_s <= 0.1,
                 "SimulationOptions.physics_dt_s = " << physics_dt_s << "; must be in [1e-4, 0.1]");
-  MAPLESS_CHECK(robot_body_height_m > 0.0 && robot_body_height_m <= 10.0,
-                "SimulationOptions.robot_body_height_m = " << robot_body_height_m
-                                                           << "; must be in (0, 10]");
+  MAPLESS_CHECK(
+      robot_body_height_m > 0.0 && robot_body_height_m <= 10.0,
+      "SimulationOptions.robot_body_height_m = " << robot_body_height_m << "; must be in (0, 10]");
   MAPLESS_CHECK(robot_body_height_m > 0.0, "SimulationOptions.robot_body_height_m = "
                                                << robot_body_height_m << "; must be > 0");
   render.Validate();
@@ -27,10 +27,7 @@ void DriveOptions::Validate() const {
 
 Simulation::Simulation(const World& world, CameraSpec camera, SimulationOptions options,
                        std::uint64_t seed)
-    : world_(world),
-      camera_(std::move(camera)),
-      options_(options),
-      seed_(seed) {
+    : world_(world), camera_(std::move(camera)), options_(options), seed_(seed) {
   options_.Validate();
   camera_.Validate();
   world_.Validate();
@@ -75,8 +72,8 @@ bool Simulation::collided(int robot) const {
 }
 
 void Simulation::Advance(double dt_s) {
-  MAPLESS_CHECK(dt_s >= 0.0 && dt_s <= 60.0, "Simulation::Advance: dt = " << dt_s
-                                                 << " s; must be in [0, 60]");
+  MAPLESS_CHECK(dt_s >= 0.0 && dt_s <= 60.0,
+                "Simulation::Advance: dt = " << dt_s << " s; must be in [0, 60]");
   const int steps = std::max(1, static_cast<int>(std::lround(dt_s / options_.physics_dt_s)));
   for (int k = 0; k < steps; ++k) {
     for (std::size_t i = 0; i < robots_.size(); ++i) {
@@ -125,7 +122,7 @@ std::vector<Surface> Simulation::OtherRobots(int robot) const {
 cv::Mat Simulation::RenderClean(int robot) const {
   const auto& r = robots_.at(static_cast<std::size_t>(robot));
   return renderer().Render(camera_.model, WorldFromCamera(r.pose(), camera_.mount),
-                          OtherRobots(robot));
+                           OtherRobots(robot));
 }
 
 cv::Mat Simulation::Render(int robot) {
@@ -137,7 +134,8 @@ cv::Mat Simulation::Render(int robot) {
   return ApplyEffects(image, camera_.effects, &rng);
 }
 
-static DriveOptions ParseDriveOptionsUnchecked(const std::string& yaml_text, const std::string& name) {
+static DriveOptions ParseDriveOptionsUnchecked(const std::string& yaml_text,
+                                               const std::string& name) {
   DriveOptions options;
   const io::YamlMap root = io::YamlMap::LoadString(yaml_text, name);
   root.CheckKnownKeys({"render", "simulation", "drive"});

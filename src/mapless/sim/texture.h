@@ -35,8 +35,7 @@ struct TextureSpec {
 
 // What makes two texture specs the same texture (the renderer generates each distinct one once):
 // type, seed, texel_m, fit, mean, contrast, size_px, file.
-using TextureKey =
-    std::tuple<int, std::uint64_t, double, bool, double, double, int, std::string>;
+using TextureKey = std::tuple<int, std::uint64_t, double, bool, double, double, int, std::string>;
 TextureKey TextureKeyOf(const TextureSpec& spec);
 
 // A tileable texture with its mip pyramid: levels[0] is size_px x size_px, each next level half.

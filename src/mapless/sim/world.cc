@@ -54,9 +54,9 @@ void World::Validate() const {
                   "World.ceiling_height_m = " << ceiling_height_m << "; must be in (0, "
                                               << kMaxObjectSizeM << "]");
   }
-  MAPLESS_CHECK(sky_top >= 0.0 && sky_top <= 255.0 && sky_horizon >= 0.0 && sky_horizon <= 255.0,
-                "World.sky: top " << sky_top << ", horizon " << sky_horizon
-                                  << "; grey levels in [0, 255]");
+  MAPLESS_CHECK(
+      sky_top >= 0.0 && sky_top <= 255.0 && sky_horizon >= 0.0 && sky_horizon <= 255.0,
+      "World.sky: top " << sky_top << ", horizon " << sky_horizon << "; grey levels in [0, 255]");
   MAPLESS_CHECK(objects.size() <= kMaxWorldObjects,
                 "World.objects: " << objects.size() << " objects (after rooms and repeats); the "
                                   << "limit is " << kMaxWorldObjects);
@@ -80,19 +80,19 @@ void World::Validate() const {
     o.texture.Validate();
     MAPLESS_CHECK(size_ok(o.height_m), name << ".height_m = " << o.height_m << "; must be in (0, "
                                             << kMaxObjectSizeM << "]");
-    MAPLESS_CHECK(coordinate_ok(o.a) && coordinate_ok(o.b) && coordinate_ok(o.center),
-                  name << ": a coordinate is beyond " << kMaxWorldCoordinateM
-                       << " m from the origin");
-    MAPLESS_CHECK(std::isfinite(o.yaw_rad) && std::isfinite(o.z_m) &&
-                      std::abs(o.z_m) <= kMaxObjectSizeM,
-                  name << ": yaw or height above the ground out of range");
+    MAPLESS_CHECK(
+        coordinate_ok(o.a) && coordinate_ok(o.b) && coordinate_ok(o.center),
+        name << ": a coordinate is beyond " << kMaxWorldCoordinateM << " m from the origin");
+    MAPLESS_CHECK(
+        std::isfinite(o.yaw_rad) && std::isfinite(o.z_m) && std::abs(o.z_m) <= kMaxObjectSizeM,
+        name << ": yaw or height above the ground out of range");
     MAPLESS_CHECK(o.kind == ObjectKind::kWall || o.kind == ObjectKind::kCylinder ||
                       (size_ok(o.size_m.x()) && size_ok(o.size_m.y())),
                   name << ".size = [" << o.size_m.x() << ", " << o.size_m.y()
                        << "]; each must be in (0, " << kMaxObjectSizeM << "] m");
-    MAPLESS_CHECK(o.kind != ObjectKind::kCylinder || size_ok(o.radius_m),
-                  name << ".radius_m = " << o.radius_m << "; must be in (0, " << kMaxObjectSizeM
-                       << "]");
+    MAPLESS_CHECK(
+        o.kind != ObjectKind::kCylinder || size_ok(o.radius_m),
+        name << ".radius_m = " << o.radius_m << "; must be in (0, " << kMaxObjectSizeM << "]");
     switch (o.kind) {
       case ObjectKind::kWall:
         MAPLESS_CHECK((o.b - o.a).norm() > 1e-6, name << ": wall ends must differ");
