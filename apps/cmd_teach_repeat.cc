@@ -156,7 +156,10 @@ void Teach(const TeachArgs& t) {
 void AddTeachRepeatCommands(CLI::App* app) {
   auto t = std::make_shared<TeachArgs>();
   CLI::App* teach = app->add_subcommand(
-      "teach", "Teach a route: keyframes from a video, an image folder, a camera or sim:SCENARIO");
+      "teach",
+      "Teach a route: keyframes from a video, an image folder, a camera or sim:SCENARIO. Ctrl-C "
+      "stops it cleanly (exit 130): a camera teach ends there with a complete route, any other "
+      "keeps its finished keyframes marked incomplete");
   teach->add_option("--source", t->source, "sim:SCENARIO, a video file, an image folder, camera:N")
       ->required();
   teach->add_option("--out", t->out, "Route directory to create")->required();

@@ -7,7 +7,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libopencv-dev          # images, features, optical flow (Debian's build: no SURF)
-  libavutil-dev          # FFmpeg's log switch: video errors reach the user as one mapless line
+  libavformat-dev libavcodec-dev libswscale-dev libavutil-dev   # video files, decoded with FFmpeg
   libeigen3-dev          # linear algebra (PCA, least squares)
   libyaml-cpp-dev        # scenario, world and configuration files
   libcli11-dev           # the `mapless` command line

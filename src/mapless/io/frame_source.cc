@@ -2,9 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cstdarg>
 #include <filesystem>
-#include <mutex>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -13,22 +11,11 @@
 #include "mapless/core/check.h"
 #include "mapless/io/image_file.h"
 #include "mapless/io/limits.h"
-
-extern "C" {
-#include <libavutil/log.h>
-}
+#include "mapless/io/video_file.h"
 
 namespace mapless::io {
 namespace {
 
-// FFmpeg prints its own messages ("moov atom not found") to stderr; a source that cannot be read
-// is reported as an InputError instead, so they are dropped.
-extern "C" void QuietFfmpegLog(void*, int, const char*, va_list) {}
-
-void SilenceFfmpeg() {
-  static std::once_flag once;
-  std::call_once(once, [] { av_log_set_callback(QuietFfmpegLog); });
-}
 
 cv::Mat ToGrey(const cv::Mat& in) {
   if (in.channels() == 1) return in;
@@ -81,23 +68,18 @@ class FolderSource : public FrameSource {
   cv::Size size_;
 };
 
-class VideoSource : public FrameSource {
+// A camera (camera:N, /dev/videoN) through OpenCV's V4L2 back end. Video files are decoded with
+// FFmpeg directly (io/video_file.h).
+class CameraSource : public FrameSource {
  public:
-  VideoSource(const std::string& spec, bool camera, int device) : spec_(spec) {
-    SilenceFfmpeg();
-    // Files through FFmpeg only: other back ends (GStreamer) probe a file noisily and slowly.
-    const bool is_file = !camera && spec.rfind("/dev/video", 0) != 0;
+  CameraSource(const std::string& spec, bool by_number, int device) : spec_(spec) {
     bool ok = false;
     try {
-      ok = camera ? capture_.open(device)
-                  : capture_.open(spec, is_file ? cv::CAP_FFMPEG : cv::CAP_ANY);
+      ok = by_number ? capture_.open(device, cv::CAP_V4L2) : capture_.open(spec, cv::CAP_V4L2);
     } catch (const cv::Exception&) {
       ok = false;
     }
-    if (!ok || !capture_.isOpened()) {
-      throw InputError(spec + (camera ? ": cannot open camera"
-                                      : ": cannot open video (missing file or unknown format)"));
-    }
+    if (!ok || !capture_.isOpened()) throw InputError(spec + ": cannot open camera");
     fps_ = capture_.get(cv::CAP_PROP_FPS);
     if (!(fps_ > 0.0 && fps_ < 1000.0)) fps_ = 30.0;
     // The container's declared size, checked before the first frame is decoded.
@@ -159,12 +141,12 @@ std::unique_ptr<FrameSource> OpenFrameSource(const std::string& spec, double fol
     if (number.empty() || used != number.size() || device < 0 || device > 63) {
       throw InputError(spec + ": expected camera:N with a device number 0..63");
     }
-    return std::make_unique<VideoSource>(spec, true, device);
+    return std::make_unique<CameraSource>(spec, true, device);
   }
-  if (spec.rfind("/dev/video", 0) == 0) return std::make_unique<VideoSource>(spec, false, 0);
+  if (spec.rfind("/dev/video", 0) == 0) return std::make_unique<CameraSource>(spec, false, 0);
   if (std::filesystem::is_directory(spec)) return std::make_unique<FolderSource>(spec, folder_fps);
   if (!std::filesystem::exists(spec)) throw InputError(spec + ": no such file, folder or camera");
-  return std::make_unique<VideoSource>(spec, false, 0);
+  return OpenVideoFile(spec);
 }
 
 }  // namespace mapless::io
