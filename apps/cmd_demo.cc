@@ -23,7 +23,6 @@ void AddDemoCommand(CLI::App* app) {
     std::string out = "demo_out";
     std::string config;
     std::uint64_t seed = 1;
-    bool overwrite = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* demo = app->add_subcommand("demo",
@@ -36,20 +35,14 @@ void AddDemoCommand(CLI::App* app) {
       ->capture_default_str()
       ->check(SeedCheck());
   demo->add_option("--config", args->config, "Run configuration YAML (see config/default.yaml)");
-  demo->add_flag("--overwrite", args->overwrite,
-                 "Replace what --out holds even when it is not an earlier demo's output");
   demo->callback([args] {
     RefuseOutputOverInputs(args->out, "--out", {args->scenario, args->config});
     const sim::Scenario scenario = sim::LoadScenario(args->scenario);
     sim::DriveOptions options = LoadDriveOptions(args->config);
     options.seed = args->seed;
-    // An earlier demo's output is replaced (when this demo is done); anything else only with
-    // --overwrite.
-    const std::filesystem::path target(args->out);
-    const bool earlier_demo = std::filesystem::exists(target / "summary.json") &&
-                              std::filesystem::exists(target / "route" / "manifest.json") &&
-                              std::filesystem::exists(target / "teach" / "frames.csv");
-    io::OutputDirectory out_dir(args->out, args->overwrite || earlier_demo, "demo's output");
+    // An earlier demo's output (it has teach/frames.csv, even when that demo was killed) is
+    // replaced when this demo is done; any other directory with content is refused.
+    io::OutputDirectory out_dir(args->out, /*replace=*/true, "demo's output", "teach/frames.csv");
     StopCleanlyOnInterrupt();
     const std::filesystem::path out(out_dir.path());
     spdlog::info("demo: teaching route '{}' ({:.1f} m) on the simulator", scenario.name,

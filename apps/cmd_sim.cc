@@ -148,7 +148,7 @@ void AddSimCommands(CLI::App* app) {
     const sim::Scenario scenario = sim::LoadScenario(drive_args->scenario);
     sim::DriveOptions options = LoadDriveOptions(drive_args->config);
     options.seed = drive_args->seed;
-    io::OutputDirectory out(drive_args->out, drive_args->overwrite, "recording");
+    io::OutputDirectory out(drive_args->out, drive_args->overwrite, "recording", "frames.csv");
     StopCleanlyOnInterrupt();
     const sim::DriveSummary summary = DriveToDirectory(scenario, options, out.path());
     out.Commit();

@@ -82,9 +82,10 @@ void Teach(const TeachArgs& t) {
   }
   if (t.overwrite && !io::IsEmptyOrMissing(t.out) &&
       !std::filesystem::exists(std::filesystem::path(t.out) / "manifest.json")) {
+    // Checked before the source is opened; io::OutputDirectory checks it again.
     throw InputError(t.out +
-                     ": holds no route (no manifest.json), so --overwrite will not "
-                     "replace it; choose a new or empty directory");
+                     ": holds something else than a route (no manifest.json), so --overwrite "
+                     "will not replace it; choose a new or empty directory");
   }
   // The source is opened before anything is written: a bad source changes nothing.
   std::optional<sim::Scenario> scenario;
@@ -94,7 +95,7 @@ void Teach(const TeachArgs& t) {
   } else {
     source = io::OpenFrameSource(t.source, t.fps);
   }
-  io::OutputDirectory out(t.out, t.overwrite, "route");
+  io::OutputDirectory out(t.out, t.overwrite, "route", "manifest.json");
   StopCleanlyOnInterrupt();
   navigation::TeachSession session(options);
   std::unique_ptr<route::RouteWriter> writer;

@@ -127,6 +127,9 @@ scenario 's/  path: \[\[2, 0\]\]/  speed_mps: 1e-300\n  path: [[2, 0]]/' slow_te
 scenario 's/  path: \[\[2, 0\]\]/  path: [[2, 0], {rotate_deg: 1e300}]/' endless_rotation
 scenario 's/  path: \[\[2, 0\]\]/  path: [[2, 0], [1e9, 0]]/' far_path
 scenario 's/box/boxx/' unknown_type
+{ printf 'name: bomb\nworld:\n  objects:\n    - &o {type: box, center: [1, 1], size_m: [0.1, 0.1, 1], repeat: {count: 1000, step: [0.001, 0]}}\n'
+  yes '    - *o' | head -n 100000
+  printf 'teach:\n  start: [0, 0, 0]\n  path: [[2, 0]]\n'; } >"$FX/alias_bomb.yaml"
 sed 's/^world:/world: fifo.yaml/; /^  objects:/d; /^    - /d' "$FX/ok.yaml" >"$FX/world_fifo.yaml"
 { cat "$FX/ok.yaml"; printf '# %.0s0123456789012345678901234567890123456789012345678901234567890123456789\n' $(seq 1 16000); } >"$FX/big.yaml"
 printf 'simulation: {physics_dt_s: 1e-300}\n' >"$FX/tiny_dt.yaml"
@@ -185,7 +188,8 @@ probe "image that is a FIFO" 2 "fifo.yaml: not a regular file" -- "$MAPLESS" shi
 echo "# hangs: values that never end a loop"
 probe "object a billion metres wide" 2 "wide_object.yaml: World.objects[0] (box).size" -- "$MAPLESS" sim drive --scenario "$FX/wide_object.yaml" --out "$NEW/d2"
 probe "object 3e12 m away" 2 "far_object.yaml: World.objects[0] (box): a coordinate is beyond" -- "$MAPLESS" sim render --scenario "$FX/far_object.yaml" --pose 0,0,0 --out "$NEW/r.png"
-probe "3000 objects" 2 "many_objects.yaml: World.objects: 3000 objects" -- "$MAPLESS" navigate --scenario "$FX/many_objects.yaml"
+probe "3000 objects" 2 "many_objects.yaml:4:5: world.objects: more than 2000 objects" -- "$MAPLESS" navigate --scenario "$FX/many_objects.yaml"
+probe "100,000 aliases of a 1000-object entry" 2 "alias_bomb.yaml:4:5: world.objects: more than 2000 objects" -- "$MAPLESS" sim render --scenario "$FX/alias_bomb.yaml" --pose 0,0,0 --out "$NEW/r.png"
 probe "60 distinct 2048-px textures" 2 "many_textures.yaml: World: 61 distinct textures" -- "$MAPLESS" sim render --scenario "$FX/many_textures.yaml" --pose 0,0,0 --out "$NEW/r.png"
 probe "physics step of 1e-300 s" 2 "tiny_dt.yaml: SimulationOptions.physics_dt_s = 1e-300" -- "$MAPLESS" sim drive --scenario "$FX/ok.yaml" --config "$FX/tiny_dt.yaml" --out "$NEW/d3"
 probe "drive timeout factor 1e300" 2 "forever.yaml: DriveOptions.timeout_factor" -- "$MAPLESS" demo --config "$FX/forever.yaml" --out "$NEW/demo2"
@@ -240,7 +244,7 @@ probe "an unknown world object type" 2 "unknown_type.yaml:4" -- "$MAPLESS" sim r
 echo "# what the user made is not lost"
 probe "teach --overwrite from a source that fails" 2 "/nonexistent: no such file" -- "$MAPLESS" teach --source /nonexistent --out "$FX/route_old" --overwrite
 probe "teach --overwrite from black frames keeps the old route" 1 "teach: 0 keyframes" -- "$MAPLESS" teach --source "$FX/black" --out "$FX/route_old" --overwrite
-probe "teach --overwrite on a folder that holds no route" 2 "notroute: holds no route" -- "$MAPLESS" teach --source "$FX/frames" --out "$FX/notroute" --overwrite
+probe "teach --overwrite on a folder that holds no route" 2 "notroute: holds something else than a route" -- "$MAPLESS" teach --source "$FX/frames" --out "$FX/notroute" --overwrite
 probe "teach into a folder that holds something else" 2 "notroute: not empty" -- "$MAPLESS" teach --source "$FX/frames" --out "$FX/notroute"
 probe "teach into its own image folder" 2 "--out $FX/frames/route: would overwrite the input" -- "$MAPLESS" teach --source "$FX/frames" --out "$FX/frames/route"
 probe "teach over an existing route without --overwrite" 2 "already holds a route" -- "$MAPLESS" teach --source "$FX/frames" --out "$FX/route_old"
@@ -250,8 +254,12 @@ probe "flow --out onto its own input" 2 "--out $FX/f0.png: would overwrite the i
 probe "ground --out onto its second frame" 2 "would overwrite the input $FX/f1.png" -- "$MAPLESS" ground "$FX/f0.png" "$FX/f1.png" --out "$FX/f1.png"
 probe "sim render --out onto the scenario" 2 "would overwrite the input" -- "$MAPLESS" sim render --scenario "$FX/ok.yaml" --pose 0,0,0 --out "$FX/ok.yaml"
 probe "sim drive into a folder that holds a route" 2 "route: not empty" -- "$MAPLESS" sim drive --scenario "$FX/ok.yaml" --out "$FX/route"
+probe "sim drive --overwrite on a route" 2 "route: holds something else than a recording" -- "$MAPLESS" sim drive --scenario "$FX/ok.yaml" --out "$FX/route" --overwrite
+probe "sim drive --overwrite on a folder of notes" 2 "notroute: holds something else than a recording" -- "$MAPLESS" sim drive --scenario "$FX/ok.yaml" --out "$FX/notroute" --overwrite
+probe "--log that is a directory" 2 "notroute: is a directory" -- "$MAPLESS" repeat --route "$FX/route" --source "$FX/frames" --log "$FX/notroute"
+probe "flow --out that is a directory" 2 "notroute: is a directory" -- "$MAPLESS" flow "$FX/f0.png" "$FX/f1.png" --out "$FX/notroute"
 probe "sim drive --out onto a file" 2 "f0.png: is a file" -- "$MAPLESS" sim drive --scenario "$FX/ok.yaml" --out "$FX/f0.png"
-probe "demo into a folder that is not a demo's" 2 "notroute: not empty" -- "$MAPLESS" demo --out "$FX/notroute"
+probe "demo into a folder that is not a demo's" 2 "notroute: holds something else than a demo's output" -- "$MAPLESS" demo --out "$FX/notroute"
 probe "navigate --save-calibration onto --calibration" 2 "would overwrite the input" -- "$MAPLESS" navigate --scenario obstacle_field --calibration "$FX/calibration.yaml" --save-calibration "$FX/calibration.yaml"
 probe "navigate --log onto the scenario" 2 "would overwrite the input" -- "$MAPLESS" navigate --scenario "$FX/ok.yaml" --log "$FX/ok.yaml"
 

@@ -18,21 +18,49 @@
 
 namespace mapless::io {
 
-void WriteFileAtomic(const std::string& path, std::string_view bytes) {
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw InputError(path + ": cannot write: " + std::strerror(errno));
+namespace {
+
+// Writes all of `bytes` to `fd`; false on an error (errno set).
+bool WriteAll(int fd, std::string_view bytes) {
   std::size_t done = 0;
   while (done < bytes.size()) {
     const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0) {
-      if (errno == EINTR) continue;
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) return false;
+    done += static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+}  // namespace
+
+OutputKind KindOfOutput(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return OutputKind::kNewOrRegular;  // follows links
+  if (S_ISDIR(st.st_mode)) throw InputError(path + ": is a directory; name a file");
+  return S_ISREG(st.st_mode) ? OutputKind::kNewOrRegular : OutputKind::kStream;
+}
+
+void WriteFileAtomic(const std::string& path, std::string_view bytes) {
+  if (KindOfOutput(path) == OutputKind::kStream) {
+    // A device or a pipe (/dev/stdout, /dev/null): written to, never replaced by a file.
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | O_NOCTTY);
+    if (fd < 0 || !WriteAll(fd, bytes)) {
       const std::string why = std::strerror(errno);
-      ::close(fd);
-      ::unlink(tmp.c_str());
+      if (fd >= 0) ::close(fd);
       throw InputError(path + ": cannot write: " + why);
     }
-    done += static_cast<std::size_t>(n);
+    ::close(fd);
+    return;
+  }
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw InputError(path + ": cannot write: " + std::strerror(errno));
+  if (!WriteAll(fd, bytes)) {
+    const std::string why = std::strerror(errno);
+    ::close(fd);
+    ::unlink(tmp.c_str());
+    throw InputError(path + ": cannot write: " + why);
   }
   if (::fsync(fd) != 0 || ::close(fd) != 0) {
     const std::string why = std::strerror(errno);

@@ -9,7 +9,14 @@
 
 namespace mapless::io {
 
-// Writes `bytes` to `path` atomically; throws InputError naming the path on failure.
+// What an output path is: nothing yet or a regular file (written atomically, replaced), or a
+// stream such as a device or a pipe (/dev/stdout, /dev/null: written to directly, never replaced).
+// Throws InputError naming the path when it is a directory.
+enum class OutputKind { kNewOrRegular, kStream };
+OutputKind KindOfOutput(const std::string& path);
+
+// Writes `bytes` to `path` atomically (a stream is written to directly); throws InputError naming
+// the path on failure.
 void WriteFileAtomic(const std::string& path, std::string_view bytes);
 
 // Encodes an image by the extension of `path` (.png, .jpg, ...) and writes it atomically.

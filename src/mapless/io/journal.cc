@@ -8,11 +8,15 @@
 #include <cstring>
 
 #include "mapless/core/check.h"
+#include "mapless/io/atomic_file.h"
 
 namespace mapless::io {
 
-JournalFile::JournalFile(const std::string& path, Mode mode)
-    : path_(path), write_path_(mode == Mode::kReplaceAtClose ? path + ".partial" : path) {
+JournalFile::JournalFile(const std::string& path, Mode mode) : path_(path), write_path_(path) {
+  // A device or a pipe (/dev/stdout) is appended to directly: never replaced by a file.
+  if (mode == Mode::kReplaceAtClose && KindOfOutput(path) == OutputKind::kNewOrRegular) {
+    write_path_ = path + ".partial";
+  }
   fd_ = ::open(write_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0644);
   if (fd_ < 0) throw InputError(path + ": cannot write: " + std::strerror(errno));
 }
@@ -27,7 +31,8 @@ JournalFile::~JournalFile() {
 
 void JournalFile::Close() {
   if (fd_ < 0) return;
-  const bool synced = ::fsync(fd_) == 0;
+  // fsync on a pipe or a device says EINVAL: there is nothing to flush to a disk.
+  const bool synced = ::fsync(fd_) == 0 || errno == EINVAL;
   ::close(fd_);
   fd_ = -1;
   if (!synced) throw InputError(path_ + ": cannot write: " + std::strerror(errno));
@@ -52,7 +57,9 @@ void JournalFile::Append(std::string_view record) {
 }
 
 void JournalFile::Sync() {
-  if (::fsync(fd_) != 0) throw InputError(path_ + ": cannot write: " + std::strerror(errno));
+  if (::fsync(fd_) != 0 && errno != EINVAL) {
+    throw InputError(path_ + ": cannot write: " + std::strerror(errno));
+  }
 }
 
 }  // namespace mapless::io

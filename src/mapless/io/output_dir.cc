@@ -35,7 +35,8 @@ bool IsEmptyOrMissing(const std::string& dir) {
   return fs::directory_iterator(dir, ec) == fs::directory_iterator() && !ec;
 }
 
-OutputDirectory::OutputDirectory(std::string target, bool replace, std::string what)
+OutputDirectory::OutputDirectory(std::string target, bool replace, std::string what,
+                                 std::string marker)
     : target_(std::move(target)) {
   std::error_code ec;
   while (target_.size() > 1 && target_.back() == '/') target_.pop_back();
@@ -54,9 +55,14 @@ OutputDirectory::OutputDirectory(std::string target, bool replace, std::string w
     path_ = target_;
     return;
   }
+  const bool ours = fs::is_regular_file(fs::path(target_) / marker, ec);
   if (!replace) {
     throw InputError(target_ + ": not empty; choose a new or empty directory for the " + what +
-                     ", or --overwrite to replace what is there");
+                     (ours ? ", or --overwrite to replace the " + what + " there" : ""));
+  }
+  if (!ours) {
+    throw InputError(target_ + ": holds something else than a " + what + " (no " + marker +
+                     "), so --overwrite will not replace it; choose a new or empty directory");
   }
   lock_ = std::make_unique<DirectoryLock>(target_);
   path_ = target_ + ".partial-" + std::to_string(::getpid());

@@ -33,9 +33,12 @@ bool IsEmptyOrMissing(const std::string& dir);
 
 class OutputDirectory {
  public:
-  // `target` must be new, empty, or `replace` must be set. `what` names the content in errors
-  // ("route", "recording"). Throws InputError naming `target` otherwise, or when it is a file.
-  OutputDirectory(std::string target, bool replace, std::string what);
+  // `target` must be new, empty, or `replace` must be set and `target` must hold what this kind of
+  // run writes: the file `marker` (relative to `target`, e.g. "manifest.json" for a route), so
+  // that no other directory (a home directory, a folder of photos) is ever replaced. `what` names
+  // the content in errors ("route", "recording"). Throws InputError naming `target` otherwise, or
+  // when it is a file.
+  OutputDirectory(std::string target, bool replace, std::string what, std::string marker);
   ~OutputDirectory();  // not committed: removes the staging directory (never the target)
   OutputDirectory(const OutputDirectory&) = delete;
   OutputDirectory& operator=(const OutputDirectory&) = delete;

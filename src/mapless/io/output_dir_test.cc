@@ -26,7 +26,7 @@ std::string Fresh(const std::string& name) {
 
 TEST(OutputDirectory, ANewDirectoryIsWrittenInPlace) {
   const std::string dir = Fresh("new");
-  OutputDirectory out(dir, false, "route");
+  OutputDirectory out(dir, false, "route", "old.txt");
   EXPECT_EQ(out.path(), dir);
   EXPECT_FALSE(out.staged());
   WriteFileAtomic(dir + "/a.txt", "a");
@@ -38,10 +38,13 @@ TEST(OutputDirectory, WhatIsThereIsReplacedOnlyWhenAskedAndOnlyOnCommit) {
   const std::string dir = Fresh("replace");
   MakeDirectories(dir);
   WriteFileAtomic(dir + "/old.txt", "old");
-  EXPECT_NE(testing::InputErrorOf([&] { OutputDirectory(dir, false, "route"); }).find("not empty"),
+  EXPECT_NE(testing::InputErrorOf([&] { OutputDirectory(dir, false, "route", "old.txt"); }).find("not empty"),
+            std::string::npos);
+  EXPECT_NE(testing::InputErrorOf([&] { OutputDirectory(dir, true, "route", "manifest.json"); })
+                .find("holds something else than a route (no manifest.json)"),
             std::string::npos);
   {
-    OutputDirectory out(dir, true, "route");
+    OutputDirectory out(dir, true, "route", "old.txt");
     EXPECT_TRUE(out.staged());
     WriteFileAtomic(out.path() + "/new.txt", "new");
     EXPECT_TRUE(fs::exists(dir + "/old.txt"));  // untouched until the commit
@@ -49,7 +52,7 @@ TEST(OutputDirectory, WhatIsThereIsReplacedOnlyWhenAskedAndOnlyOnCommit) {
   EXPECT_EQ(ReadFile(dir + "/old.txt", 16), "old");
   EXPECT_FALSE(fs::exists(dir + "/new.txt"));
   {
-    OutputDirectory out(dir, true, "route");
+    OutputDirectory out(dir, true, "route", "old.txt");
     WriteFileAtomic(out.path() + "/new.txt", "new");
     out.Commit();
   }
@@ -64,10 +67,10 @@ TEST(OutputDirectory, WhatIsThereIsReplacedOnlyWhenAskedAndOnlyOnCommit) {
 
 TEST(OutputDirectory, ASecondWriterIsRefusedWhileTheFirstHoldsTheDirectory) {
   const std::string dir = Fresh("locked");
-  OutputDirectory first(dir, false, "route");
+  OutputDirectory first(dir, false, "route", "a.txt");
   WriteFileAtomic(dir + "/a.txt", "a");
   EXPECT_NE(testing::InputErrorOf([&] {
-              OutputDirectory(dir, true, "route");
+              OutputDirectory(dir, true, "route", "a.txt");
             }).find("another mapless process is writing"),
             std::string::npos);
 }
@@ -75,7 +78,7 @@ TEST(OutputDirectory, ASecondWriterIsRefusedWhileTheFirstHoldsTheDirectory) {
 TEST(OutputDirectory, AFileIsNotADirectory) {
   const std::string file = Fresh("file");
   WriteFileAtomic(file, "x");
-  EXPECT_NE(testing::InputErrorOf([&] { OutputDirectory(file, true, "route"); }).find("is a file"),
+  EXPECT_NE(testing::InputErrorOf([&] { OutputDirectory(file, true, "route", "a.txt"); }).find("is a file"),
             std::string::npos);
 }
 

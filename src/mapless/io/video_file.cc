@@ -3,7 +3,9 @@
 extern "C" {
 #include <libavcodec/avcodec.h>
 #include <libavformat/avformat.h>
+#include <libavutil/dict.h>
 #include <libavutil/log.h>
+#include <libavutil/mem.h>
 #include <libswscale/swscale.h>
 }
 
@@ -22,10 +24,24 @@ namespace {
 // reported as one InputError instead, so they are dropped.
 extern "C" void QuietFfmpegLog(void*, int, const char*, va_list) {}
 
-void SilenceFfmpeg() {
+// The largest single allocation FFmpeg may make: a 40-megapixel frame in 4 bytes a pixel is 160 MB.
+// (A malformed file made a demuxer ask for 1.9 GB; found by the video_file fuzzer.)
+constexpr std::size_t kMaxFfmpegAllocation = std::size_t{256} << 20;
+
+void ConfigureFfmpeg() {
   static std::once_flag once;
-  std::call_once(once, [] { av_log_set_callback(QuietFfmpegLog); });
+  std::call_once(once, [] {
+    av_log_set_callback(QuietFfmpegLog);
+    av_max_alloc(kMaxFfmpegAllocation);
+  });
 }
+
+// The containers and codecs of cameras, phones, dashcams and robot recordings; FFmpeg's other
+// demuxers and decoders (hundreds, some printing to stderr on their own) are not offered a file.
+constexpr const char* kContainers = "avi,mov,matroska,mpegts,mpeg,flv,ogg,asf,mjpeg,h264,hevc,m4v";
+constexpr const char* kCodecs =
+    "h264,hevc,mpeg4,mjpeg,vp8,vp9,av1,libdav1d,libaom-av1,mpeg1video,mpeg2video,rawvideo,theora,"
+    "msmpeg4v2,msmpeg4v3,wmv1,wmv2,wmv3,vc1,h263,flv,png,ffv1";
 
 struct FormatCloser {
   void operator()(AVFormatContext* f) const { avformat_close_input(&f); }
@@ -49,10 +65,16 @@ constexpr int kMaxPacketsPerFrame = 10'000;
 class FfmpegVideo : public FrameSource {
  public:
   explicit FfmpegVideo(const std::string& path) : path_(path) {
-    SilenceFfmpeg();
+    ConfigureFfmpeg();
+    AVDictionary* options = nullptr;
+    av_dict_set(&options, "format_whitelist", kContainers, 0);
+    av_dict_set(&options, "codec_whitelist", kCodecs, 0);
     AVFormatContext* format = nullptr;  // freed by avformat_open_input when it fails
-    if (avformat_open_input(&format, path.c_str(), nullptr, nullptr) < 0) {
-      Fail(": cannot open video (missing file or unknown format)");
+    const int opened = avformat_open_input(&format, path.c_str(), nullptr, &options);
+    av_dict_free(&options);
+    if (opened < 0) {
+      Fail(": cannot open video (missing file, or not a video in a container mapless reads: "
+           "AVI, MP4/MOV, MKV/WebM, MPEG-TS/PS, FLV, Ogg, ASF, raw MJPEG/H.264/H.265)");
     }
     format_.reset(format);
     if (avformat_find_stream_info(format_.get(), nullptr) < 0) {
@@ -68,7 +90,14 @@ class FfmpegVideo : public FrameSource {
       Fail(": cannot set up the video decoder");
     }
     decoder_->thread_count = 1;  // deterministic, and mapless runs one thread per method
-    if (avcodec_open2(decoder_.get(), codec, nullptr) < 0) Fail(": cannot open the video decoder");
+    AVDictionary* codec_options = nullptr;
+    av_dict_set(&codec_options, "codec_whitelist", kCodecs, 0);
+    const int decoder_open = avcodec_open2(decoder_.get(), codec, &codec_options);
+    av_dict_free(&codec_options);
+    if (decoder_open < 0) {
+      Fail(": cannot decode its video codec '" + std::string(codec->name) + "' (mapless reads " +
+           kCodecs + ")");
+    }
     const AVRational rate =
         stream->avg_frame_rate.num > 0 ? stream->avg_frame_rate : stream->r_frame_rate;
     const double fps = rate.den > 0 ? av_q2d(rate) : 0.0;

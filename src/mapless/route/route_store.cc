@@ -357,6 +357,10 @@ Route LoadRoute(const std::string& dir) {
     }
     if (!std::filesystem::exists(thumb)) throw InputError(thumb + ": keyframe image is missing");
     kf.thumbnail = io::ReadImage(thumb, cv::IMREAD_GRAYSCALE);
+    if (kf.thumbnail.cols > route.image_width || kf.thumbnail.rows > route.image_height) {
+      throw InputError(thumb + ": keyframe image of " + std::to_string(kf.thumbnail.cols) + "x" +
+                       std::to_string(kf.thumbnail.rows) + " is larger than the route's images");
+    }
     route.keyframes.push_back(std::move(kf));
   }
   return route;

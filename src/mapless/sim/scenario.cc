@@ -184,6 +184,12 @@ World ParseWorld(const YamlMap& m, std::uint64_t seed, const std::string& base_d
     const auto objects = m.GetMapList("objects");
     for (std::size_t i = 0; i < objects.size(); ++i) {
       ParseObject(objects[i], MixSeed(seed, 100 + i), base_dir, &w.objects);
+      // Checked as the list grows: YAML aliases can repeat one entry a million times in a few
+      // bytes, and each entry can expand to a thousand objects.
+      if (w.objects.size() > kMaxWorldObjects) {
+        m.Fail("objects", "more than " + std::to_string(kMaxWorldObjects) +
+                              " objects (after rooms and repeats) by entry " + std::to_string(i));
+      }
     }
   }
   return w;
