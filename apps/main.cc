@@ -4,13 +4,43 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <cstdio>
 #include <iostream>
+#include <string>
 #include <opencv2/core.hpp>
 #include <opencv2/core/utils/logger.hpp>
 
 #include "cli_common.h"
 #include "interrupt.h"
 #include "mapless/core/check.h"
+
+namespace {
+
+// The error on one line, whatever it quotes: control characters (a newline in a file name) are
+// written as escapes.
+std::string OneLine(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\r') {
+      out += "\\r";
+    } else if (c == '\t') {
+      out += "\\t";
+    } else if (u < 0x20 || u == 0x7f) {
+      char hex[8];
+      std::snprintf(hex, sizeof(hex), "\\x%02x", u);
+      out += hex;
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"mapless: appearance-based robot navigation from one uncalibrated camera, no map"};
@@ -44,24 +74,24 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << "mapless: error: " << e.what() << " (see --help)\n";
+    std::cerr << "mapless: error: " << OneLine(e.what()) << " (see --help)\n";
     return mapless::app::kExitBadInput;
   } catch (const mapless::app::Interrupted& e) {
     std::cerr << "mapless: " << e.what() << ": stopped cleanly, every finished file kept\n";
     return e.exit_code();
   } catch (const mapless::InputError& e) {
-    std::cerr << "mapless: error: " << e.what() << "\n";
+    std::cerr << "mapless: error: " << OneLine(e.what()) << "\n";
     return mapless::app::kExitBadInput;
   } catch (const mapless::app::RunFailed& e) {
-    std::cerr << "mapless: " << e.what() << "\n";
+    std::cerr << "mapless: " << OneLine(e.what()) << "\n";
     return mapless::app::kExitRunFailed;
   } catch (const cv::Exception& e) {
     // Inputs are checked before they reach OpenCV; one that still trips it is a mapless bug.
-    std::cerr << "mapless: error: internal (OpenCV " << e.func << "): " << e.err
+    std::cerr << "mapless: error: internal (OpenCV " << e.func << "): " << OneLine(e.err)
               << "; please report this with the command line\n";
     return mapless::app::kExitRunFailed;
   } catch (const std::exception& e) {
-    std::cerr << "mapless: error: " << e.what() << "\n";
+    std::cerr << "mapless: error: " << OneLine(e.what()) << "\n";
     return mapless::app::kExitRunFailed;
   }
   return 0;

@@ -214,6 +214,10 @@ probe "a truncated PNG" 2 "truncated.png (PNG): corrupt image" -- "$MAPLESS" flo
 probe "a PNG whose data does not decode" 2 "baddata.png (PNG): corrupt image" -- "$MAPLESS" shift "$FX/baddata.png" "$FX/f0.png"
 probe "a BMP with an impossible header" 2 "badheader.bmp (BMP): corrupt image" -- "$MAPLESS" flow "$FX/f0.png" "$FX/badheader.bmp" --out "$NEW/x.flo"
 probe "a text file named .png" 2 "notimage.png: not an image mapless reads" -- "$MAPLESS" ground "$FX/notimage.png" "$FX/f0.png" --out "$NEW/g.png"
+probe "a FIFO as a video source" 2 "fifo.yaml: not a regular file" -- "$MAPLESS" teach --source "$FX/fifo.yaml" --out "$NEW/t10"
+probe "/dev/zero as a video source" 2 "/dev/zero: not a regular file" -- "$MAPLESS" repeat --route "$FX/route" --source /dev/zero
+probe "a newline in a file name stays on one line" 2 'line\nbreak.png: cannot open file' -- "$MAPLESS" shift "$FX/f0.png" "$FX/line
+break.png"
 probe "camera:N that is not a number" 2 "camera:abc: expected camera:N" -- "$MAPLESS" teach --source camera:abc --out "$NEW/t6"
 
 echo "# silent garbage: out-of-range options"

@@ -9,6 +9,8 @@ extern "C" {
 #include <libswscale/swscale.h>
 }
 
+#include <sys/stat.h>
+
 #include <cstdarg>
 #include <cstdint>
 #include <mutex>
@@ -66,6 +68,11 @@ class FfmpegVideo : public FrameSource {
  public:
   explicit FfmpegVideo(const std::string& path) : path_(path) {
     ConfigureFfmpeg();
+    // FFmpeg would wait for a writer on a FIFO and read /dev/zero for ever.
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) {
+      Fail(": not a regular file (a video file must be one; cameras are camera:N or /dev/videoN)");
+    }
     AVDictionary* options = nullptr;
     av_dict_set(&options, "format_whitelist", kContainers, 0);
     av_dict_set(&options, "codec_whitelist", kCodecs, 0);
