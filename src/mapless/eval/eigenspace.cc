@@ -10,6 +10,9 @@
 #include "mapless/eval/potential.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/localization/nearest.h"
+#include "mapless/robot/loop.h"
+#include "mapless/robot/methods.h"
+#include "mapless/robot/sim_link.h"
 #include "mapless/sim/driver.h"
 #include "mapless/sim/simulation.h"
 
@@ -156,18 +159,26 @@ EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario, const Eigenspac
     run.route_images = route->size();
     sim::Simulation sim(scenario.world, scenario.camera, {}, seed + 7919);
     const int robot = sim.AddRobot(StartPose(scenario, options), FollowerRobot(scenario, options));
-    std::string stop;
-    bool arrived = false;
-    while (true) {
-      arrived = FollowerFrame(&sim, robot, &follower, &faulty_camera, *route, image_truth, options, observer,
-                              &metrics, &run);
-      if (arrived) break;
-      sim.Advance(period);
-      stop = SimulationStop(sim, robot, timeout_s);
-      if (!stop.empty()) break;
-    }
+    robot::FollowMethod method([&] { return route; }, options.follower);
+    robot::SimLinkOptions link_options;
+    link_options.period_s = period;
+    link_options.timeout_s = timeout_s;
+    link_options.camera_faults = options.camera_faults;
+    link_options.fault_seed = options.seed;
+    robot::SimLink link(sim, robot, link_options);
+    const robot::LoopResult result = robot::RunLoop(
+        method, link, robot::LoopOptions{},
+        [&](const robot::Observation& obs, const robot::Decision& decision) {
+          const auto& step = std::get<navigation::FollowerStep>(decision.detail);
+          const Pose2 truth = link.truth();
+          run.follower_path.push_back(truth);
+          metrics.Add(truth, step, obs.image, *route, image_truth, run.leader_path, options);
+          if (observer) observer(step, truth);
+          return true;
+        });
+    const bool arrived = result.finished;
     run.collided = sim.collided(robot);
-    Finalize(options, metrics, stop, arrived, &run);
+    Finalize(options, metrics, arrived ? std::string() : result.reason, arrived, &run);
     return run;
   }
 

@@ -8,6 +8,9 @@
 #include "mapless/core/rng.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/flow/flow.h"
+#include "mapless/robot/loop.h"
+#include "mapless/robot/methods.h"
+#include "mapless/robot/sim_link.h"
 #include "mapless/sim/renderer.h"
 #include "mapless/sim/simulation.h"
 
@@ -90,52 +93,52 @@ PotentialRun RunPotential(const sim::Scenario& scenario,
 
   navigation::PotentialNavOptions nav = options.nav;
   nav.homing = options.homing;
-  navigation::PotentialNavigator navigator(calibration, nav);
   const std::vector<Eigen::Vector2d> taught = PathPoints(scenario);
   double length = 0.0;
   for (std::size_t i = 1; i < taught.size(); ++i) length += (taught[i] - taught[i - 1]).norm();
   Eigen::Vector2d goal(start.x_m, start.y_m);
   if (options.destination) {
-    navigator.SetDestination(*options.destination);
     length = (*options.destination - goal).norm() * (options.homing ? 2.0 : 1.0);
     if (!options.homing) goal = *options.destination;
   }
   MAPLESS_CHECK(taught.size() >= 2 || options.destination,
                 "scenario '" << scenario.name << "' has no taught path for corridor centring");
+  robot::PotentialMethod method(calibration, nav, options.destination);
   const Eigen::Vector2d end = taught.back();
   const Eigen::Vector2d end_dir = (taught.back() - taught[taught.size() - 2]).normalized();
-  const double period = 1.0 / scenario.camera.rate_hz;
-  const double timeout =
+  robot::SimLinkOptions link_options;
+  link_options.period_s = 1.0 / scenario.camera.rate_hz;
+  link_options.timeout_s =
       options.timeout_factor * length / nav.potential.max_translation_mps + 20.0;
+  link_options.camera_faults = options.camera_faults;
+  link_options.fault_seed = options.seed;
+  robot::SimLink link(sim, r, link_options);
 
   PotentialRun run;
-  sim::FaultyCamera faulty_camera(options.camera_faults, options.seed);
-  while (true) {
-    const Pose2 pose = sim.robot(r).pose();
-    run.path.push_back(pose);
-    const cv::Mat image = faulty_camera.Apply(sim.Render(r), ToSeconds(sim.now_ns()));
-    const navigation::PotentialStep step = navigator.Update(image, sim.robot(r).odometry());
-    if (observer) observer(pose, image, step);
-    if (step.status == navigation::PotentialStatus::kSearching && !step.plane_mask.empty())
-      ++run.no_plane_frames;
-    if (!options.destination &&
-        (Eigen::Vector2d(pose.x_m, pose.y_m) - end).dot(end_dir) >= 0.0) {
-      run.reached = true;
-      run.status = "passed the end of the corridor";
-      break;
-    }
-    if (navigator.finished()) {
-      run.reached = step.status == navigation::PotentialStatus::kArrived;
-      run.status = step.reason;
-      break;
-    }
-    if (std::string stop = SimulationStop(sim, r, timeout); !stop.empty()) {
-      run.collided = sim.collided(r);
-      run.status = std::move(stop);
-      break;
-    }
-    sim.SetCommand(r, step.command);
-    sim.Advance(period);
+  bool passed_end = false;
+  const robot::LoopResult result = robot::RunLoop(
+      method, link, robot::LoopOptions{},
+      [&](const robot::Observation& obs, const robot::Decision& decision) {
+        const auto& step = std::get<navigation::PotentialStep>(decision.detail);
+        const Pose2 pose = link.truth();
+        run.path.push_back(pose);
+        if (observer) observer(pose, obs.image, step);
+        if (step.status == navigation::PotentialStatus::kSearching && !step.plane_mask.empty())
+          ++run.no_plane_frames;
+        if (!options.destination &&
+            (Eigen::Vector2d(pose.x_m, pose.y_m) - end).dot(end_dir) >= 0.0) {
+          passed_end = true;
+          return false;
+        }
+        return true;
+      });
+  if (passed_end) {
+    run.reached = true;
+    run.status = "passed the end of the corridor";
+  } else {
+    run.reached = result.finished;
+    run.status = result.reason;
+    run.collided = sim.collided(r);
   }
   run.duration_s = ToSeconds(sim.now_ns());
   const Pose2& last = run.path.back();

@@ -5,6 +5,9 @@
 
 #include "mapless/core/check.h"
 #include "mapless/core/rng.h"
+#include "mapless/robot/loop.h"
+#include "mapless/robot/methods.h"
+#include "mapless/robot/sim_link.h"
 
 namespace mapless::eval {
 
@@ -38,16 +41,6 @@ double DistanceToPath(const std::vector<Pose2>& path, double x_m, double y_m) {
   }
   if (path.size() == 1) best = std::hypot(path[0].x_m - x_m, path[0].y_m - y_m);
   return best;
-}
-
-std::string SimulationStop(const sim::Simulation& sim, int robot, double timeout_s) {
-  if (sim.collided(robot)) {
-    for (const sim::Collision& c : sim.collisions())
-      if (c.robot == robot) return "collision with " + c.with;
-  }
-  const double t = ToSeconds(sim.now_ns());
-  if (t > timeout_s) return "timeout after " + std::to_string(static_cast<int>(t)) + " s";
-  return {};
 }
 
 TaughtRoute TeachOnSimulator(const sim::Scenario& scenario, const navigation::TeachOptions& options,
@@ -94,31 +87,26 @@ RepeatRun RepeatOnSimulator(const sim::Scenario& scenario, const TaughtRoute& ta
   sim::Simulation sim(sim::ApplyVariant(scenario.world, scenario.repeat_variant), camera, {},
                       rng.NextU64());
   const int r = sim.AddRobot(start, robot);
-  navigation::RepeatSession session(taught.route, options.repeat);
-  const double period = 1.0 / scenario.camera.rate_hz;
-  const double timeout = options.timeout_factor * std::max(taught.duration_s, 1.0);
+  robot::RepeatMethod method(taught.route, options.repeat);
+  robot::SimLinkOptions link_options;
+  link_options.period_s = 1.0 / scenario.camera.rate_hz;
+  link_options.timeout_s = options.timeout_factor * std::max(taught.duration_s, 1.0);
+  link_options.camera_faults = options.camera_faults;
+  link_options.fault_seed = options.seed;
+  robot::SimLink link(sim, r, link_options);
   RepeatRun run;
-  sim::FaultyCamera faulty_camera(options.camera_faults, options.seed);
-  while (true) {
-    const Pose2 pose = sim.robot(r).pose();
-    run.path.push_back(pose);
-    const cv::Mat image = faulty_camera.Apply(sim.Render(r), ToSeconds(sim.now_ns()));
-    const navigation::RepeatStep step = session.Update(image, sim.now_ns());
-    if (observer) observer(pose, image, step);
-    run.steps.push_back(step);
-    if (session.finished()) {
-      run.completed = step.status == navigation::RepeatStatus::kCompleted;
-      run.status = step.reason;
-      break;
-    }
-    if (std::string stop = SimulationStop(sim, r, timeout); !stop.empty()) {
-      run.collided = sim.collided(r);
-      run.status = std::move(stop);
-      break;
-    }
-    sim.SetCommand(r, step.command);
-    sim.Advance(period);
-  }
+  const robot::LoopResult result = robot::RunLoop(
+      method, link, robot::LoopOptions{},
+      [&](const robot::Observation& obs, const robot::Decision& decision) {
+        const auto& step = std::get<navigation::RepeatStep>(decision.detail);
+        run.path.push_back(link.truth());
+        if (observer) observer(link.truth(), obs.image, step);
+        run.steps.push_back(step);
+        return true;
+      });
+  run.completed = result.finished;
+  run.collided = sim.collided(r);
+  run.status = result.reason;
   run.duration_s = ToSeconds(sim.now_ns());
   const Pose2& end = run.path.back();
   run.final_error_m = end.DistanceTo(taught.path.back());

@@ -9,6 +9,7 @@
 
 #include "mapless/navigation/repeat.h"
 #include "mapless/navigation/teach.h"
+#include "mapless/robot/sim_link.h"
 #include "mapless/sim/camera_faults.h"
 #include "mapless/sim/scenario.h"
 #include "mapless/sim/simulation.h"
@@ -62,9 +63,8 @@ RepeatRun RepeatOnSimulator(const sim::Scenario& scenario, const TaughtRoute& ta
 // (a repeat must end within 3x the taught duration).
 double RepeatSpeedFor(const sim::Scenario& scenario, double cap_mps);
 
-// Why a closed-loop run on the simulator must end now: "collision with ..." or "timeout after N s"
-// (simulated time past timeout_s); empty while it may go on.
-std::string SimulationStop(const sim::Simulation& sim, int robot, double timeout_s);
+// Why a closed-loop run on the simulator must end now (robot/sim_link.h).
+using robot::SimulationStop;
 
 // Distance from a point to a polyline (the taught path).
 double DistanceToPath(const std::vector<Pose2>& path, double x_m, double y_m);

@@ -186,6 +186,8 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
     step = Stop(step, RepeatStatus::kWaiting, camera.reason);
   } else {
     step = Decide(image, t_ns);
+    step.current_px = current_px_;
+    step.destination_px = destination_px_;
   }
   last_command_ = step.command;
   return step;

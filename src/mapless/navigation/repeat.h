@@ -94,6 +94,10 @@ struct RepeatStep {
   control::SlopedFunnelLaneResult sloped;
   control::StandardFunnelLaneResult standard;
   Twist2 command;  // zero unless driving
+  // The features in use after this frame (debug pictures): in the current image and their matches
+  // in the destination keyframe, pixels.
+  std::vector<cv::Point2f> current_px;
+  std::vector<cv::Point2f> destination_px;
 };
 
 class RepeatSession {

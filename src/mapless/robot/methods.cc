@@ -1,0 +1,116 @@
+#include "mapless/robot/methods.h"
+
+#include <utility>
+
+#include "mapless/core/check.h"
+
+namespace mapless::robot {
+
+const char* MethodStateName(MethodState state) {
+  switch (state) {
+    case MethodState::kDriving: return "driving";
+    case MethodState::kStopped: return "stopped";
+    case MethodState::kFinished: return "finished";
+    case MethodState::kFailed: return "failed";
+  }
+  return "?";
+}
+
+namespace {
+
+Decision Make(MethodState state, const Twist2& command, std::string status, std::string reason) {
+  Decision d;
+  d.state = state;
+  d.command = state == MethodState::kDriving ? command : Twist2{};
+  d.status = std::move(status);
+  d.reason = std::move(reason);
+  return d;
+}
+
+// A method that needs odometry does not drive on a frame without it.
+Decision NoOdometry(const char* method) {
+  return Make(MethodState::kStopped, {}, "stopped",
+              std::string(method) + " needs wheel odometry and this frame has none");
+}
+
+}  // namespace
+
+// ---- repeat ----------------------------------------------------------------------------------
+
+RepeatMethod::RepeatMethod(std::shared_ptr<const route::Route> route,
+                           navigation::RepeatOptions options)
+    : session_(route, options), size_(route->image_width, route->image_height) {}
+
+Decision RepeatMethod::Step(const Observation& observation) {
+  navigation::RepeatStep step = session_.Update(observation.image, observation.t_ns);
+  MethodState state = MethodState::kDriving;
+  switch (step.status) {
+    case navigation::RepeatStatus::kDriving: state = MethodState::kDriving; break;
+    case navigation::RepeatStatus::kWaiting: state = MethodState::kStopped; break;
+    case navigation::RepeatStatus::kCompleted: state = MethodState::kFinished; break;
+    case navigation::RepeatStatus::kAborted: state = MethodState::kFailed; break;
+  }
+  Decision d = Make(state, step.command, navigation::RepeatStatusName(step.status), step.reason);
+  d.detail = std::move(step);
+  return d;
+}
+
+// ---- navigate --------------------------------------------------------------------------------
+
+PotentialMethod::PotentialMethod(navigation::PlanarFlowCalibration calibration,
+                                 navigation::PotentialNavOptions options,
+                                 std::optional<Eigen::Vector2d> destination)
+    : navigator_(calibration, options), size_(calibration.width, calibration.height) {
+  if (destination) navigator_.SetDestination(*destination);
+}
+
+Decision PotentialMethod::Step(const Observation& observation) {
+  if (!observation.odometry) return NoOdometry(name());
+  navigation::PotentialStep step = navigator_.Update(observation.image, *observation.odometry);
+  MethodState state = MethodState::kStopped;
+  switch (step.status) {
+    case navigation::PotentialStatus::kDriving:
+    case navigation::PotentialStatus::kLooking:
+    case navigation::PotentialStatus::kSearching:
+    case navigation::PotentialStatus::kTurningAround:
+      // Searching and turning round move the robot too (in place, or one creeping frame).
+      state = MethodState::kDriving;
+      break;
+    case navigation::PotentialStatus::kArrived: state = MethodState::kFinished; break;
+    case navigation::PotentialStatus::kAborted: state = MethodState::kFailed; break;
+    case navigation::PotentialStatus::kCameraFault: state = MethodState::kStopped; break;
+  }
+  Decision d = Make(state, step.command, navigation::PotentialStatusName(step.status), step.reason);
+  d.detail = std::move(step);
+  return d;
+}
+
+// ---- follow ----------------------------------------------------------------------------------
+
+FollowMethod::FollowMethod(RouteSource route, navigation::AppearanceFollowerOptions options,
+                           cv::Size image_size)
+    : route_(std::move(route)), follower_(options), size_(image_size) {
+  MAPLESS_CHECK(route_, "FollowMethod: no route source");
+}
+
+Decision FollowMethod::Step(const Observation& observation) {
+  if (!observation.odometry) return NoOdometry(name());
+  const std::shared_ptr<const route::AppearanceRoute> route = route_();
+  if (!route || route->size() == 0) {
+    return Make(MethodState::kStopped, {}, "waiting", "no route image yet: waiting for the leader");
+  }
+  navigation::FollowerStep step = follower_.Update(observation.image, *observation.odometry, *route);
+  MethodState state = MethodState::kDriving;
+  switch (step.state) {
+    case navigation::FollowerState::kInitializing:
+    case navigation::FollowerState::kFollowing: state = MethodState::kDriving; break;
+    case navigation::FollowerState::kStopped:
+    case navigation::FollowerState::kWaitingForLeader: state = MethodState::kStopped; break;
+    case navigation::FollowerState::kArrived: state = MethodState::kFinished; break;
+  }
+  Decision d = Make(state, step.command, navigation::FollowerStateName(step.state), step.reason);
+  d.detail = std::move(step);
+  return d;
+}
+
+}  // namespace mapless::robot

@@ -1,0 +1,161 @@
+#include "mapless/robot/robot_file.h"
+
+#include <cctype>
+#include <cmath>
+
+#include "mapless/core/check.h"
+#include "mapless/io/atomic_file.h"
+#include "mapless/io/limits.h"
+#include "mapless/io/yaml_reader.h"
+
+namespace mapless::robot {
+
+const char* MiddlewareName(Middleware m) { return m == Middleware::kRos1 ? "ros1" : "ros2"; }
+
+const char* CameraMountName(CameraMount m) {
+  switch (m) {
+    case CameraMount::kUpright: return "upright";
+    case CameraMount::kRotated180: return "rotated_180";
+    case CameraMount::kMirrored: return "mirrored";
+    case CameraMount::kFlippedVertically: return "flipped_vertically";
+  }
+  return "?";
+}
+
+namespace {
+
+bool ValidTopic(const std::string& t) {
+  if (t.empty() || t.size() > 256) return false;
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    const char c = t[i];
+    const bool ok = std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '/';
+    if (!ok) return false;
+    if (c == '/' && i + 1 < t.size() && t[i + 1] == '/') return false;
+  }
+  const std::size_t first = t[0] == '/' ? 1 : 0;
+  if (first >= t.size()) return false;  // "/" alone
+  return std::isdigit(static_cast<unsigned char>(t[first])) == 0 && t.back() != '/';
+}
+
+void CheckTopic(const io::YamlMap& map, const std::string& key, const std::string& value,
+                bool may_be_empty) {
+  if (value.empty() && may_be_empty) return;
+  if (!ValidTopic(value))
+    map.Fail(key, "'" + value +
+                      "' is not a ROS topic name (letters, digits, '_' and '/', not starting "
+                      "with a digit, no '//', no trailing '/')");
+}
+
+double Positive(const io::YamlMap& map, const std::string& key, double fallback, double hi) {
+  const double v = map.GetDouble(key, fallback);
+  if (!std::isfinite(v) || v <= 0.0 || v > hi)
+    map.Fail(key, "must be in (0, " + std::to_string(hi) + "]");
+  return v;
+}
+
+}  // namespace
+
+std::string RobotFile::Resolve(const std::string& topic) const {
+  if (topic.empty() || topic[0] == '/') return topic;
+  if (ns.empty() || ns == "/") return "/" + topic;
+  return ns + "/" + topic;
+}
+
+LoopOptions RobotFile::Loop() const {
+  LoopOptions o;
+  o.max_speed_mps = max_speed_mps;
+  o.max_turn_rate_radps = max_turn_rate_radps;
+  o.max_frame_age_s = max_frame_age_s;
+  o.give_up_without_frames_s = give_up_without_frames_s;
+  return o;
+}
+
+void RobotFile::Validate() const { Loop().Validate(); }
+
+RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
+  return io::WithYamlErrors(name, [&] {
+    const io::YamlMap map = io::YamlMap::LoadString(text, name);
+    map.CheckKnownKeys({"middleware", "name", "namespace", "node_name", "topics", "limits",
+                        "camera", "safety", "use_sim_time"});
+    RobotFile r;
+    r.source = name;
+    const std::string middleware = map.GetString("middleware", "ros1");
+    if (middleware == "ros1") {
+      r.middleware = Middleware::kRos1;
+    } else if (middleware == "ros2") {
+      r.middleware = Middleware::kRos2;
+    } else {
+      map.Fail("middleware", "'" + middleware + "' is not one of ros1, ros2");
+    }
+    r.name = map.GetString("name", r.name);
+    r.ns = map.GetString("namespace", "");
+    if (!r.ns.empty()) {
+      if (r.ns[0] != '/') r.ns = "/" + r.ns;
+      if (r.ns != "/") CheckTopic(map, "namespace", r.ns, false);
+    }
+    r.node_name = map.GetString("node_name", r.node_name);
+    if (!ValidTopic(r.node_name) || r.node_name.find('/') != std::string::npos)
+      map.Fail("node_name", "'" + r.node_name + "' is not a ROS node name");
+    if (map.Has("topics")) {
+      const io::YamlMap t = map.GetMap("topics");
+      t.CheckKnownKeys({"image", "compressed_image", "odometry", "cmd_vel", "status",
+                        "debug_image", "estop"});
+      auto get = [&](const char* key, std::string* field, bool may_be_empty) {
+        *field = t.GetString(key, *field);
+        CheckTopic(t, key, *field, may_be_empty);
+      };
+      get("image", &r.topics.image, false);
+      get("compressed_image", &r.topics.compressed_image, true);
+      get("odometry", &r.topics.odometry, true);
+      get("cmd_vel", &r.topics.cmd_vel, false);
+      get("status", &r.topics.status, false);
+      get("debug_image", &r.topics.debug_image, true);
+      get("estop", &r.topics.estop, true);
+    }
+    if (map.Has("limits")) {
+      const io::YamlMap l = map.GetMap("limits");
+      l.CheckKnownKeys({"max_speed_mps", "max_turn_rate_radps"});
+      r.max_speed_mps = Positive(l, "max_speed_mps", r.max_speed_mps, 5.0);
+      r.max_turn_rate_radps = Positive(l, "max_turn_rate_radps", r.max_turn_rate_radps, 10.0);
+    }
+    if (map.Has("camera")) {
+      const io::YamlMap c = map.GetMap("camera");
+      c.CheckKnownKeys({"mount"});
+      const std::string mount = c.GetString("mount", "upright");
+      bool found = false;
+      for (CameraMount m : {CameraMount::kUpright, CameraMount::kRotated180, CameraMount::kMirrored,
+                            CameraMount::kFlippedVertically}) {
+        if (mount == CameraMountName(m)) {
+          r.mount = m;
+          found = true;
+        }
+      }
+      if (!found)
+        c.Fail("mount", "'" + mount +
+                            "' is not one of upright, rotated_180, mirrored, flipped_vertically");
+    }
+    if (map.Has("safety")) {
+      const io::YamlMap s = map.GetMap("safety");
+      s.CheckKnownKeys({"camera_timeout_s", "max_frame_age_s", "give_up_without_frames_s",
+                        "connect_timeout_s"});
+      r.camera_timeout_s = Positive(s, "camera_timeout_s", r.camera_timeout_s, 10.0);
+      r.max_frame_age_s = Positive(s, "max_frame_age_s", r.max_frame_age_s, 60.0);
+      r.give_up_without_frames_s = s.GetDouble("give_up_without_frames_s",
+                                               r.give_up_without_frames_s);
+      if (!std::isfinite(r.give_up_without_frames_s) || r.give_up_without_frames_s < 0.0 ||
+          r.give_up_without_frames_s > 3600.0)
+        s.Fail("give_up_without_frames_s", "must be in [0, 3600] (0: wait for ever)");
+      r.connect_timeout_s = Positive(s, "connect_timeout_s", r.connect_timeout_s, 600.0);
+    }
+    r.use_sim_time = map.GetBool("use_sim_time", false);
+    r.Validate();
+    return r;
+  });
+}
+
+RobotFile LoadRobotFile(const std::string& path) {
+  RobotFile r = ParseRobotFile(io::ReadFile(path, io::kMaxYamlFileBytes), path);
+  return r;
+}
+
+}  // namespace mapless::robot

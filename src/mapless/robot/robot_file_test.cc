@@ -1,0 +1,55 @@
+#include "mapless/robot/robot_file.h"
+
+#include <gtest/gtest.h>
+
+#include "mapless/core/check.h"
+
+namespace mapless::robot {
+namespace {
+
+TEST(RobotFile, DefaultsAreTheRosConventions) {
+  const RobotFile r = ParseRobotFile("{}", "robot.yaml");
+  EXPECT_EQ(r.middleware, Middleware::kRos1);
+  EXPECT_EQ(r.Resolve(r.topics.image), "/camera/image_raw");
+  EXPECT_EQ(r.Resolve(r.topics.odometry), "/odom");
+  EXPECT_EQ(r.Resolve(r.topics.cmd_vel), "/cmd_vel");
+  EXPECT_FALSE(r.use_sim_time);
+}
+
+TEST(RobotFile, NamespaceAppliesToRelativeTopicsOnly) {
+  const RobotFile r = ParseRobotFile(
+      "namespace: robot1\ntopics: {image: front/image_raw, cmd_vel: /base/cmd_vel}\n"
+      "limits: {max_speed_mps: 0.5, max_turn_rate_radps: 0.8}\ncamera: {mount: rotated_180}\n",
+      "r.yaml");
+  EXPECT_EQ(r.Resolve(r.topics.image), "/robot1/front/image_raw");
+  EXPECT_EQ(r.Resolve(r.topics.cmd_vel), "/base/cmd_vel");
+  EXPECT_EQ(r.max_speed_mps, 0.5);
+  EXPECT_EQ(r.mount, CameraMount::kRotated180);
+}
+
+void ExpectError(const std::string& text, const std::string& needle) {
+  try {
+    ParseRobotFile(text, "bad.yaml");
+    FAIL() << "accepted: " << text;
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("bad.yaml"), std::string::npos) << what;
+    EXPECT_NE(what.find(needle), std::string::npos) << what;
+  }
+}
+
+TEST(RobotFile, BadFieldsAreNamed) {
+  ExpectError("topic: {image: x}\n", "topic");
+  ExpectError("topics: {imagee: x}\n", "imagee");
+  ExpectError("middleware: ros3\n", "ros3");
+  ExpectError("topics: {image: 'a b'}\n", "topics.image");
+  ExpectError("topics: {cmd_vel: ''}\n", "topics.cmd_vel");
+  ExpectError("limits: {max_speed_mps: -1}\n", "limits.max_speed_mps");
+  ExpectError("limits: {max_speed_mps: .nan}\n", "limits.max_speed_mps");
+  ExpectError("camera: {mount: sideways}\n", "sideways");
+  ExpectError("safety: {camera_timeout_s: 0}\n", "safety.camera_timeout_s");
+  ExpectError("[1, 2]\n", "bad.yaml");
+}
+
+}  // namespace
+}  // namespace mapless::robot
