@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
+#include "robot_run.h"
 #include "interrupt.h"
 #include "mapless/core/check.h"
 #include "mapless/io/atomic_file.h"
@@ -132,6 +133,8 @@ void AddSimCommands(CLI::App* app) {
     bool overwrite = false;
   };
   auto drive_args = std::make_shared<DriveArgs>();
+  AddSimServeCommand(simcmd);
+
   CLI::App* drive = simcmd->add_subcommand(
       "drive", "Drive a scenario's taught path; write frames, poses (TUM) and a top-down picture");
   drive->add_option("--scenario", drive_args->scenario, "Built-in scenario name or YAML file")

@@ -11,6 +11,8 @@
 
 #include "cli_common.h"
 #include "interrupt.h"
+#include "robot_run.h"
+#include "mapless/robot/methods.h"
 #include "mapless/core/check.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/io/frame_source.h"
@@ -184,14 +186,24 @@ void AddTeachRepeatCommands(CLI::App* app) {
     double motion_noise = 0.1;
     double image_noise = 2.0;
     double fps = 10.0;
+    std::string robot;
+    double speed = 0.2;
   };
   auto r = std::make_shared<RepeatArgs>();
   CLI::App* repeat = app->add_subcommand(
       "repeat",
       "Repeat a taught route: drive the simulator, or decide frame by frame on a recording");
   repeat->add_option("--route", r->route, "Route directory (from mapless teach)")->required();
-  repeat->add_option("--source", r->source, "sim:SCENARIO, a video file, an image folder, camera:N")
-      ->required();
+  CLI::Option* source_opt = repeat->add_option(
+      "--source", r->source, "sim:SCENARIO, a video file, an image folder, camera:N");
+  repeat->add_option("--robot", r->robot,
+                     "Drive a robot: its robot file (YAML: middleware, topics, limits)")
+      ->excludes(source_opt);
+  repeat->add_option("--speed", r->speed,
+                     "Robot: forward speed of the funnel lanes, m/s (the simulator uses the "
+                     "scenario's teach speed, at most 0.2)")
+      ->capture_default_str()
+      ->check(FiniteIn(0.01, 5.0));
   repeat->add_option("--controller", r->controller, "sloped or standard")->capture_default_str();
   repeat
       ->add_option("--switching", r->switching,
@@ -218,7 +230,9 @@ void AddTeachRepeatCommands(CLI::App* app) {
       ->capture_default_str()
       ->check(FiniteIn(io::kMinFolderFps, io::kMaxFolderFps));
   repeat->callback([r] {
-    RefuseOutputOverInputs(r->log, "--log", {r->route, SourceInput(r->source)});
+    if (r->source.empty() && r->robot.empty())
+      throw InputError("repeat: give --source (simulator, recording, camera) or --robot");
+    RefuseOutputOverInputs(r->log, "--log", {r->route, SourceInput(r->source), r->robot});
     auto route = std::make_shared<route::Route>(route::LoadRoute(r->route));
     if (!route->complete)
       spdlog::warn("repeat: {} is an interrupted teach; repeating its {} keyframes", r->route,
@@ -228,6 +242,13 @@ void AddTeachRepeatCommands(CLI::App* app) {
     options.switching = navigation::ParseSwitching(r->switching);
     options.end_by_local_scale = ParseEndByLocalScale(r->end);
     options.features.type = features::ParseDetectorType(route->detector);
+    if (!r->robot.empty()) {
+      options.sloped.max_speed_mps = r->speed;
+      options.standard.forward_speed_mps = r->speed;
+      robot::RepeatMethod method(route, options);
+      RunOnRobot(method, r->robot, r->log);
+      return;
+    }
     std::unique_ptr<io::FrameSource> source;
     std::optional<sim::Scenario> scenario;
     if (IsSim(r->source)) {

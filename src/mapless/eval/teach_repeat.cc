@@ -70,23 +70,32 @@ TaughtRoute TeachOnSimulator(const sim::Scenario& scenario, const navigation::Te
   return taught;
 }
 
-RepeatRun RepeatOnSimulator(const sim::Scenario& scenario, const TaughtRoute& taught,
-                            const RepeatRunOptions& options, const RepeatObserver& observer) {
+SimSetup RepeatSimSetup(const sim::Scenario& scenario, const RepeatRunOptions& options) {
   options.Validate();
   Rng rng(options.seed);
-  sim::CameraSpec camera = scenario.camera;
-  camera.effects.noise_sigma = std::max(camera.effects.noise_sigma, options.image_noise_sigma);
-  sim::RobotOptions robot = scenario.robot;
-  robot.motion_noise_v_frac = options.motion_noise_frac;
-  robot.motion_noise_omega_frac = options.motion_noise_frac;
-  const Pose2 start =
+  SimSetup setup;
+  setup.camera = scenario.camera;
+  setup.camera.effects.noise_sigma =
+      std::max(setup.camera.effects.noise_sigma, options.image_noise_sigma);
+  setup.robot = scenario.robot;
+  setup.robot.motion_noise_v_frac = options.motion_noise_frac;
+  setup.robot.motion_noise_omega_frac = options.motion_noise_frac;
+  setup.start =
       scenario.repeat_start *
       Pose2{rng.Uniform(-options.start_offset_m, options.start_offset_m),
             rng.Uniform(-options.start_offset_m, options.start_offset_m),
             DegToRad(rng.Uniform(-options.start_offset_deg, options.start_offset_deg))};
-  sim::Simulation sim(sim::ApplyVariant(scenario.world, scenario.repeat_variant), camera, {},
-                      rng.NextU64());
-  const int r = sim.AddRobot(start, robot);
+  setup.world = sim::ApplyVariant(scenario.world, scenario.repeat_variant);
+  setup.seed = rng.NextU64();
+  return setup;
+}
+
+RepeatRun RepeatOnSimulator(const sim::Scenario& scenario, const TaughtRoute& taught,
+                            const RepeatRunOptions& options, const RepeatObserver& observer) {
+  options.Validate();
+  const SimSetup setup = RepeatSimSetup(scenario, options);
+  sim::Simulation sim(setup.world, setup.camera, {}, setup.seed);
+  const int r = sim.AddRobot(setup.start, setup.robot);
   robot::RepeatMethod method(taught.route, options.repeat);
   robot::SimLinkOptions link_options;
   link_options.period_s = 1.0 / scenario.camera.rate_hz;

@@ -56,6 +56,17 @@ struct RepeatRun {
 using RepeatObserver =
     std::function<void(const Pose2&, const cv::Mat&, const navigation::RepeatStep&)>;
 
+// The world, camera, robot, start pose and simulation seed of a run: the same for a run driven
+// directly (RepeatOnSimulator) and one served to another process (`mapless sim serve --like`).
+struct SimSetup {
+  sim::World world;
+  sim::CameraSpec camera;
+  sim::RobotOptions robot;
+  Pose2 start;
+  std::uint64_t seed = 1;
+};
+SimSetup RepeatSimSetup(const sim::Scenario& scenario, const RepeatRunOptions& options);
+
 RepeatRun RepeatOnSimulator(const sim::Scenario& scenario, const TaughtRoute& taught,
                             const RepeatRunOptions& options, const RepeatObserver& observer = {});
 

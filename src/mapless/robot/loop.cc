@@ -100,6 +100,7 @@ LoopResult RunLoop(Method& method, RobotLink& link, const LoopOptions& options,
     ++result.frames;
     if (observer && !observer(obs, decision)) return end(true, "the run's goal was reached");
     if (decision.done()) {
+      link.Send(Twist2{}, obs, decision);  // the final decision reaches the status, with a zero
       return end(decision.state == MethodState::kFinished,
                  decision.reason.empty() ? decision.status : decision.reason);
     }

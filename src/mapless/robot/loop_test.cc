@@ -69,7 +69,8 @@ TEST(RunLoop, SendsLimitedCommandsAndStopsWhenTheMethodFinishes) {
   const LoopResult result = RunLoop(method, link, options);
   EXPECT_TRUE(result.finished);
   EXPECT_EQ(result.frames, 3);
-  ASSERT_EQ(link.sent.size(), 2u);
+  ASSERT_EQ(link.sent.size(), 3u);  // the last decision is sent with a zero command
+  EXPECT_EQ(link.sent[2].v_mps, 0.0);
   EXPECT_DOUBLE_EQ(link.sent[0].v_mps, 0.3);
   EXPECT_DOUBLE_EQ(link.sent[0].omega_radps, -1.0);
   ASSERT_EQ(link.stops.size(), 1u);

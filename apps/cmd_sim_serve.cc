@@ -1,0 +1,127 @@
+// `mapless sim serve`: the simulator as a ROS robot (ros1/sim_serve.h), set up like the robot of
+// an evaluation run (--like) so that a run through ROS can be compared with the same run driven
+// directly.
+#include <spdlog/spdlog.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_common.h"
+#include "interrupt.h"
+#include "mapless/core/check.h"
+#include "mapless/eval/teach_repeat.h"
+#include "mapless/io/atomic_file.h"
+#include "mapless/robot/robot_file.h"
+#include "robot_run.h"
+#ifdef MAPLESS_HAVE_ROS1
+#include "mapless/ros1/ros1_link.h"
+#include "mapless/ros1/sim_serve.h"
+#endif
+
+namespace mapless::app {
+
+namespace {
+
+nlohmann::json PoseJson(const Pose2& p) {
+  return {{"x_m", p.x_m}, {"y_m", p.y_m}, {"theta_deg", RadToDeg(p.theta_rad)}};
+}
+
+}  // namespace
+
+void AddSimServeCommand(CLI::App* simcmd) {
+  struct Args {
+    std::string scenario;
+    std::string robot;
+    std::string like = "teach";
+    std::uint64_t seed = 1;
+    double motion_noise = 0.1;
+    double image_noise = 2.0;
+    double timeout_s = 600.0;
+    std::string summary;
+  };
+  auto a = std::make_shared<Args>();
+  CLI::App* cmd = simcmd->add_subcommand(
+      "serve",
+      "Serve a simulated robot over the robot file's middleware: camera, odometry and /clock "
+      "out, cmd_vel in (lockstep in simulated time when the file sets use_sim_time)");
+  cmd->add_option("--scenario", a->scenario, "Built-in scenario name or scenario YAML file")
+      ->required();
+  cmd->add_option("--robot", a->robot, "Robot file (YAML): topics, namespace, use_sim_time")
+      ->required();
+  cmd->add_option("--like", a->like,
+                  "Set the robot up like a run of: teach (the teach start, no noise), repeat "
+                  "(the repeat start with a seeded offset and noise, as `mapless repeat`)")
+      ->capture_default_str();
+  cmd->add_option("--seed", a->seed, "Seed (as in `mapless repeat --seed`)")
+      ->capture_default_str()
+      ->check(SeedCheck());
+  cmd->add_option("--motion-noise", a->motion_noise, "Fraction of the command (repeat)")
+      ->capture_default_str()
+      ->check(FiniteIn(0.0, 0.9));
+  cmd->add_option("--image-noise", a->image_noise, "Grey levels (repeat)")
+      ->capture_default_str()
+      ->check(FiniteIn(0.0, 100.0));
+  cmd->add_option("--timeout", a->timeout_s, "Simulated seconds, then the serve ends")
+      ->capture_default_str()
+      ->check(FiniteIn(1.0, 86400.0));
+  cmd->add_option("--summary", a->summary,
+                  "Write the run's ground truth (pose at the method's last decision) as JSON here");
+  cmd->callback([a] {
+    RefuseOutputOverInputs(a->summary, "--summary", {a->robot, a->scenario});
+    const robot::RobotFile file = robot::LoadRobotFile(a->robot);
+    const sim::Scenario scenario = sim::LoadScenario(a->scenario);
+    eval::SimSetup setup;
+    if (a->like == "teach") {
+      setup.world = scenario.world;
+      setup.camera = scenario.camera;
+      setup.robot = scenario.robot;
+      setup.start = scenario.teach_start;
+      setup.seed = a->seed;
+    } else if (a->like == "repeat") {
+      eval::RepeatRunOptions o;
+      o.seed = a->seed;
+      o.motion_noise_frac = a->motion_noise;
+      o.image_noise_sigma = a->image_noise;
+      setup = eval::RepeatSimSetup(scenario, o);
+    } else {
+      throw InputError("--like " + a->like + ": must be teach or repeat");
+    }
+#ifdef MAPLESS_HAVE_ROS1
+    if (file.middleware != robot::Middleware::kRos1)
+      throw InputError(a->robot + ": sim serve speaks ros1 in this build");
+    sim::Simulation sim(setup.world, setup.camera, {}, setup.seed);
+    const int r = sim.AddRobot(setup.start, setup.robot);
+    StopCleanlyOnInterrupt();
+    ros1::StartNode(file, "mapless_sim");
+    ros1::ServeOptions options;
+    options.period_s = 1.0 / scenario.camera.rate_hz;
+    options.timeout_s = a->timeout_s;
+    options.interrupted = [] { return InterruptSignal() != 0; };
+    options.log = [](const std::string& m) { spdlog::info("{}", m); };
+    const ros1::ServeSummary s = ros1::ServeSimulation(sim, r, file, options);
+    spdlog::info("sim serve: {} after {} frames, {} commands, {:.1f} s simulated{}", s.end,
+                 s.frames, s.commands, s.sim_time_s, s.collided ? "; " + s.collision : "");
+    if (!a->summary.empty()) {
+      nlohmann::json j;
+      j["scenario"] = scenario.name;
+      j["like"] = a->like;
+      j["seed"] = a->seed;
+      j["end"] = s.end;
+      j["frames"] = s.frames;
+      j["commands"] = s.commands;
+      j["sim_time_s"] = s.sim_time_s;
+      j["collided"] = s.collided;
+      if (s.collided) j["collision"] = s.collision;
+      j["final"] = PoseJson(s.final_pose);
+      if (s.have_decided_pose) j["decided"] = PoseJson(s.decided_pose);
+      io::WriteFileAtomic(a->summary, j.dump(2) + "\n");
+    }
+    ThrowIfInterrupted();
+#else
+    (void)file;
+    throw InputError("sim serve needs a middleware: this mapless was built without ROS 1 "
+                     "(scripts/setup.sh --ros, then build again)");
+#endif
+  });
+}
+
+}  // namespace mapless::app

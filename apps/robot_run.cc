@@ -1,0 +1,65 @@
+#include "robot_run.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+
+#include "cli_common.h"
+#include "interrupt.h"
+#include "mapless/core/check.h"
+#include "mapless/robot/loop.h"
+#include "mapless/robot/status.h"
+#ifdef MAPLESS_HAVE_ROS1
+#include "mapless/ros1/ros1_link.h"
+#endif
+
+namespace mapless::app {
+
+std::unique_ptr<robot::RobotLink> OpenRobotLink(const robot::RobotFile& robot, cv::Size image_size,
+                                                const std::string& method) {
+  if (robot.middleware == robot::Middleware::kRos1) {
+#ifdef MAPLESS_HAVE_ROS1
+    ros1::StartNode(robot, robot.node_name);
+    return std::make_unique<ros1::Ros1Link>(robot, image_size, method, [](const std::string& m) {
+      spdlog::warn("{}", m);
+    });
+#else
+    throw InputError(robot.source +
+                     ": middleware ros1, but this mapless was built without ROS 1 (install it "
+                     "with scripts/setup.sh --ros and build again)");
+#endif
+  }
+  throw InputError(robot.source + ": middleware " + robot::MiddlewareName(robot.middleware) +
+                   " is not available in this build");
+}
+
+void RunOnRobot(robot::Method& method, const std::string& robot_path, const std::string& log_path) {
+  const robot::RobotFile file = robot::LoadRobotFile(robot_path);
+  std::unique_ptr<JsonLines> log;
+  if (!log_path.empty()) log = std::make_unique<JsonLines>(log_path);
+  StopCleanlyOnInterrupt();
+  std::unique_ptr<robot::RobotLink> link = OpenRobotLink(file, method.image_size(), method.name());
+  spdlog::info("{}: on {} ({}), commands to {}", method.name(), file.name,
+               robot::MiddlewareName(file.middleware), file.Resolve(file.topics.cmd_vel));
+  int frame = 0;
+  std::string last_state;
+  const robot::LoopResult result = robot::RunLoop(
+      method, *link, file.Loop(),
+      [&](const robot::Observation& obs, const robot::Decision& decision) {
+        if (log) log->Write(robot::StatusJson(method.name(), frame, obs, decision));
+        ++frame;
+        const std::string state = decision.status + ": " + decision.reason;
+        if (decision.state != robot::MethodState::kDriving && state != last_state)
+          spdlog::info("{}: {}", method.name(), state);
+        last_state = decision.state == robot::MethodState::kDriving ? "" : state;
+        return true;
+      },
+      [] { return InterruptSignal() != 0; });
+  link.reset();  // zero velocity published, then off the graph
+  spdlog::info("{}: {} after {} frames: {}", method.name(),
+               result.finished ? "finished" : "stopped", result.frames, result.reason);
+  ThrowIfInterrupted();
+  if (!result.finished) throw RunFailed(std::string(method.name()) + " stopped: " + result.reason);
+}
+
+}  // namespace mapless::app

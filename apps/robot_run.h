@@ -1,0 +1,29 @@
+// Running a method on a robot named by a robot file (`--robot ROBOT.yaml`): opens the robot link of
+// the file's middleware, runs the loop (robot/loop.h) until the method is done or the user
+// interrupts, logs each decision, and turns the outcome into the exit code.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <memory>
+#include <string>
+
+#include "mapless/robot/link.h"
+#include "mapless/robot/method.h"
+#include "mapless/robot/robot_file.h"
+
+namespace mapless::app {
+
+// The robot link of the file's middleware; throws InputError when mapless was built without it.
+// `image_size`: frames are resized to it (0x0: as they come).
+std::unique_ptr<robot::RobotLink> OpenRobotLink(const robot::RobotFile& robot, cv::Size image_size,
+                                                const std::string& method);
+
+// Runs `method` on the robot. Decisions go to `log_path` as JSON lines ("" : none, "-": stdout).
+// Throws RunFailed when the method failed or gave up, Interrupted on SIGINT/SIGTERM (after the
+// robot was stopped).
+void RunOnRobot(robot::Method& method, const std::string& robot_path, const std::string& log_path);
+
+// `mapless sim serve`.
+void AddSimServeCommand(CLI::App* sim);
+
+}  // namespace mapless::app
