@@ -6,6 +6,8 @@
 
 #include "cli_common.h"
 #include "interrupt.h"
+#include "mapless/robot/methods.h"
+#include "robot_run.h"
 #include "mapless/core/check.h"
 #include "mapless/eval/potential.h"
 #include "mapless/io/atomic_file.h"
@@ -19,8 +21,8 @@ constexpr double kNavigationMarginM = 5.0;
 
 }  // namespace
 
-void AddNavigateCommand(CLI::App* app) {
-  struct Args {
+namespace {
+struct NavigateArgs {
     std::string scenario;
     std::string destination;
     int destination_index = -1;
@@ -32,14 +34,57 @@ void AddNavigateCommand(CLI::App* app) {
     std::uint64_t seed = 1;
     double motion_noise = 0.1;
     double image_noise = 2.0;
-  };
+  std::string robot;
+};
+
+// `navigate --robot`: the visual potential on a robot through its robot link.
+void NavigateOnRobot(const NavigateArgs& a, bool by_index) {
+  RefuseOutputOverInputs(a.log, "--log", {a.robot, a.calibration});
+  if (a.calibration.empty())
+    throw InputError("navigate --robot needs --calibration FILE (the planar-flow calibration: "
+                     "`mapless navigate --scenario S --save-calibration FILE` on the simulator)");
+  const navigation::PlanarFlowCalibration calibration = navigation::CalibrationFromYaml(
+      io::ReadFile(a.calibration, io::kMaxYamlFileBytes), a.calibration);
+  std::optional<Eigen::Vector2d> destination;
+  if (!a.destination.empty() && by_index)
+    throw InputError("--destination and --destination-index: give one of them");
+  if (!a.destination.empty()) {
+    const std::vector<double> d = ParseNumbers(a.destination, "--destination", 2, "X,Y");
+    if (std::hypot(d[0], d[1]) > 1000.0)
+      throw InputError("--destination " + a.destination + ": more than 1 km away");
+    destination = Eigen::Vector2d(d[0], d[1]);
+  } else if (by_index) {
+    if (a.scenario.empty()) throw InputError("--destination-index needs --scenario");
+    const sim::Scenario scenario = sim::LoadScenario(a.scenario);
+    if (a.destination_index < 0 ||
+        a.destination_index >= static_cast<int>(scenario.destinations.size()))
+      throw InputError("--destination-index " + std::to_string(a.destination_index) +
+                       ": scenario " + scenario.name + " has " +
+                       std::to_string(scenario.destinations.size()) + " destinations");
+    destination = scenario.destinations[static_cast<std::size_t>(a.destination_index)];
+  }
+  if (a.homing && !destination) throw InputError("--homing needs a destination");
+  navigation::PotentialNavOptions nav;
+  nav.homing = a.homing;
+  robot::PotentialMethod method(calibration, nav, destination);
+  RunOnRobot(method, a.robot, a.log);
+}
+
+}  // namespace
+
+void AddNavigateCommand(CLI::App* app) {
+  using Args = NavigateArgs;
   auto a = std::make_shared<Args>();
   CLI::App* cmd = app->add_subcommand(
       "navigate",
       "Visual-potential navigation on the simulator: free ground from optical flow, obstacles "
       "avoided, a destination reached (and home again with --homing)");
-  cmd->add_option("--scenario", a->scenario, "Built-in scenario name or scenario YAML file")
-      ->required();
+  cmd->add_option("--scenario", a->scenario,
+                  "Built-in scenario name or scenario YAML file (with --robot: only to look up "
+                  "--destination-index)");
+  cmd->add_option("--robot", a->robot,
+                  "Drive a robot: its robot file (YAML). Needs --calibration; --destination is "
+                  "then in the odometry frame (REP-105 odom), metres");
   cmd->add_option("--destination", a->destination,
                   "X,Y in the world (metres); without one the robot drives ahead and keeps to "
                   "the middle of free space until it passes the end of the taught path");
@@ -60,6 +105,11 @@ void AddNavigateCommand(CLI::App* app) {
       ->capture_default_str()
       ->check(FiniteIn(0.0, 100.0));
   cmd->callback([a, cmd] {
+    if (!a->robot.empty()) {
+      NavigateOnRobot(*a, cmd->count("--destination-index") > 0);
+      return;
+    }
+    if (a->scenario.empty()) throw InputError("navigate: give --scenario (simulator) or --robot");
     RefuseOutputOverInputs(a->log, "--log", {a->scenario, a->calibration});
     RefuseOutputOverInputs(a->save_calibration, "--save-calibration",
                            {a->scenario, a->calibration, a->log});

@@ -8,6 +8,7 @@
 #include "cli_common.h"
 #include "interrupt.h"
 #include "mapless/core/check.h"
+#include "mapless/eval/potential.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/io/atomic_file.h"
 #include "mapless/robot/robot_file.h"
@@ -49,7 +50,8 @@ void AddSimServeCommand(CLI::App* simcmd) {
       ->required();
   cmd->add_option("--like", a->like,
                   "Set the robot up like a run of: teach (the teach start, no noise), repeat "
-                  "(the repeat start with a seeded offset and noise, as `mapless repeat`)")
+                  "(the repeat start with a seeded offset and noise, as `mapless repeat`), "
+                  "navigate (the teach start and noise, as `mapless navigate`)")
       ->capture_default_str();
   cmd->add_option("--seed", a->seed, "Seed (as in `mapless repeat --seed`)")
       ->capture_default_str()
@@ -82,8 +84,14 @@ void AddSimServeCommand(CLI::App* simcmd) {
       o.motion_noise_frac = a->motion_noise;
       o.image_noise_sigma = a->image_noise;
       setup = eval::RepeatSimSetup(scenario, o);
+    } else if (a->like == "navigate") {
+      eval::PotentialRunOptions o;
+      o.seed = a->seed;
+      o.motion_noise_frac = a->motion_noise;
+      o.image_noise_sigma = a->image_noise;
+      setup = eval::PotentialSimSetup(scenario, o);
     } else {
-      throw InputError("--like " + a->like + ": must be teach or repeat");
+      throw InputError("--like " + a->like + ": must be teach, repeat or navigate");
     }
 #ifdef MAPLESS_HAVE_ROS1
     if (file.middleware != robot::Middleware::kRos1)
@@ -112,7 +120,11 @@ void AddSimServeCommand(CLI::App* simcmd) {
       j["collided"] = s.collided;
       if (s.collided) j["collision"] = s.collision;
       j["final"] = PoseJson(s.final_pose);
-      if (s.have_decided_pose) j["decided"] = PoseJson(s.decided_pose);
+      if (s.have_decided_pose) {
+        j["decided"] = PoseJson(s.decided_pose);
+        j["decided_x_m"] = s.decided_pose.x_m;  // flat, for scripts
+        j["decided_y_m"] = s.decided_pose.y_m;
+      }
       io::WriteFileAtomic(a->summary, j.dump(2) + "\n");
     }
     ThrowIfInterrupted();

@@ -2,7 +2,18 @@
 # Installs every Debian package mapless needs to build, test and benchmark.
 # Idempotent: packages already installed are skipped; nothing is done when all are present.
 # Usage: scripts/setup.sh            (as root, or with sudo available)
+#        scripts/setup.sh --ros      also ROS 1 (roscpp, the message packages, roscore): the robot
+#                                    link over ROS 1 is built when they are present. About 170
+#                                    Debian packages, so the demo (README command 1) does without;
+#                                    the test command (command 2) and robot users take them.
 set -euo pipefail
+WITH_ROS=0
+for arg in "$@"; do
+  case "$arg" in
+    --ros) WITH_ROS=1 ;;
+    *) echo "setup: unknown option $arg (known: --ros)" >&2; exit 2 ;;
+  esac
+done
 
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
@@ -17,6 +28,13 @@ PACKAGES=(
   libbenchmark-dev       # micro benchmarks
   libzmq3-dev cppzmq-dev # fleet messaging (leader/follower)
 )
+if [ "$WITH_ROS" = "1" ]; then
+  PACKAGES+=(
+    libroscpp-dev          # ROS 1 client library (Noetic level in Debian 12)
+    libsensor-msgs-dev libgeometry-msgs-dev libnav-msgs-dev libstd-msgs-dev
+    ros-core-dev           # roscore / rosmaster, for `mapless sim serve` and the tests
+  )
+fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -75,21 +75,31 @@ void PotentialRunOptions::Validate() const {
                 "timeout_factor and success_radius_m must be > 0");
 }
 
+SimSetup PotentialSimSetup(const sim::Scenario& scenario, const PotentialRunOptions& options) {
+  options.Validate();
+  Rng rng(options.seed);
+  SimSetup setup;
+  setup.camera = scenario.camera;
+  setup.camera.effects.invert_fraction =
+      std::max(setup.camera.effects.invert_fraction, options.invert_fraction);
+  setup.camera.effects.noise_sigma =
+      std::max(setup.camera.effects.noise_sigma, options.image_noise_sigma);
+  setup.robot = scenario.robot;
+  setup.robot.motion_noise_v_frac = options.motion_noise_frac;
+  setup.robot.motion_noise_omega_frac = options.motion_noise_frac;
+  setup.start = scenario.teach_start * Pose2{0.0, options.start_lateral_m, 0.0};
+  setup.world = scenario.world;
+  setup.seed = rng.NextU64();
+  return setup;
+}
+
 PotentialRun RunPotential(const sim::Scenario& scenario,
                           const navigation::PlanarFlowCalibration& calibration,
                           const PotentialRunOptions& options, const PotentialObserver& observer) {
-  options.Validate();
-  Rng rng(options.seed);
-  sim::CameraSpec camera = scenario.camera;
-  camera.effects.invert_fraction = std::max(camera.effects.invert_fraction,
-                                            options.invert_fraction);
-  camera.effects.noise_sigma = std::max(camera.effects.noise_sigma, options.image_noise_sigma);
-  sim::RobotOptions robot = scenario.robot;
-  robot.motion_noise_v_frac = options.motion_noise_frac;
-  robot.motion_noise_omega_frac = options.motion_noise_frac;
-  const Pose2 start = scenario.teach_start * Pose2{0.0, options.start_lateral_m, 0.0};
-  sim::Simulation sim(scenario.world, camera, {}, rng.NextU64());
-  const int r = sim.AddRobot(start, robot);
+  const SimSetup setup = PotentialSimSetup(scenario, options);
+  const Pose2& start = setup.start;
+  sim::Simulation sim(setup.world, setup.camera, {}, setup.seed);
+  const int r = sim.AddRobot(setup.start, setup.robot);
 
   navigation::PotentialNavOptions nav = options.nav;
   nav.homing = options.homing;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "mapless/eval/suite.h"
+#include "mapless/eval/teach_repeat.h"
 #include "mapless/navigation/potential.h"
 #include "mapless/sim/camera_faults.h"
 #include "mapless/sim/scenario.h"
@@ -51,6 +52,10 @@ struct PotentialRun {
   std::string status;
   std::vector<Pose2> path;  // ground truth, one per frame
 };
+
+// The simulated robot of a run (see eval::SimSetup): the same for RunPotential and `mapless sim
+// serve --like navigate`.
+SimSetup PotentialSimSetup(const sim::Scenario& scenario, const PotentialRunOptions& options);
 
 using PotentialObserver =
     std::function<void(const Pose2&, const cv::Mat&, const navigation::PotentialStep&)>;
