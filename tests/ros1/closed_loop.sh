@@ -1,0 +1,143 @@
+#!/usr/bin/env bash
+# Closed loop through ROS 1 on loopback (issue 17): a ROS master, `mapless sim serve` as the robot
+# and the method as a second process, in simulated time (lockstep), compared run by run with the
+# same run driven directly on the simulator (same scenario, seed and options).
+#
+#   tests/ros1/closed_loop.sh [--runs N] [--methods repeat,navigate] [--seed S] [--out DIR]
+#                             [--mapless BIN] [--port P]
+#
+# Per line: runs that completed through ROS, runs that completed directly, the largest distance
+# between the final poses of the two (the pose at the method's last decision), collisions. A line
+# passes when every run completed both ways, without a collision, and every pair of final poses
+# lies within 0.05 m. Exit 0 when every line passes, 1 otherwise, 2 on bad usage; 77 (skipped)
+# when ROS 1 or the adapter is absent.
+set -uo pipefail
+cd "$(dirname "$0")/../.."
+RUNS=10
+METHODS=repeat,navigate
+SEED=1
+OUT=""
+BIN=build/release/apps/mapless
+PORT=$((20000 + $$ % 20000))
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --runs) RUNS="$2"; shift 2 ;;
+    --methods) METHODS="$2"; shift 2 ;;
+    --seed) SEED="$2"; shift 2 ;;
+    --out) OUT="$2"; shift 2 ;;
+    --mapless) BIN="$2"; shift 2 ;;
+    --port) PORT="$2"; shift 2 ;;
+    *) echo "closed_loop.sh: unknown option $1" >&2; exit 2 ;;
+  esac
+done
+case "$RUNS" in ''|*[!0-9]*) echo "closed_loop.sh: --runs $RUNS: not a number" >&2; exit 2 ;; esac
+if ! command -v rosmaster >/dev/null 2>&1; then
+  echo "closed_loop.sh: SKIPPED: rosmaster not found (scripts/setup.sh --ros installs ROS 1)"
+  exit 77
+fi
+if ! "$BIN" sim serve --help >/dev/null 2>&1 || ! "$BIN" sim serve --help | grep -q -- --robot; then
+  echo "closed_loop.sh: SKIPPED: $BIN has no sim serve" ; exit 77
+fi
+BIN=$(realpath "$BIN")
+[ -n "$OUT" ] || OUT=$(mktemp -d /tmp/mapless_ros1.XXXXXX)
+mkdir -p "$OUT"
+OUT=$(realpath "$OUT")
+
+export ROS_MASTER_URI="http://127.0.0.1:$PORT" ROS_IP=127.0.0.1 ROS_HOSTNAME=127.0.0.1
+export ROS_HOME="$OUT/roshome" ROS_LOG_DIR="$OUT/roshome/log"
+PIDS=()
+cleanup() {
+  for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null; done
+  sleep 0.2
+  for p in "${PIDS[@]}"; do kill -9 "$p" 2>/dev/null; done
+}
+trap cleanup EXIT INT TERM
+rosmaster --core -p "$PORT" >"$OUT/master.log" 2>&1 &
+PIDS+=($!)
+for _ in $(seq 1 100); do
+  grep -q "started" "$OUT/master.log" 2>/dev/null && break
+  (exec 3<>"/dev/tcp/127.0.0.1/$PORT") 2>/dev/null && break
+  sleep 0.1
+done
+
+cat >"$OUT/robot.yaml" <<YAML
+# The simulated robot over ROS 1, in simulated time (lockstep with the method). The limits are
+# the simulated robot's own (sim::RobotOptions), so that they clamp nothing the direct run does not.
+name: simulated
+use_sim_time: true
+limits: {max_speed_mps: 1.0, max_turn_rate_radps: 2.0}
+YAML
+
+field() { grep -o "\"$2\": *[-0-9.e]*" "$1" | tail -1 | sed 's/.*: *//'; }
+last_field() { tail -1 "$1" | grep -o "\"$2\":[-0-9.e]*" | sed 's/.*://'; }
+
+# run_pair NAME SEED SCENARIO LIKE DIRECT_CMD... -- ROS_CMD...
+ALL_OK=1
+line() {  # name scenario like direct... ; uses globals DIRECT ROSCMD
+  local name="$1" scenario="$2" like="$3"
+  local done_ros=0 done_direct=0 collisions=0 worst=0 fails=""
+  for k in $(seq 0 $((RUNS - 1))); do
+    local s=$((SEED + k)) d="$OUT/$name/seed$((SEED + k))"
+    mkdir -p "$d"
+    "${DIRECT[@]}" --seed "$s" --log "$d/direct.jsonl" >"$d/direct.log" 2>&1
+    local direct_rc=$?
+    timeout 600 "$BIN" sim serve --scenario "$scenario" --robot "$OUT/robot.yaml" --like "$like" \
+      --seed "$s" --summary "$d/serve.json" >"$d/serve.log" 2>&1 &
+    local serve=$!
+    PIDS+=("$serve")
+    timeout 600 "${ROSCMD[@]}" --log "$d/ros.jsonl" >"$d/ros.log" 2>&1
+    local ros_rc=$?
+    wait "$serve"
+    [ "$direct_rc" = 0 ] && done_direct=$((done_direct + 1))
+    [ "$ros_rc" = 0 ] && done_ros=$((done_ros + 1))
+    grep -q '"collided": true' "$d/serve.json" 2>/dev/null && collisions=$((collisions + 1))
+    local dx dy rx ry dist
+    dx=$(last_field "$d/direct.jsonl" x_m); dy=$(last_field "$d/direct.jsonl" y_m)
+    rx=$(field "$d/serve.json" decided_x_m); ry=$(field "$d/serve.json" decided_y_m)
+    if [ -z "$dx" ] || [ -z "$rx" ]; then
+      dist=inf
+    else
+      dist=$(awk -v a="$dx" -v b="$dy" -v c="$rx" -v e="$ry" 'BEGIN{printf "%.4f", sqrt((a-c)^2+(b-e)^2)}')
+    fi
+    worst=$(awk -v w="$worst" -v d="$dist" 'BEGIN{ if (d == "inf" || d + 0 > w + 0) print d; else print w }')
+    echo "{\"line\":\"$name\",\"seed\":$s,\"ros_exit\":$ros_rc,\"direct_exit\":$direct_rc,\"final_pose_difference_m\":\"$dist\"}" >>"$OUT/runs.jsonl"
+    [ "$ros_rc" = 0 ] || fails="$fails seed$s(ros exit $ros_rc)"
+  done
+  local ok=1
+  [ "$done_ros" = "$RUNS" ] && [ "$done_direct" = "$RUNS" ] && [ "$collisions" = 0 ] || ok=0
+  awk -v w="$worst" 'BEGIN{ exit !(w != "inf" && w + 0 <= 0.05) }' || ok=0
+  [ "$ok" = 1 ] || ALL_OK=0
+  printf "%-42s ros %2d/%d  direct %2d/%d  max final-pose difference %s m  collisions %d  %s%s\n" \
+    "$name" "$done_ros" "$RUNS" "$done_direct" "$RUNS" "$worst" "$collisions" \
+    "$([ $ok = 1 ] && echo PASS || echo FAIL)" "${fails:+ ($fails)}"
+}
+
+: >"$OUT/runs.jsonl"
+START=$(date +%s)
+IFS=, read -r -a M <<<"$METHODS"
+for m in "${M[@]}"; do
+  case "$m" in
+    repeat)
+      for sc in table1_sharp_turn_low_texture table1_almost_straight; do
+        "$BIN" teach --source "sim:$sc" --out "$OUT/routes/$sc" --overwrite >"$OUT/teach_$sc.log" 2>&1 ||
+          { echo "closed_loop.sh: teach $sc failed (see $OUT/teach_$sc.log)"; exit 1; }
+        DIRECT=("$BIN" repeat --route "$OUT/routes/$sc" --source "sim:$sc")
+        ROSCMD=("$BIN" repeat --route "$OUT/routes/$sc" --robot "$OUT/robot.yaml")
+        line "repeat sloped $sc" "$sc" repeat
+      done ;;
+    navigate)
+      "$BIN" navigate --scenario obstacle_field --destination-index 0 --seed 0 --motion-noise 0 \
+        --image-noise 0 --save-calibration "$OUT/obstacle_field_calibration.yaml" \
+        >"$OUT/calibrate.log" 2>&1 || true
+      [ -s "$OUT/obstacle_field_calibration.yaml" ] ||
+        { echo "closed_loop.sh: calibration failed (see $OUT/calibrate.log)"; exit 1; }
+      DIRECT=("$BIN" navigate --scenario obstacle_field --destination-index 0 --homing
+              --calibration "$OUT/obstacle_field_calibration.yaml")
+      ROSCMD=("$BIN" navigate --robot "$OUT/robot.yaml" --scenario obstacle_field
+              --destination-index 0 --homing --calibration "$OUT/obstacle_field_calibration.yaml")
+      line "navigate obstacle_field destination 0 + home" obstacle_field navigate ;;
+    *) echo "closed_loop.sh: unknown method $m (repeat, navigate)" >&2; exit 2 ;;
+  esac
+done
+echo "closed_loop.sh: $(( $(date +%s) - START )) s; runs in $OUT"
+[ "$ALL_OK" = 1 ]
