@@ -78,6 +78,7 @@ void AddShiftCommand(CLI::App* app);
 void AddEvalCommand(CLI::App* app);
 void AddSoakCommand(CLI::App* app);
 void AddTeachRepeatCommands(CLI::App* app);
+void AddFollowCommand(CLI::App* app);
 void AddFlowCommand(CLI::App* app);
 void AddGroundCommand(CLI::App* app);
 void AddNavigateCommand(CLI::App* app);

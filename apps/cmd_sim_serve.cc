@@ -8,6 +8,7 @@
 #include "cli_common.h"
 #include "interrupt.h"
 #include "mapless/core/check.h"
+#include "mapless/eval/eigenspace.h"
 #include "mapless/eval/potential.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/io/atomic_file.h"
@@ -51,7 +52,8 @@ void AddSimServeCommand(CLI::App* simcmd) {
   cmd->add_option("--like", a->like,
                   "Set the robot up like a run of: teach (the teach start, no noise), repeat "
                   "(the repeat start with a seeded offset and noise, as `mapless repeat`), "
-                  "navigate (the teach start and noise, as `mapless navigate`)")
+                  "navigate (the teach start and noise, as `mapless navigate`), follow (as `mapless "
+                  "follow`)")
       ->capture_default_str();
   cmd->add_option("--seed", a->seed, "Seed (as in `mapless repeat --seed`)")
       ->capture_default_str()
@@ -90,8 +92,13 @@ void AddSimServeCommand(CLI::App* simcmd) {
       o.motion_noise_frac = a->motion_noise;
       o.image_noise_sigma = a->image_noise;
       setup = eval::PotentialSimSetup(scenario, o);
+    } else if (a->like == "follow") {
+      eval::EigenspaceRunOptions o;
+      o.seed = a->seed;
+      o.motion_noise = a->motion_noise;
+      setup = eval::FollowSimSetup(scenario, o);
     } else {
-      throw InputError("--like " + a->like + ": must be teach, repeat or navigate");
+      throw InputError("--like " + a->like + ": must be teach, repeat, navigate or follow");
     }
 #ifdef MAPLESS_HAVE_ROS1
     if (file.middleware != robot::Middleware::kRos1)

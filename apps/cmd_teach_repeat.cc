@@ -11,6 +11,7 @@
 
 #include "cli_common.h"
 #include "interrupt.h"
+#include "teach.h"
 #include "robot_run.h"
 #include "mapless/robot/methods.h"
 #include "mapless/core/check.h"
@@ -22,7 +23,6 @@
 namespace mapless::app {
 namespace {
 
-bool IsSim(const std::string& source) { return source.rfind("sim:", 0) == 0; }
 
 nlohmann::json StepJson(int frame, Timestamp t_ns, const navigation::RepeatStep& s) {
   nlohmann::json j;
@@ -46,116 +46,6 @@ nlohmann::json StepJson(int frame, Timestamp t_ns, const navigation::RepeatStep&
 
 }  // namespace
 
-struct TeachArgs {
-  std::string source;
-  std::string out;
-  bool overwrite = false;
-  std::string detector = "orb";
-  double fps = 10.0;
-};
-
-// The input files of a source ("" for sim built-ins and cameras), for RefuseOutputOverInputs.
-std::string SourceInput(const std::string& source) {
-  if (IsSim(source)) {
-    const std::string name = source.substr(4);
-    return name.find('/') != std::string::npos || name.find(".y") != std::string::npos ? name : "";
-  }
-  return source.rfind("camera:", 0) == 0 ? "" : source;
-}
-
-bool IsLive(const std::string& source) {
-  return source.rfind("camera:", 0) == 0 || source.rfind("/dev/video", 0) == 0;
-}
-
-// Teaching writes the route keyframe by keyframe into ROUTE (a new or empty directory), or, with
-// --overwrite over an existing route, into a staging directory that replaces ROUTE when the teach
-// is done (io::OutputDirectory). Ctrl-C ends the teach cleanly: a camera teach ends there with a
-// complete route; a recording or simulator teach keeps its keyframes in ROUTE marked incomplete
-// (in place), or leaves the old route untouched (--overwrite).
-void Teach(const TeachArgs& t) {
-  navigation::TeachOptions options;
-  options.features.type = features::ParseDetectorType(t.detector);
-  options.Validate();
-  RefuseOutputOverInputs(t.out, "--out", {SourceInput(t.source)});
-  if (!t.overwrite && std::filesystem::exists(std::filesystem::path(t.out) / "manifest.json")) {
-    throw InputError(t.out +
-                     ": already holds a route (manifest.json); choose another directory, "
-                     "or --overwrite to replace it");
-  }
-  if (t.overwrite && !io::IsEmptyOrMissing(t.out) &&
-      !std::filesystem::exists(std::filesystem::path(t.out) / "manifest.json")) {
-    // Checked before the source is opened; io::OutputDirectory checks it again.
-    throw InputError(t.out +
-                     ": holds something else than a route (no manifest.json), so --overwrite "
-                     "will not replace it; choose a new or empty directory");
-  }
-  // The source is opened before anything is written: a bad source changes nothing.
-  std::optional<sim::Scenario> scenario;
-  std::unique_ptr<io::FrameSource> source;
-  if (IsSim(t.source)) {
-    scenario = sim::LoadScenario(t.source.substr(4));
-  } else {
-    source = io::OpenFrameSource(t.source, t.fps);
-  }
-  io::OutputDirectory out(t.out, t.overwrite, "route", "manifest.json");
-  StopCleanlyOnInterrupt();
-  navigation::TeachSession session(options);
-  std::unique_ptr<route::RouteWriter> writer;
-  int keyframes = 0;
-  int frames = 0;
-  const auto keep = [&](const std::optional<route::Keyframe>& kf) {
-    if (!kf) return;
-    writer->Append(*kf);
-    ++keyframes;
-  };
-  const auto frame_in = [&](const cv::Mat& image, Timestamp t_ns) {
-    ThrowIfInterrupted();
-    if (!writer) {
-      writer = std::make_unique<route::RouteWriter>(out.path(), t.detector, image.cols, image.rows);
-    }
-    keep(session.Update(image, t_ns));
-    ++frames;
-  };
-  bool interrupted = false;
-  try {
-    if (scenario) {
-      const sim::DriveSummary summary =
-          sim::DriveTaughtPath(*scenario, sim::DriveOptions{},
-                               [&](const sim::DriveFrame& f) { frame_in(f.image, f.t_ns); });
-      if (!summary.completed) {
-        throw RunFailed("teach: the drive of '" + scenario->name +
-                        "' did not complete: " + summary.status);
-      }
-    } else {
-      io::Frame frame;
-      while (source->Next(&frame)) frame_in(frame.image, frame.t_ns);
-    }
-  } catch (const Interrupted&) {
-    if (!writer || !IsLive(t.source)) throw;
-    interrupted = true;  // the end of a camera teach
-  }
-  if (!writer) throw InputError(t.source + ": no frames");
-  keep(session.Finish());
-  if (session.deferred_keyframes() > 0) {
-    spdlog::warn("teach: {} keyframes were deferred for lack of features (a weak stretch)",
-                 session.deferred_keyframes());
-  }
-  spdlog::info("teach: {} frames, {} keyframes", frames, keyframes);
-  if (keyframes < 2) {
-    throw RunFailed("teach: " + std::to_string(keyframes) + " keyframe" +
-                    (keyframes == 1 ? "" : "s") +
-                    " (too few features in the images?); a route "
-                    "needs at least 2, so none was " +
-                    (out.staged() ? "put in place of the old "
-                                    "one"
-                                  : "marked complete"));
-  }
-  writer->Finish();
-  out.Commit();
-  spdlog::info("teach: route of {} keyframes written to {}", keyframes, t.out);
-  if (interrupted) throw Interrupted(InterruptSignal());
-}
-
 void AddTeachRepeatCommands(CLI::App* app) {
   auto t = std::make_shared<TeachArgs>();
   CLI::App* teach = app->add_subcommand(
@@ -163,8 +53,16 @@ void AddTeachRepeatCommands(CLI::App* app) {
       "Teach a route: keyframes from a video, an image folder, a camera or sim:SCENARIO. Ctrl-C "
       "stops it cleanly (exit 130): a camera teach ends there with a complete route, any other "
       "keeps its finished keyframes marked incomplete");
-  teach->add_option("--source", t->source, "sim:SCENARIO, a video file, an image folder, camera:N")
-      ->required();
+  CLI::Option* teach_source =
+      teach->add_option("--source", t->source, "sim:SCENARIO, a video file, an image folder, camera:N");
+  teach->add_option("--robot", t->robot,
+                    "Teach on a robot (its robot file): a person drives it (teleop on cmd_vel), "
+                    "mapless records from the camera topic until Ctrl-C")
+      ->excludes(teach_source);
+  teach->add_option("--method", t->method,
+                    "funnel (keyframes, for `repeat`) or eigenspace (appearance route images, "
+                    "for `follow`)")
+      ->capture_default_str();
   teach->add_option("--out", t->out, "Route directory to create")->required();
   teach->add_flag("--overwrite", t->overwrite,
                   "Replace a route already in --out (the old one stays until the new one is done)");

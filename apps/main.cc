@@ -57,6 +57,7 @@ int main(int argc, char** argv) {
   mapless::app::AddDemoCommand(&app);
   mapless::app::AddSimCommands(&app);
   mapless::app::AddTeachRepeatCommands(&app);
+  mapless::app::AddFollowCommand(&app);
   mapless::app::AddShiftCommand(&app);
   mapless::app::AddFlowCommand(&app);
   mapless::app::AddGroundCommand(&app);

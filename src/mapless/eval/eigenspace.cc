@@ -128,6 +128,22 @@ bool FollowerFrame(sim::Simulation* sim, int robot, navigation::AppearanceFollow
 
 }  // namespace
 
+SimSetup FollowSimSetup(const sim::Scenario& scenario, const EigenspaceRunOptions& options) {
+  SimSetup setup;
+  setup.world = scenario.world;
+  setup.camera = scenario.camera;
+  setup.robot = FollowerRobot(scenario, options);
+  setup.start = StartPose(scenario, options);
+  setup.seed = options.seed + 7919;
+  return setup;
+}
+
+double FollowTimeoutS(const sim::Scenario& scenario, const EigenspaceRunOptions& options) {
+  const double nominal = scenario.PathLength() / options.follower.steering.max_speed_mps +
+                         scenario.PathLength() / scenario.teach_speed_mps + 30.0;
+  return options.timeout_factor * nominal;
+}
+
 EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario, const EigenspaceRunOptions& options,
                                   const EigenspaceObserver& observer) {
   MAPLESS_CHECK(options.leader.incremental || !options.concurrent,
@@ -140,9 +156,7 @@ EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario, const Eigenspac
   route::AppearanceRouteChannel channel;
   std::vector<Pose2> image_truth;
   FollowerMetrics metrics;
-  const double nominal = scenario.PathLength() / options.follower.steering.max_speed_mps +
-                         scenario.PathLength() / scenario.teach_speed_mps + 30.0;
-  const double timeout_s = options.timeout_factor * nominal;
+  const double timeout_s = FollowTimeoutS(scenario, options);
   const std::uint64_t seed = options.seed;
 
   if (!options.concurrent) {
@@ -157,8 +171,9 @@ EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario, const Eigenspac
     channel.Publish(leader.Snapshot());
     const std::shared_ptr<const route::AppearanceRoute> route = channel.Latest();
     run.route_images = route->size();
-    sim::Simulation sim(scenario.world, scenario.camera, {}, seed + 7919);
-    const int robot = sim.AddRobot(StartPose(scenario, options), FollowerRobot(scenario, options));
+    const SimSetup setup = FollowSimSetup(scenario, options);
+    sim::Simulation sim(setup.world, setup.camera, {}, setup.seed);
+    const int robot = sim.AddRobot(setup.start, setup.robot);
     robot::FollowMethod method([&] { return route; }, options.follower);
     robot::SimLinkOptions link_options;
     link_options.period_s = period;

@@ -12,6 +12,7 @@
 #include "mapless/eval/suite.h"
 #include "mapless/navigation/appearance.h"
 #include "mapless/sim/camera_faults.h"
+#include "mapless/eval/teach_repeat.h"
 #include "mapless/sim/scenario.h"
 
 namespace mapless::eval {
@@ -35,6 +36,12 @@ struct EigenspaceRunOptions {
   navigation::AppearanceLeaderOptions leader;
   navigation::AppearanceFollowerOptions follower;
 };
+
+// The follower's simulated robot of a run that follows a finished route (see eval::SimSetup), and
+// its timeout in simulated seconds: the same for RunEigenspaceFollow, `mapless follow` and
+// `mapless sim serve --like follow`.
+SimSetup FollowSimSetup(const sim::Scenario& scenario, const EigenspaceRunOptions& options);
+double FollowTimeoutS(const sim::Scenario& scenario, const EigenspaceRunOptions& options);
 
 struct EigenspaceRun {
   bool success = false;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "mapless/core/check.h"
 #include "mapless/localization/nearest.h"
@@ -37,11 +38,44 @@ bool AppearanceLeader::Update(const cv::Mat& image, const Pose2& odometry) {
       std::abs(WrapAngle(odometry.theta_rad - last_stored_.theta_rad)) >= options_.image_turn_rad;
   if (!first && !far && !turned) return false;
 
-  const cv::Mat low = appearance::LowResolution(image, options_.image);
+  // The route image is kept as the 8-bit low-resolution image (what the route store writes); the
+  // model is built from it, so a follower that loads the store rebuilds exactly this model.
+  cv::Mat grey;
+  if (image.channels() == 3) {
+    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  } else if (image.channels() == 4) {
+    cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
+  } else {
+    grey = image;
+  }
+  cv::resize(grey, last_low_, cv::Size(options_.image.width, options_.image.height), 0, 0,
+             cv::INTER_AREA);
+  Add(last_low_, distance_m_, odometry);
+  last_stored_ = odometry;
+  last_stored_distance_m_ = distance_m_;
+  return true;
+}
+
+void AppearanceLeader::AddStored(const cv::Mat& low, double distance_m, const Pose2& odometry) {
+  MAPLESS_CHECK(!finished_, "AppearanceLeader::AddStored after Finish()");
+  MAPLESS_CHECK(low.type() == CV_8UC1 && low.cols == options_.image.width &&
+                    low.rows == options_.image.height,
+                "AppearanceLeader::AddStored: a route image must be 8-bit "
+                    << options_.image.width << "x" << options_.image.height);
+  Add(low, distance_m, odometry);
+  have_last_ = true;
+  last_odometry_ = odometry;
+  last_stored_ = odometry;
+  distance_m_ = distance_m;
+  last_stored_distance_m_ = distance_m;
+}
+
+void AppearanceLeader::Add(const cv::Mat& low8, double distance_m, const Pose2& odometry) {
+  const cv::Mat low = appearance::LowResolution(low8, options_.image);
   const appearance::Vector vector = appearance::ToVector(low);
   auto stored = std::make_shared<route::AppearanceRouteImage>();
   stored->windows = appearance::BuildSubWindowEigenspace(low, options_.windows);
-  stored->distance_m = distance_m_;
+  stored->distance_m = distance_m;
   stored->odometry = odometry;
   if (options_.incremental) {
     pca_.Add(vector);
@@ -49,9 +83,6 @@ bool AppearanceLeader::Update(const cv::Mat& image, const Pose2& odometry) {
     vectors_.push_back(vector);
   }
   images_.push_back(std::move(stored));
-  last_stored_ = odometry;
-  last_stored_distance_m_ = distance_m_;
-  return true;
 }
 
 void AppearanceLeader::Finish() {

@@ -44,6 +44,12 @@ class AppearanceLeader {
   explicit AppearanceLeader(AppearanceLeaderOptions options = {});
   // Offers a camera frame and the odometry; returns true when it became a route image.
   bool Update(const cv::Mat& image, const Pose2& odometry);
+  // The 8-bit low-resolution image of the last route image Update() stored (for the route store).
+  const cv::Mat& last_low() const { return last_low_; }
+  double distance_m() const { return distance_m_; }
+  // Adds a route image read back from the route store (route/appearance_store.h): the model then
+  // equals the leader's that stored it.
+  void AddStored(const cv::Mat& low, double distance_m, const Pose2& odometry);
   // The route is complete (batch PCA is computed here when incremental is false).
   void Finish();
   // The current route as an immutable snapshot (null before any image, or before Finish() for
@@ -52,7 +58,10 @@ class AppearanceLeader {
   int images() const { return static_cast<int>(images_.size()); }
 
  private:
+  void Add(const cv::Mat& low8, double distance_m, const Pose2& odometry);
+
   AppearanceLeaderOptions options_;
+  cv::Mat last_low_;
   appearance::IncrementalPca pca_;
   std::vector<appearance::Vector> vectors_;  // batch mode only
   std::vector<std::shared_ptr<const route::AppearanceRouteImage>> images_;

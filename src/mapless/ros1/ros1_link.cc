@@ -116,7 +116,10 @@ class Ros1Link::Impl {
         return event;
       }
       const Timestamp now = ToNs(ros::Time::now());
-      if (now < last_event_ns_) last_event_ns_ = now;  // the clock went back (a new /clock)
+      // A frame may arrive before the /clock message of its time, so the clock lags the last frame
+      // by a period or so; only a jump back of more than a second (a restarted simulation, a
+      // replay looping) resets the watchdog's reference.
+      if (now + kNsPerSecond < last_event_ns_) last_event_ns_ = now;
       // Before the first frame the camera has connect_timeout_s to appear (the robot is stopped
       // anyway); a zero Twist then would also be taken as the answer to a lockstep simulator's
       // first frame.

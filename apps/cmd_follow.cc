@@ -1,0 +1,132 @@
+// `mapless follow`: the appearance route follower (Payá et al.) on a stored appearance route (from
+// `mapless teach --method eigenspace`), on the simulator or on a robot.
+#include <spdlog/spdlog.h>
+
+#include "cli_common.h"
+#include "interrupt.h"
+#include "mapless/core/check.h"
+#include "mapless/eval/eigenspace.h"
+#include "mapless/robot/loop.h"
+#include "mapless/robot/methods.h"
+#include "mapless/robot/sim_link.h"
+#include "mapless/robot/status.h"
+#include "mapless/route/appearance_store.h"
+#include "mapless/sim/driver.h"
+#include "robot_run.h"
+#include "teach.h"
+
+namespace mapless::app {
+
+namespace {
+
+// The route as the leader that stored it had it: the stored images replayed through the
+// incremental PCA (deterministic), complete when the teach finished.
+std::shared_ptr<const route::AppearanceRoute> RebuildRoute(const std::string& dir,
+                                                           cv::Size* image_size) {
+  const route::StoredAppearanceRoute stored = route::LoadAppearanceRoute(dir);
+  navigation::AppearanceLeaderOptions options;
+  if (stored.low_width != options.image.width || stored.low_height != options.image.height)
+    throw InputError(dir + ": route images are " + std::to_string(stored.low_width) + "x" +
+                     std::to_string(stored.low_height) + ", this mapless builds its model at " +
+                     std::to_string(options.image.width) + "x" +
+                     std::to_string(options.image.height));
+  if (stored.images.size() < 2)
+    throw InputError(dir + ": " + std::to_string(stored.images.size()) +
+                     " route images; following needs at least 2");
+  navigation::AppearanceLeader leader(options);
+  for (const route::StoredAppearanceImage& image : stored.images)
+    leader.AddStored(image.low, image.distance_m, image.odometry);
+  if (stored.complete) {
+    leader.Finish();
+  } else {
+    spdlog::warn("follow: {} is an interrupted teach; the follower will stop at its end", dir);
+  }
+  *image_size = cv::Size(stored.image_width, stored.image_height);
+  return leader.Snapshot();
+}
+
+}  // namespace
+
+void AddFollowCommand(CLI::App* app) {
+  struct Args {
+    std::string route;
+    std::string source;
+    std::string robot;
+    std::string log;
+    std::uint64_t seed = 1;
+    double motion_noise = 0.1;
+  };
+  auto a = std::make_shared<Args>();
+  CLI::App* cmd = app->add_subcommand(
+      "follow",
+      "Follow an appearance route (teach --method eigenspace): initial localization, Markov "
+      "localization and sub-window steering, on the simulator or a robot");
+  cmd->add_option("--route", a->route, "Appearance route directory")->required();
+  CLI::Option* source = cmd->add_option("--source", a->source, "sim:SCENARIO");
+  cmd->add_option("--robot", a->robot, "Drive a robot: its robot file (YAML)")->excludes(source);
+  cmd->add_option("--log", a->log, "Per-frame decisions as JSON lines (- for stdout)");
+  cmd->add_option("--seed", a->seed, "Simulator: seed of the motion noise")
+      ->capture_default_str()
+      ->check(SeedCheck());
+  cmd->add_option("--motion-noise", a->motion_noise, "Simulator: fraction of the command")
+      ->capture_default_str()
+      ->check(FiniteIn(0.0, 0.9));
+  cmd->callback([a] {
+    if (a->source.empty() == a->robot.empty())
+      throw InputError("follow: give one of --source sim:SCENARIO or --robot");
+    RefuseOutputOverInputs(a->log, "--log", {a->route, SourceInput(a->source), a->robot});
+    cv::Size size;
+    const std::shared_ptr<const route::AppearanceRoute> route = RebuildRoute(a->route, &size);
+    const navigation::AppearanceFollowerOptions follower;
+    robot::FollowMethod method([route] { return route; }, follower, size);
+    if (!a->robot.empty()) {
+      RunOnRobot(method, a->robot, a->log);
+      return;
+    }
+    if (!IsSim(a->source))
+      throw InputError("--source " + a->source + ": follow runs on sim:SCENARIO or --robot");
+    const sim::Scenario scenario = sim::LoadScenario(a->source.substr(4));
+    if (scenario.camera.model.width != size.width || scenario.camera.model.height != size.height)
+      throw InputError(a->source + ": the camera is " +
+                       std::to_string(scenario.camera.model.width) + "x" +
+                       std::to_string(scenario.camera.model.height) + ", the route " + a->route +
+                       " was taught at " + std::to_string(size.width) + "x" +
+                       std::to_string(size.height));
+    eval::EigenspaceRunOptions options;
+    options.seed = a->seed;
+    options.motion_noise = a->motion_noise;
+    const eval::SimSetup setup = eval::FollowSimSetup(scenario, options);
+    sim::Simulation sim(setup.world, setup.camera, {}, setup.seed);
+    const int r = sim.AddRobot(setup.start, setup.robot);
+    robot::SimLinkOptions link_options;
+    link_options.period_s = 1.0 / scenario.camera.rate_hz;
+    link_options.timeout_s = eval::FollowTimeoutS(scenario, options);
+    robot::SimLink link(sim, r, link_options);
+    JsonLines log(a->log);
+    StopCleanlyOnInterrupt();
+    int frame = 0;
+    const robot::LoopResult result = robot::RunLoop(
+        method, link, robot::LoopOptions{},
+        [&](const robot::Observation& obs, const robot::Decision& decision) {
+          ThrowIfInterrupted();
+          nlohmann::json j = robot::StatusJson(method.name(), frame++, obs, decision);
+          j["x_m"] = link.truth().x_m;
+          j["y_m"] = link.truth().y_m;
+          j["theta_rad"] = link.truth().theta_rad;
+          if (!a->log.empty()) log.Write(j);
+          return true;
+        });
+    // The taught path's end (drawn without rendering) is where the follower should arrive.
+    Pose2 end = scenario.teach_start;
+    sim::DriveOptions drive;
+    drive.render_frames = false;
+    sim::DriveTaughtPath(scenario, drive, [&](const sim::DriveFrame& f) { end = f.truth; });
+    const double error = link.truth().DistanceTo(end);
+    spdlog::info("follow: {} ({} frames); {:.2f} m from the route's end", result.reason,
+                 result.frames, error);
+    if (!result.finished || sim.collided(r) || error > options.arrive_tolerance_m)
+      throw RunFailed("follow did not succeed: " + result.reason);
+  });
+}
+
+}  // namespace mapless::app

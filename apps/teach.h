@@ -1,0 +1,25 @@
+// `mapless teach`: a route from the simulator, a recording, a camera or a robot, as keyframes for
+// the funnel-lane repeat or as appearance route images for the eigenspace follower.
+#pragma once
+
+#include <string>
+
+namespace mapless::app {
+
+struct TeachArgs {
+  std::string source;
+  std::string robot;
+  std::string out;
+  std::string method = "funnel";  // funnel | eigenspace
+  bool overwrite = false;
+  std::string detector = "orb";
+  double fps = 10.0;
+};
+
+bool IsSim(const std::string& source);
+// The input files of a source ("" for sim built-ins and cameras), for RefuseOutputOverInputs.
+std::string SourceInput(const std::string& source);
+
+void Teach(const TeachArgs& t);
+
+}  // namespace mapless::app

@@ -1,0 +1,163 @@
+#include "mapless/route/appearance_store.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "mapless/core/check.h"
+#include "mapless/io/atomic_file.h"
+#include "mapless/io/image_file.h"
+#include "mapless/io/limits.h"
+
+namespace mapless::route {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kManifest = "appearance.json";
+
+std::string ImageFile(int index) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "images/%06d.png", index);
+  return name;
+}
+
+}  // namespace
+
+AppearanceRouteWriter::AppearanceRouteWriter(std::string dir, int image_width, int image_height,
+                                             int low_width, int low_height)
+    : dir_(std::move(dir)) {
+  header_.image_width = image_width;
+  header_.image_height = image_height;
+  header_.low_width = low_width;
+  header_.low_height = low_height;
+  MAPLESS_CHECK(!fs::exists(fs::path(dir_) / kManifest),
+                dir_ << ": already holds an appearance route");
+  fs::create_directories(fs::path(dir_) / "images");
+  WriteManifest();
+}
+
+void AppearanceRouteWriter::Append(const StoredAppearanceImage& image) {
+  MAPLESS_CHECK(image.low.type() == CV_8UC1 && image.low.cols == header_.low_width &&
+                    image.low.rows == header_.low_height,
+                "AppearanceRouteWriter: a route image must be 8-bit " << header_.low_width << "x"
+                                                                      << header_.low_height);
+  const int index = images();
+  io::WriteImageAtomic((fs::path(dir_) / ImageFile(index)).string(), image.low);
+  StoredAppearanceImage entry = image;
+  entry.low = cv::Mat();
+  entries_.push_back(entry);
+  WriteManifest();
+}
+
+void AppearanceRouteWriter::Finish() {
+  header_.complete = true;
+  WriteManifest();
+}
+
+void AppearanceRouteWriter::WriteManifest() const {
+  nlohmann::json j;
+  j["format"] = "mapless-appearance-route";
+  j["version"] = kAppearanceRouteFormatVersion;
+  j["image_width"] = header_.image_width;
+  j["image_height"] = header_.image_height;
+  j["low_width"] = header_.low_width;
+  j["low_height"] = header_.low_height;
+  j["complete"] = header_.complete;
+  nlohmann::json images = nlohmann::json::array();
+  for (std::size_t i = 0; i < entries_.size(); ++i) {
+    const StoredAppearanceImage& e = entries_[i];
+    images.push_back({{"index", i},
+                      {"distance_m", e.distance_m},
+                      {"x_m", e.odometry.x_m},
+                      {"y_m", e.odometry.y_m},
+                      {"theta_rad", e.odometry.theta_rad},
+                      {"file", ImageFile(static_cast<int>(i))}});
+  }
+  j["images"] = images;
+  io::WriteFileAtomic((fs::path(dir_) / kManifest).string(), j.dump(1) + "\n");
+}
+
+StoredAppearanceRoute ParseAppearanceManifest(const std::string& text, const std::string& name,
+                                              std::vector<std::string>* files) {
+  const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+  MAPLESS_CHECK(!j.is_discarded() && j.is_object(), name << ": not a JSON object");
+  auto number = [&](const nlohmann::json& o, const char* key, const std::string& where) {
+    MAPLESS_CHECK(o.contains(key) && o[key].is_number(),
+                  name << ": " << where << key << ": missing or not a number");
+    const double v = o[key].get<double>();
+    MAPLESS_CHECK(std::isfinite(v) && std::abs(v) <= 1e7,
+                  name << ": " << where << key << " = " << v << ": out of range");
+    return v;
+  };
+  auto integer = [&](const char* key, int lo, int hi) {
+    const double v = number(j, key, "");
+    MAPLESS_CHECK(v == std::floor(v) && v >= lo && v <= hi,
+                  name << ": " << key << " = " << v << "; must be a whole number in [" << lo
+                       << ", " << hi << "]");
+    return static_cast<int>(v);
+  };
+  MAPLESS_CHECK(j.contains("format") && j["format"] == "mapless-appearance-route",
+                name << ": format: not a mapless appearance route");
+  MAPLESS_CHECK(integer("version", 0, 1000) == kAppearanceRouteFormatVersion,
+                name << ": version " << j["version"].dump() << " (this mapless reads version "
+                     << kAppearanceRouteFormatVersion << ")");
+  StoredAppearanceRoute route;
+  route.image_width = integer("image_width", 16, io::kMaxImageSide);
+  route.image_height = integer("image_height", 16, io::kMaxImageSide);
+  route.low_width = integer("low_width", 8, 1024);
+  route.low_height = integer("low_height", 8, 1024);
+  MAPLESS_CHECK(j.contains("complete") && j["complete"].is_boolean(),
+                name << ": complete: missing or not true/false");
+  route.complete = j["complete"].get<bool>();
+  MAPLESS_CHECK(j.contains("images") && j["images"].is_array(),
+                name << ": images: missing or not a list");
+  const auto& images = j["images"];
+  MAPLESS_CHECK(images.size() <= static_cast<std::size_t>(io::kMaxKeyframes),
+                name << ": " << images.size() << " images (at most " << io::kMaxKeyframes << ")");
+  double last_distance = 0.0;
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    const auto& e = images[i];
+    const std::string where = "images[" + std::to_string(i) + "].";
+    MAPLESS_CHECK(e.is_object(), name << ": " << where << ": not an object");
+    MAPLESS_CHECK(number(e, "index", where) == static_cast<double>(i),
+                  name << ": " << where << "index: must be " << i);
+    StoredAppearanceImage image;
+    image.distance_m = number(e, "distance_m", where);
+    MAPLESS_CHECK(image.distance_m >= last_distance,
+                  name << ": " << where << "distance_m goes backwards");
+    last_distance = image.distance_m;
+    image.odometry = Pose2{number(e, "x_m", where), number(e, "y_m", where),
+                           number(e, "theta_rad", where)};
+    MAPLESS_CHECK(e.contains("file") && e["file"].is_string() &&
+                      e["file"].get<std::string>() == ImageFile(static_cast<int>(i)),
+                  name << ": " << where << "file: must be " << ImageFile(static_cast<int>(i)));
+    if (files) files->push_back(e["file"].get<std::string>());
+    route.images.push_back(image);
+  }
+  return route;
+}
+
+StoredAppearanceRoute LoadAppearanceRoute(const std::string& dir) {
+  const std::string manifest = (fs::path(dir) / kManifest).string();
+  MAPLESS_CHECK(fs::exists(manifest), dir << ": no appearance route here (no " << kManifest
+                                          << "; teach one with `mapless teach --method "
+                                             "eigenspace`)");
+  std::vector<std::string> files;
+  StoredAppearanceRoute route =
+      ParseAppearanceManifest(io::ReadFile(manifest, io::kMaxManifestBytes), manifest, &files);
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    const std::string path = (fs::path(dir) / files[i]).string();
+    cv::Mat low = io::ReadImage(path, cv::IMREAD_GRAYSCALE);
+    MAPLESS_CHECK(low.cols == route.low_width && low.rows == route.low_height,
+                  path << ": " << low.cols << "x" << low.rows << ", the route's images are "
+                       << route.low_width << "x" << route.low_height);
+    route.images[i].low = low;
+  }
+  return route;
+}
+
+}  // namespace mapless::route
