@@ -48,7 +48,8 @@ void RunOnRobot(robot::Method& method, const std::string& robot_path, const std:
       [&](const robot::Observation& obs, const robot::Decision& decision) {
         if (log) log->Write(robot::StatusJson(method.name(), frame, obs, decision));
         ++frame;
-        const std::string state = decision.status + ": " + decision.reason;
+        const std::string state =
+            decision.status + (decision.reason.empty() ? "" : ": " + decision.reason);
         if (decision.state != robot::MethodState::kDriving && state != last_state)
           spdlog::info("{}: {}", method.name(), state);
         last_state = decision.state == robot::MethodState::kDriving ? "" : state;

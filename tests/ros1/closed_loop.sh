@@ -3,7 +3,7 @@
 # and the method as a second process, in simulated time (lockstep), compared run by run with the
 # same run driven directly on the simulator (same scenario, seed and options).
 #
-#   tests/ros1/closed_loop.sh [--runs N] [--methods repeat,navigate] [--seed S] [--out DIR]
+#   tests/ros1/closed_loop.sh [--runs N] [--methods repeat,navigate,follow] [--seed S] [--out DIR]
 #                             [--mapless BIN] [--port P]
 #
 # Per line: runs that completed through ROS, runs that completed directly, the largest distance
@@ -14,7 +14,7 @@
 set -uo pipefail
 cd "$(dirname "$0")/../.."
 RUNS=10
-METHODS=repeat,navigate
+METHODS=repeat,navigate,follow
 SEED=1
 OUT=""
 BIN=build/release/apps/mapless
@@ -136,7 +136,14 @@ for m in "${M[@]}"; do
       ROSCMD=("$BIN" navigate --robot "$OUT/robot.yaml" --scenario obstacle_field
               --destination-index 0 --homing --calibration "$OUT/obstacle_field_calibration.yaml")
       line "navigate obstacle_field destination 0 + home" obstacle_field navigate ;;
-    *) echo "closed_loop.sh: unknown method $m (repeat, navigate)" >&2; exit 2 ;;
+    follow)
+      "$BIN" teach --source sim:office_aliasing --method eigenspace --out "$OUT/routes/office_eigenspace" \
+        --overwrite >"$OUT/teach_office_eigenspace.log" 2>&1 ||
+        { echo "closed_loop.sh: teach office_aliasing failed"; exit 1; }
+      DIRECT=("$BIN" follow --route "$OUT/routes/office_eigenspace" --source sim:office_aliasing)
+      ROSCMD=("$BIN" follow --route "$OUT/routes/office_eigenspace" --robot "$OUT/robot.yaml")
+      line "follow office_aliasing" office_aliasing follow ;;
+    *) echo "closed_loop.sh: unknown method $m (repeat, navigate, follow)" >&2; exit 2 ;;
   esac
 done
 echo "closed_loop.sh: $(( $(date +%s) - START )) s; runs in $OUT"

@@ -57,8 +57,10 @@ class Server {
            cmd_sub_.getNumPublishers() > 0 && status_sub_.getNumPublishers() > 0;
   }
 
+  // Stamped with the simulated time in lockstep (it is the ROS clock there, via /clock), with
+  // the ROS clock itself in real time.
   void Publish(const sim::Simulation& sim, int robot, const cv::Mat& image) {
-    const ros::Time stamp = Stamp(sim.now_ns());
+    const ros::Time stamp = file_.use_sim_time ? Stamp(sim.now_ns()) : ros::Time::now();
     if (clock_pub_) {
       rosgraph_msgs::Clock clock;
       clock.clock = stamp;
