@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "cli_common.h"
 #include "interrupt.h"
@@ -39,6 +40,8 @@ void AddSimServeCommand(CLI::App* simcmd) {
     double image_noise = 2.0;
     double timeout_s = 600.0;
     std::string summary;
+    std::string encoding = "mono8";
+    std::string size;
   };
   auto a = std::make_shared<Args>();
   CLI::App* cmd = simcmd->add_subcommand(
@@ -67,6 +70,11 @@ void AddSimServeCommand(CLI::App* simcmd) {
   cmd->add_option("--timeout", a->timeout_s, "Simulated seconds, then the serve ends")
       ->capture_default_str()
       ->check(FiniteIn(1.0, 86400.0));
+  cmd->add_option("--encoding", a->encoding,
+                  "Camera messages: mono8, rgb8, bgr8 (Image), jpeg, png (CompressedImage on "
+                  "topics.compressed_image, or IMAGE/compressed)")
+      ->capture_default_str();
+  cmd->add_option("--size", a->size, "Publish the camera at WIDTHxHEIGHT (default: as simulated)");
   cmd->add_option("--summary", a->summary,
                   "Write the run's ground truth (pose at the method's last decision) as JSON here");
   cmd->callback([a] {
@@ -112,6 +120,16 @@ void AddSimServeCommand(CLI::App* simcmd) {
     options.timeout_s = a->timeout_s;
     options.interrupted = [] { return InterruptSignal() != 0; };
     options.log = [](const std::string& m) { spdlog::info("{}", m); };
+    options.encoding = a->encoding;
+    if (!a->size.empty()) {
+      int w = 0, h = 0;
+      char x = 0;
+      std::istringstream in(a->size);
+      if (!(in >> w >> x >> h) || x != 'x' || w < 16 || h < 16 || w > 4096 || h > 4096 ||
+          !in.eof())
+        throw InputError("--size " + a->size + ": expected WIDTHxHEIGHT, 16 to 4096 a side");
+      options.size = cv::Size(w, h);
+    }
     const ros1::ServeSummary s = ros1::ServeSimulation(sim, r, file, options);
     spdlog::info("sim serve: {} after {} frames, {} commands, {:.1f} s simulated{}", s.end,
                  s.frames, s.commands, s.sim_time_s, s.collided ? "; " + s.collision : "");

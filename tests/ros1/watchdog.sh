@@ -11,7 +11,7 @@ OUT=$(mktemp -d /tmp/mapless_watchdog.XXXXXX)
 PORT=$((20000 + ($$ + 7) % 20000))
 export ROS_MASTER_URI="http://127.0.0.1:$PORT" ROS_IP=127.0.0.1 ROS_HOSTNAME=127.0.0.1 ROS_HOME="$OUT/roshome"
 PIDS=()
-cleanup() { for p in "${PIDS[@]}"; do kill -9 "$p" 2>/dev/null; done; rm -rf "$OUT"; }
+cleanup() { for p in "${PIDS[@]}"; do kill -9 "$p" 2>/dev/null; wait "$p" 2>/dev/null; done; rm -rf "$OUT"; }
 trap cleanup EXIT INT TERM
 rosmaster --core -p "$PORT" >"$OUT/master.log" 2>&1 &
 PIDS+=($!)

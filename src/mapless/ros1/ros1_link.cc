@@ -103,6 +103,7 @@ class Ros1Link::Impl {
       if (have_frame_) {
         have_frame_ = false;
         got_frame_ = true;
+        last_frame_steady_ns_ = SteadyNs();
         robot::LinkEvent event{robot::LinkEventType::kFrame, {}, {}};
         event.observation.image = frame_;
         event.observation.t_ns = frame_t_ns_;
@@ -116,6 +117,16 @@ class Ros1Link::Impl {
         return event;
       }
       const Timestamp now = ToNs(ros::Time::now());
+      // Giving up is on the wall clock: under use_sim_time a simulator that no frame reaches us
+      // from may never advance the ROS clock.
+      const double without_s = ToSeconds(SteadyNs() - last_frame_steady_ns_);
+      if (robot_.give_up_without_frames_s > 0.0 && without_s > robot_.give_up_without_frames_s) {
+        std::string why = "no usable camera frame on " + camera_topic_ + " for " +
+                          std::to_string(static_cast<int>(without_s)) + " s: giving up";
+        if (image_sub_.getNumPublishers() == 0) why += " (no publisher)";
+        if (!bad_input_.empty()) why += " (" + bad_input_ + ")";
+        return {robot::LinkEventType::kClosed, {}, why};
+      }
       // A frame may arrive before the /clock message of its time, so the clock lags the last frame
       // by a period or so; only a jump back of more than a second (a restarted simulation, a
       // replay looping) resets the watchdog's reference.
@@ -276,6 +287,7 @@ class Ros1Link::Impl {
   std::string bad_input_;
   std::set<std::string> warned_;
   Timestamp last_event_ns_ = 0;
+  std::int64_t last_frame_steady_ns_ = SteadyNs();  // the last frame, or the start
   int frames_ = 0;
 };
 

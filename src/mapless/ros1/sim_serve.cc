@@ -4,6 +4,7 @@
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <std_msgs/String.h>
 
@@ -13,6 +14,8 @@
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <thread>
 
 #include "mapless/robot/sim_link.h"
@@ -33,7 +36,15 @@ class Server {
       : file_(file), options_(options), spinner_(1) {
     ros::NodeHandle nh;
     const ros::TransportHints hints = ros::TransportHints().tcpNoDelay();
-    image_pub_ = nh.advertise<sensor_msgs::Image>(file.Resolve(file.topics.image), 2);
+    compressed_ = options.encoding == "jpeg" || options.encoding == "png";
+    if (compressed_) {
+      const std::string topic = file.topics.compressed_image.empty()
+                                    ? file.Resolve(file.topics.image) + "/compressed"
+                                    : file.Resolve(file.topics.compressed_image);
+      image_pub_ = nh.advertise<sensor_msgs::CompressedImage>(topic, 2);
+    } else {
+      image_pub_ = nh.advertise<sensor_msgs::Image>(file.Resolve(file.topics.image), 2);
+    }
     if (!file.topics.odometry.empty())
       odom_pub_ = nh.advertise<nav_msgs::Odometry>(file.Resolve(file.topics.odometry), 10);
     if (file.use_sim_time) clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
@@ -78,15 +89,39 @@ class Server {
       odom.pose.pose.orientation.w = std::cos(o.theta_rad / 2.0);
       odom_pub_.publish(odom);
     }
+    cv::Mat frame = image;
+    if (options_.size.area() > 0 && options_.size != image.size())
+      cv::resize(image, frame, options_.size, 0, 0, cv::INTER_LINEAR);
+    const std::string& enc = options_.encoding;
+    if (compressed_) {
+      sensor_msgs::CompressedImage msg;
+      msg.header.stamp = stamp;
+      msg.header.frame_id = "camera";
+      msg.format = enc;
+      std::vector<uchar> bytes;
+      cv::imencode(enc == "png" ? ".png" : ".jpg", frame, bytes);
+      msg.data.assign(bytes.begin(), bytes.end());
+      image_pub_.publish(msg);
+      return;
+    }
+    cv::Mat packed;
+    if (enc == "rgb8") {
+      cv::cvtColor(frame, packed, cv::COLOR_GRAY2RGB);
+    } else if (enc == "bgr8") {
+      cv::cvtColor(frame, packed, cv::COLOR_GRAY2BGR);
+    } else if (enc == "mono8") {
+      packed = frame.isContinuous() ? frame : frame.clone();
+    } else {
+      packed = cv::Mat(frame.rows, frame.cols, CV_8UC2, cv::Scalar(128, 128));  // unknown
+    }
     sensor_msgs::Image msg;
     msg.header.stamp = stamp;
     msg.header.frame_id = "camera";
-    msg.width = static_cast<std::uint32_t>(image.cols);
-    msg.height = static_cast<std::uint32_t>(image.rows);
-    msg.encoding = "mono8";
-    msg.step = static_cast<std::uint32_t>(image.cols);
-    const cv::Mat packed = image.isContinuous() ? image : image.clone();
-    msg.data.assign(packed.data, packed.data + packed.total());
+    msg.width = static_cast<std::uint32_t>(packed.cols);
+    msg.height = static_cast<std::uint32_t>(packed.rows);
+    msg.encoding = enc;
+    msg.step = static_cast<std::uint32_t>(packed.cols * packed.channels());
+    msg.data.assign(packed.data, packed.data + packed.total() * packed.elemSize());
     image_pub_.publish(msg);
   }
 
@@ -138,6 +173,7 @@ class Server {
 
   robot::RobotFile file_;
   ServeOptions options_;
+  bool compressed_ = false;
   ros::AsyncSpinner spinner_;
   ros::Publisher image_pub_, odom_pub_, clock_pub_;
   ros::Subscriber cmd_sub_, status_sub_;

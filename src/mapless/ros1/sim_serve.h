@@ -21,6 +21,12 @@ struct ServeOptions {
   double period_s = 0.1;
   double timeout_s = 1e9;           // simulated time: the serve ends
   double command_timeout_s = 0.5;   // real time: no command this long stops the robot
+  // How the camera is published, to try a method against other cameras: "mono8", "rgb8", "bgr8"
+  // (sensor_msgs/Image on topics.image), "jpeg" or "png" (CompressedImage on
+  // topics.compressed_image); any other name is published as a raw Image with that encoding and
+  // two bytes a pixel (to test how a method meets an encoding it does not know).
+  std::string encoding = "mono8";
+  cv::Size size;                    // publish at this size (0x0: the simulated camera's)
   std::function<bool()> interrupted;
   std::function<void(const std::string&)> log;
 };

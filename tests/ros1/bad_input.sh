@@ -1,0 +1,88 @@
+#!/usr/bin/env bash
+# Bad input on the robot link (issue 17): each case must end with one clear line naming the field,
+# topic or encoding, the robot stopped (exit 1) or the input refused (exit 2), never a crash; and a
+# camera of another size or a compressed camera is converted, not refused. Exit 77 without ROS 1.
+#   tests/ros1/bad_input.sh MAPLESS
+set -uo pipefail
+BIN=$1
+command -v rosmaster >/dev/null 2>&1 || { echo "bad_input.sh: SKIPPED: no rosmaster (scripts/setup.sh --ros)"; exit 77; }
+OUT=$(mktemp -d /tmp/mapless_badinput.XXXXXX)
+PORT=$((20000 + ($$ + 13) % 20000))
+export ROS_MASTER_URI="http://127.0.0.1:$PORT" ROS_IP=127.0.0.1 ROS_HOSTNAME=127.0.0.1 ROS_HOME="$OUT/roshome"
+PIDS=()
+cleanup() { for p in "${PIDS[@]}"; do kill -9 "$p" 2>/dev/null; wait "$p" 2>/dev/null; done; rm -rf "$OUT"; }
+trap cleanup EXIT INT TERM
+rosmaster --core -p "$PORT" >"$OUT/master.log" 2>&1 &
+PIDS+=($!)
+for _ in $(seq 1 100); do (exec 3<>"/dev/tcp/127.0.0.1/$PORT") 2>/dev/null && break; sleep 0.1; done
+"$BIN" teach --source sim:table1_almost_straight --out "$OUT/route" >"$OUT/teach.log" 2>&1 ||
+  { echo "bad_input.sh: teach failed"; exit 1; }
+FAILS=0
+check() {  # name expected_exit actual_exit stderr_file needle
+  local name="$1" want="$2" got="$3" err="$4" needle="$5"
+  local lines
+  lines=$(grep -c '^mapless:' "$err")
+  if [ "$got" = "$want" ] && grep -q -- "$needle" "$err" && [ "$lines" -le 1 ] &&
+     ! grep -q -E 'Segmentation|terminate called|Aborted|AddressSanitizer' "$err"; then
+    echo "ok   $name (exit $got)"
+  else
+    echo "FAIL $name: exit $got (want $want), '$needle' $(grep -q -- "$needle" "$err" && echo found || echo missing), $lines error lines"
+    sed 's/^/     /' "$err" | tail -5
+    FAILS=$((FAILS + 1))
+  fi
+}
+serve() {  # robot.yaml extra-args...
+  local robot="$1"; shift
+  "$BIN" sim serve --scenario table1_almost_straight --robot "$robot" --like repeat "$@" \
+    >"$OUT/serve.log" 2>&1 &
+  SERVE=$!; PIDS+=("$SERVE")
+}
+stop_serve() { kill -INT "$SERVE" 2>/dev/null; sleep 0.3; kill -9 "$SERVE" 2>/dev/null; wait "$SERVE" 2>/dev/null; }
+
+# 1. A robot file with an unknown field: refused before anything connects.
+printf 'use_sim_time: true\ntopics: {imag: camera/image_raw}\n' >"$OUT/unknown.yaml"
+timeout 30 "$BIN" repeat --route "$OUT/route" --robot "$OUT/unknown.yaml" 2>"$OUT/e1" >/dev/null
+check "robot file with an unknown field" 2 $? "$OUT/e1" "topics.imag"
+
+# 2. A wrong encoding: one warning, the robot stopped, giving up after 2 s.
+printf 'use_sim_time: true\nsafety: {give_up_without_frames_s: 2}\n' >"$OUT/giveup.yaml"
+serve "$OUT/giveup.yaml" --encoding yuv422
+timeout 30 "$BIN" repeat --route "$OUT/route" --robot "$OUT/giveup.yaml" 2>"$OUT/e2" >/dev/null
+check "camera in an unsupported encoding" 1 $? "$OUT/e2" "encoding 'yuv422' is not supported"
+[ "$(grep -c "yuv422" "$OUT/e2")" -ge 1 ] && [ "$(grep -c "said once" "$OUT/e2")" = 1 ] ||
+  { echo "FAIL the encoding warning is not said exactly once"; FAILS=$((FAILS + 1)); }
+stop_serve
+
+# 3. A missing topic: nobody publishes the camera the robot file names.
+printf 'use_sim_time: false\ntopics: {image: front_camera/image_raw}\nsafety: {give_up_without_frames_s: 2, connect_timeout_s: 1}\n' >"$OUT/missing.yaml"
+timeout 30 "$BIN" repeat --route "$OUT/route" --robot "$OUT/missing.yaml" 2>"$OUT/e3" >/dev/null
+check "camera topic with no publisher" 1 $? "$OUT/e3" "/front_camera/image_raw.*no publisher"
+
+# 4. A camera of another size, JPEG-compressed: converted and resized, the repeat completes.
+printf 'use_sim_time: true\ntopics: {compressed_image: camera/image_raw/compressed}\n' >"$OUT/jpeg.yaml"
+serve "$OUT/jpeg.yaml" --encoding jpeg --size 640x480
+timeout 120 "$BIN" repeat --route "$OUT/route" --robot "$OUT/jpeg.yaml" 2>"$OUT/e4" >/dev/null
+RC=$?
+if [ "$RC" = 0 ] && grep -q "route completed" "$OUT/e4"; then
+  echo "ok   640x480 JPEG camera for a 320x240 route (completed)"
+else
+  echo "FAIL 640x480 JPEG camera: exit $RC"; tail -3 "$OUT/e4"; FAILS=$((FAILS + 1))
+fi
+stop_serve
+
+# 5. An RGB camera: converted to grey, the decisions are those of the mono8 camera.
+printf 'use_sim_time: true\n' >"$OUT/rgb.yaml"
+for enc in mono8 rgb8; do
+  serve "$OUT/rgb.yaml" --encoding "$enc" --seed 3
+  timeout 120 "$BIN" repeat --route "$OUT/route" --robot "$OUT/rgb.yaml" --log "$OUT/$enc.jsonl" \
+    2>"$OUT/e5_$enc" >/dev/null
+  stop_serve
+done
+if cmp -s "$OUT/mono8.jsonl" "$OUT/rgb8.jsonl" && [ -s "$OUT/mono8.jsonl" ]; then
+  echo "ok   rgb8 camera gives the same decisions as mono8 ($(wc -l <"$OUT/mono8.jsonl") frames)"
+else
+  echo "FAIL rgb8 and mono8 decisions differ"; FAILS=$((FAILS + 1))
+fi
+
+echo "bad_input.sh: $FAILS failures"
+[ "$FAILS" = 0 ]
