@@ -22,6 +22,9 @@
 #include "mapless/sim/driver.h"
 
 namespace mapless::app {
+
+void BenchRos1(nlohmann::json* j);  // bench_ros1.cc
+
 namespace {
 
 // Median over `repeats` calls of `fn(i)`, in milliseconds (after `warmup` untimed calls).
@@ -268,6 +271,7 @@ void AddBenchCommand(CLI::App* app) {
     bool json = false;
     int repeats = 100;
     std::string scenario;  // empty: the default mix of indoor, outdoor and aliasing scenes
+    bool ros1 = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* bench = app->add_subcommand(
@@ -280,6 +284,9 @@ void AddBenchCommand(CLI::App* app) {
   bench->add_option("--scenario", args->scenario,
                     "Render views of this scenario only (default: narrow_room_sharp_turn, "
                     "outdoor_70m and office_aliasing, 12 views along each taught path)");
+  bench->add_flag("--ros1", args->ros1,
+                  "Also the ROS 1 adapter's latency, frame received to command published "
+                  "(starts a ROS master on loopback)");
   bench->callback([args] {
     cv::setNumThreads(1);
     const std::vector<std::string> names =
@@ -358,6 +365,7 @@ void AddBenchCommand(CLI::App* app) {
     BenchTeachRepeat(&j);
     BenchPotential(args->repeats, &j);
     BenchEigenspace(args->repeats, &j);
+    if (args->ros1) BenchRos1(&j);
     if (args->json) {
       std::cout << j.dump() << "\n";
       return;
@@ -386,6 +394,20 @@ void AddBenchCommand(CLI::App* app) {
     for (const char* key : {"ipca_add_1000", "markov_update_10000", "subwindow_control"}) {
       std::printf("%-34s %10.2f  (issue 5: <= 1.5)\n", (std::string(key) + " / dis_fast").c_str(),
                   j[std::string(key) + "_over_dis_fast"].get<double>());
+    }
+    if (j.contains("ros1_link")) {
+      std::printf("%-34s %s\n", "ros1_link", j["ros1_link"].get<std::string>().c_str());
+    } else if (args->ros1) {
+      for (const char* cam : {"320x240_mono8", "640x480_rgb8"}) {
+        const std::string k = std::string("ros1_link_") + cam;
+        std::printf("%-34s %10.3f  p99 %.3f  (issue 17: p99 <= 5)\n",
+                    ("ros1 adapter " + std::string(cam)).c_str(),
+                    j[k + "_adapter_median_ms"].get<double>(),
+                    j[k + "_adapter_p99_ms"].get<double>());
+        std::printf("%-34s %10.3f  p99 %.3f\n", ("ros1 end to end " + std::string(cam)).c_str(),
+                    j[k + "_end_to_end_median_ms"].get<double>(),
+                    j[k + "_end_to_end_p99_ms"].get<double>());
+      }
     }
   });
 }

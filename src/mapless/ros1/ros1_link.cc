@@ -250,15 +250,18 @@ class Ros1Link::Impl {
     cv_.notify_all();
   }
 
-  // The odometry at a frame's time: the message nearest to it, after waiting briefly (wall time)
-  // for one stamped at or after it, so that a frame and the odometry published with it pair up
-  // whichever arrives first.
+  // The odometry at a frame's time: the message nearest to it. Under use_sim_time (a lockstep
+  // simulator publishes the odometry of each frame's time with it) it first waits briefly (wall
+  // time) for one stamped at or after the frame, so that the two pair up whichever arrives first;
+  // in real time it takes the nearest it has, adding no latency.
   std::optional<Pose2> OdometryAt(Timestamp t_ns) {
     if (robot_.topics.odometry.empty()) return std::nullopt;
     std::unique_lock<std::mutex> lock(mutex_);
-    cv_.wait_for(lock, std::chrono::milliseconds(50), [&] {
-      return !odometry_.empty() && odometry_.back().first >= t_ns;
-    });
+    if (robot_.use_sim_time) {
+      cv_.wait_for(lock, std::chrono::milliseconds(50), [&] {
+        return !odometry_.empty() && odometry_.back().first >= t_ns;
+      });
+    }
     if (odometry_.empty()) return std::nullopt;
     const std::pair<Timestamp, Pose2>* best = &odometry_.back();
     for (const auto& o : odometry_)
