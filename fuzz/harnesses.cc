@@ -11,6 +11,9 @@
 #include "mapless/io/frame_source.h"
 #include "mapless/io/tum.h"
 #include "mapless/navigation/potential.h"
+#include "mapless/robot/camera_image.h"
+#include "mapless/robot/robot_file.h"
+#include "mapless/route/appearance_store.h"
 #include "mapless/route/route_store.h"
 #include "mapless/sim/driver.h"
 #include "mapless/sim/renderer.h"
@@ -146,6 +149,44 @@ void ScenarioWorld(const std::string& input) {
   });
 }
 
+void RobotFile(const std::string& input) {
+  AcceptInputError([&] { robot::ParseRobotFile(input, "fuzz_robot.yaml"); });
+}
+
+void AppearanceManifest(const std::string& input) {
+  AcceptInputError([&] {
+    std::vector<std::string> files;
+    route::ParseAppearanceManifest(input, "fuzz/appearance.json", &files);
+  });
+}
+
+void CameraMessage(const std::string& input) {
+  if (input.empty()) return;
+  const std::size_t nul = input.find('\0', 1);
+  if (nul == std::string::npos || nul > 64) return;
+  const std::string label = input.substr(1, nul - 1);
+  std::string_view rest(input);
+  rest.remove_prefix(nul + 1);
+  AcceptInputError([&] {
+    cv::Mat grey;
+    if (input[0] == 1) {
+      grey = robot::GreyFromCompressed(label, rest);
+    } else {
+      if (rest.size() < 13) return;
+      auto u32 = [&](std::size_t at) {
+        std::uint32_t v = 0;
+        for (int b = 3; b >= 0; --b) v = (v << 8) | static_cast<unsigned char>(rest[at + b]);
+        return v;
+      };
+      const std::uint32_t w = u32(0), h = u32(4), step = u32(8);
+      const bool big = rest[12] != 0;
+      rest.remove_prefix(13);
+      grey = robot::GreyFromRaw(label, w, h, step, big, rest);
+    }
+    robot::PrepareFrame(grey, robot::CameraMount::kRotated180, cv::Size(320, 240));
+  });
+}
+
 const std::vector<NamedHarness>& Harnesses() {
   static const std::vector<NamedHarness> harnesses = {{"route_manifest", RouteManifest},
                                                       {"route_keyframe", RouteKeyframe},
@@ -156,7 +197,10 @@ const std::vector<NamedHarness>& Harnesses() {
                                                       {"tum", Tum},
                                                       {"image_folder", ImageFolder},
                                                       {"video_file", VideoFile},
-                                                      {"scenario_world", ScenarioWorld}};
+                                                      {"scenario_world", ScenarioWorld},
+                                                      {"robot_file", RobotFile},
+                                                      {"appearance_manifest", AppearanceManifest},
+                                                      {"camera_message", CameraMessage}};
   return harnesses;
 }
 

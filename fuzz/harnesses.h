@@ -35,6 +35,17 @@ void VideoFile(const std::string& input);
 // robot for 30 frames, the scenario's area, and the top-down picture.
 void ScenarioWorld(const std::string& input);
 
+// The robot file (robot/robot_file.h).
+void RobotFile(const std::string& input);
+// The appearance route's manifest (route/appearance_store.h).
+void AppearanceManifest(const std::string& input);
+// A camera message from the network, as the robot links decode it (robot/camera_image.h): the
+// first byte chooses a raw Image (0) or a CompressedImage (1); a raw one carries its encoding up to
+// a NUL, then width, height and step as 4-byte little-endian numbers, a big-endian flag and the
+// data; a compressed one its format up to a NUL, then the data. The frame is then prepared for a
+// 320x240 method, upright and turned.
+void CameraMessage(const std::string& input);
+
 const std::vector<NamedHarness>& Harnesses();
 
 }  // namespace mapless::fuzz

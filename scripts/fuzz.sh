@@ -6,7 +6,8 @@
 #     -r RUNS     executions per target (default 1000000)
 #     -t SECONDS  time limit per target (default 600)
 #     TARGET      route_manifest route_keyframe scenario config calibration flo tum image_folder
-#                 video_file scenario_world (default: all)
+#                 video_file scenario_world robot_file appearance_manifest camera_message
+#                 (default: all)
 #
 # Each target starts from fuzz/corpus/<target>/ (kept inputs) and grows a working corpus in
 # build/fuzz/corpus/<target>/. A crash, sanitizer report, leak or hang stops that target; its input is
