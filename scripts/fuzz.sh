@@ -31,7 +31,7 @@ shift $((OPTIND - 1))
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
   targets=(route_manifest route_keyframe scenario config calibration flo tum image_folder video_file
-           scenario_world)
+           scenario_world robot_file appearance_manifest camera_message)
 fi
 
 bash scripts/setup.sh
