@@ -29,22 +29,14 @@
 #include "mapless/core/rng.h"
 #include "mapless/flow/flow.h"
 #include "mapless/ground/dominant_plane.h"
+#include "mapless/io/planar_flow_calibration.h"
 
 namespace mapless::navigation {
 
-// The pure translational and rotational planar flows of Section 4.3, calibrated by driving at a
-// constant velocity (as the paper does) and stored as the two fitted ground homographies: the flow
-// at any pixel is model(x) - x (ground::PlanarFlow). Both are for one frame period.
-struct PlanarFlowCalibration {
-  int width = 0;
-  int height = 0;
-  double period_s = 0.0;     // frame period of the calibration drive
-  double speed_mps = 0.0;    // translation during the translational drive
-  double omega_radps = 0.0;  // rotation (counter-clockwise) during the rotational drive
-  cv::Mat translational;     // 3x3 CV_64F homography, forward motion
-  cv::Mat rotational;        // 3x3 CV_64F homography, counter-clockwise rotation
-  void Validate() const;     // throws InputError naming the field
-};
+// The planar-flow calibration (Section 4.3) and its file: io/planar_flow_calibration.h.
+using PlanarFlowCalibration = io::PlanarFlowCalibration;
+using io::CalibrationFromYaml;
+using io::CalibrationToYaml;
 
 // The mean ground homography over consecutive pairs of `frames` (taken while driving at constant
 // velocity): each pair's flow is fitted by RANSAC and the models (normalised to h33 = 1) averaged.
@@ -52,9 +44,6 @@ struct PlanarFlowCalibration {
 cv::Mat CalibratePlanarModel(const std::vector<cv::Mat>& frames, const flow::FlowOptions& flow,
                              const ground::DominantPlaneOptions& plane);
 
-// The calibration as a small YAML document (versioned), and back. Parse errors name `source`.
-std::string CalibrationToYaml(const PlanarFlowCalibration& calibration);
-PlanarFlowCalibration CalibrationFromYaml(const std::string& text, const std::string& source);
 
 ground::DominantPlaneOptions DefaultPlaneOptions();
 inline flow::FlowOptions MediumFlow() {
