@@ -89,11 +89,17 @@ class KeyframeTeacher : public Teacher {
 
 class AppearanceTeacher : public Teacher {
  public:
-  explicit AppearanceTeacher(std::string dir) : dir_(std::move(dir)) {}
+  // `no_odometry_source`: the source never has odometry (a recording): refuse at once.
+  AppearanceTeacher(std::string dir, bool no_odometry_source)
+      : dir_(std::move(dir)), no_odometry_source_(no_odometry_source) {}
   void Frame(const cv::Mat& image, Timestamp, const std::optional<Pose2>& odometry) override {
-    if (!odometry)
+    if (!odometry) {
+      // A robot's first frames may come before its first odometry message: skip them, but not
+      // for ever.
+      if (++without_odometry_ < 30 && !no_odometry_source_) return;
       throw InputError("teach --method eigenspace needs wheel odometry (route images are spaced "
                        "by distance): teach on sim:SCENARIO or on a robot with an odometry topic");
+    }
     if (!writer_) {
       writer_ = std::make_unique<route::AppearanceRouteWriter>(
           dir_, image.cols, image.rows, options_.image.width, options_.image.height);
@@ -114,6 +120,8 @@ class AppearanceTeacher : public Teacher {
   navigation::AppearanceLeaderOptions options_;
   navigation::AppearanceLeader leader_{options_};
   std::unique_ptr<route::AppearanceRouteWriter> writer_;
+  bool no_odometry_source_ = false;
+  int without_odometry_ = 0;
 };
 
 }  // namespace
@@ -158,7 +166,7 @@ void Teach(const TeachArgs& t) {
   StopCleanlyOnInterrupt();
   std::unique_ptr<Teacher> teacher;
   if (eigenspace) {
-    teacher = std::make_unique<AppearanceTeacher>(out.path());
+    teacher = std::make_unique<AppearanceTeacher>(out.path(), source != nullptr);
   } else {
     teacher = std::make_unique<KeyframeTeacher>(out.path(), t.detector);
   }

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# Safety on the ROS 1 link (issue 17): while `mapless repeat --robot` drives a simulated robot
+# (`mapless sim serve`, real time), each of these must give a zero Twist within 0.3 s:
+#   - the camera publisher killed (SIGKILL): the watchdog;
+#   - Ctrl-C (SIGINT) to the method: the zero goes out before it leaves;
+#   - true on the e-stop topic: zero until false, then the robot is driven again.
+# A probe (safety_probe) waits until the robot is driven, acts, and times the first command after.
+# Exit 77 (skipped) without ROS 1.
+#   tests/ros1/safety.sh MAPLESS SAFETY_PROBE [RUNS]
+set -uo pipefail
+BIN=$1; PROBE=$2; RUNS=${3:-3}
+command -v rosmaster >/dev/null 2>&1 || { echo "safety.sh: SKIPPED: no rosmaster (scripts/setup.sh --ros)"; exit 77; }
+OUT=$(mktemp -d /tmp/mapless_safety.XXXXXX)
+PORT=$((20000 + ($$ + 7) % 20000))
+export ROS_MASTER_URI="http://127.0.0.1:$PORT" ROS_IP=127.0.0.1 ROS_HOSTNAME=127.0.0.1 ROS_HOME="$OUT/roshome"
+PIDS=()
+cleanup() { for p in "${PIDS[@]}"; do kill -9 "$p" 2>/dev/null; wait "$p" 2>/dev/null; done; rm -rf "$OUT"; }
+trap cleanup EXIT INT TERM
+rosmaster --core -p "$PORT" >"$OUT/master.log" 2>&1 &
+PIDS+=($!)
+for _ in $(seq 1 100); do (exec 3<>"/dev/tcp/127.0.0.1/$PORT") 2>/dev/null && break; sleep 0.1; done
+printf 'name: real-time simulated robot\nuse_sim_time: false\n' >"$OUT/robot.yaml"
+"$BIN" teach --source sim:table1_almost_straight --out "$OUT/route" >"$OUT/teach.log" 2>&1 ||
+  { echo "safety.sh: teach failed"; exit 1; }
+FAILS=0
+TOTAL=0
+for mode in kill int estop; do
+  for k in $(seq 1 "$RUNS"); do
+    "$BIN" sim serve --scenario table1_almost_straight --robot "$OUT/robot.yaml" --like repeat \
+      --seed "$k" >"$OUT/serve.log" 2>&1 &
+    SERVE=$!; PIDS+=("$SERVE")
+    timeout 60 "$BIN" repeat --route "$OUT/route" --robot "$OUT/robot.yaml" >"$OUT/repeat.log" 2>&1 &
+    REPEAT=$!; PIDS+=("$REPEAT")
+    TARGET=$SERVE
+    [ "$mode" = int ] && TARGET=$REPEAT
+    RESULT=$(timeout 70 "$PROBE" "$mode" "$TARGET" 0.3 10)
+    RC=$?
+    TOTAL=$((TOTAL + 1))
+    echo "safety $mode run $k: $RESULT"
+    [ "$RC" = 0 ] || FAILS=$((FAILS + 1))
+    kill -INT "$REPEAT" 2>/dev/null; wait "$REPEAT" 2>/dev/null
+    REPEAT_RC=$?
+    if [ "$mode" = int ] && [ "$REPEAT_RC" != 130 ]; then
+      echo "safety int run $k: repeat exited $REPEAT_RC after SIGINT (want 130)"; FAILS=$((FAILS + 1))
+    fi
+    kill -INT "$SERVE" 2>/dev/null; sleep 0.2; kill -9 "$SERVE" 2>/dev/null; wait "$SERVE" 2>/dev/null
+  done
+done
+echo "safety.sh: $((TOTAL - FAILS))/$TOTAL runs published a zero Twist within 0.3 s"
+[ "$FAILS" = 0 ]

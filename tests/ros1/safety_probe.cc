@@ -1,0 +1,127 @@
+// The safety tests' probe (issue 17): subscribes cmd_vel, waits until the robot is being driven
+// (N non-zero commands), then does one thing and measures the time until the method publishes a
+// zero Twist:
+//   kill PID    SIGKILL to the camera publisher (the watchdog)
+//   int PID     SIGINT to the method (Ctrl-C)
+//   estop       true on /mapless/estop; then false, and the robot must be driven again within 2 s
+// Prints one JSON line; exit 0 when the zero came within the limit, 1 when it came late, was not
+// zero, or never came (or, for estop, driving did not resume).
+//   safety_probe kill|int|estop PID LIMIT_S [NONZERO_COMMANDS]
+#include <geometry_msgs/Twist.h>
+#include <ros/ros.h>
+#include <std_msgs/Bool.h>
+#include <signal.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <mutex>
+#include <string>
+#include <thread>
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+std::mutex g_mutex;
+int g_nonzero = 0;
+bool g_killed = false;
+Clock::time_point g_kill_time;
+bool g_after = false;
+bool g_after_zero = false;
+double g_after_s = 0.0;
+bool g_released = false;
+int g_nonzero_after_release = 0;
+int g_nonzero_during_stop = 0;  // must stay 0 while the e-stop is on
+
+void OnTwist(const geometry_msgs::TwistConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  const bool zero = msg->linear.x == 0.0 && msg->angular.z == 0.0;
+  if (!g_killed) {
+    if (!zero) ++g_nonzero;
+    return;
+  }
+  if (g_released && !zero) ++g_nonzero_after_release;
+  if (!g_released && !zero) ++g_nonzero_during_stop;
+  if (g_after) return;
+  g_after = true;
+  g_after_zero = zero;
+  g_after_s = std::chrono::duration<double>(Clock::now() - g_kill_time).count();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 4) {
+    std::fprintf(stderr, "usage: safety_probe kill|int|estop PID LIMIT_S [NONZERO_COMMANDS]\n");
+    return 2;
+  }
+  const std::string mode = argv[1];
+  const int pid = std::atoi(argv[2]);
+  const double limit = std::atof(argv[3]);
+  const int wanted = argc > 4 ? std::atoi(argv[4]) : 10;
+  ros::init(argc, argv, "safety_probe", ros::init_options::NoSigintHandler);
+  ros::NodeHandle nh;
+  ros::Subscriber sub = nh.subscribe("/cmd_vel", 100, OnTwist, ros::TransportHints().tcpNoDelay());
+  ros::Publisher estop = nh.advertise<std_msgs::Bool>("/mapless/estop", 1, true);
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+  const auto deadline = Clock::now() + std::chrono::seconds(60);
+  while (true) {
+    {
+      std::lock_guard<std::mutex> lock(g_mutex);
+      if (g_nonzero >= wanted) {
+        g_killed = true;
+        g_kill_time = Clock::now();
+        if (mode == "kill") {
+          kill(pid, SIGKILL);
+        } else if (mode == "int") {
+          kill(pid, SIGINT);
+        } else {
+          std_msgs::Bool on;
+          on.data = true;
+          estop.publish(on);
+        }
+        break;
+      }
+    }
+    if (Clock::now() > deadline) {
+      std::printf("{\"error\": \"the robot was never driven (%d non-zero commands)\"}\n", g_nonzero);
+      return 1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  const auto wait_until = Clock::now() + std::chrono::seconds(3);
+  while (Clock::now() < wait_until) {
+    {
+      std::lock_guard<std::mutex> lock(g_mutex);
+      if (g_after) break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  bool resumed = true;
+  if (mode == "estop") {
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    {
+      std::lock_guard<std::mutex> lock(g_mutex);
+      g_released = true;
+      // Stopped all the while: every command since the e-stop was zero.
+      if (g_nonzero_during_stop > 0) resumed = false;
+    }
+    std_msgs::Bool off;
+    off.data = false;
+    estop.publish(off);
+    std::this_thread::sleep_for(std::chrono::seconds(2));
+    std::lock_guard<std::mutex> lock(g_mutex);
+    resumed = resumed && g_nonzero_after_release > 0;
+  }
+  std::lock_guard<std::mutex> lock(g_mutex);
+  if (!g_after) {
+    std::printf("{\"mode\": \"%s\", \"error\": \"no command within 3 s\"}\n", mode.c_str());
+    return 1;
+  }
+  std::printf("{\"mode\": \"%s\", \"zero\": %s, \"after_s\": %.4f, \"limit_s\": %.3f%s}\n",
+              mode.c_str(), g_after_zero ? "true" : "false", g_after_s, limit,
+              mode == "estop" ? (resumed ? ", \"resumed\": true" : ", \"resumed\": false") : "");
+  return g_after_zero && g_after_s <= limit && resumed ? 0 : 1;
+}

@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# Teaching on a robot (issue 17): `mapless teach --robot` records while the robot is driven by
+# someone else — here `mapless repeat --robot` of a route taught on the simulator stands in for the
+# person with the joystick — and Ctrl-C ends the teach with a complete route that loads. Both route
+# kinds at once: keyframes (funnel lanes) and appearance route images (eigenspace). Exit 77
+# (skipped) without ROS 1.
+#   tests/ros1/teach.sh MAPLESS [SECONDS]
+set -uo pipefail
+BIN=$1; SECONDS_TO_TEACH=${2:-15}
+command -v rosmaster >/dev/null 2>&1 || { echo "teach.sh: SKIPPED: no rosmaster (scripts/setup.sh --ros)"; exit 77; }
+OUT=$(mktemp -d /tmp/mapless_teach.XXXXXX)
+PORT=$((20000 + ($$ + 23) % 20000))
+export ROS_MASTER_URI="http://127.0.0.1:$PORT" ROS_IP=127.0.0.1 ROS_HOSTNAME=127.0.0.1 ROS_HOME="$OUT/roshome"
+PIDS=()
+cleanup() { for p in "${PIDS[@]}"; do kill -9 "$p" 2>/dev/null; wait "$p" 2>/dev/null; done; rm -rf "$OUT"; }
+trap cleanup EXIT INT TERM
+rosmaster --core -p "$PORT" >"$OUT/master.log" 2>&1 &
+PIDS+=($!)
+for _ in $(seq 1 100); do (exec 3<>"/dev/tcp/127.0.0.1/$PORT") 2>/dev/null && break; sleep 0.1; done
+printf 'name: real-time simulated robot\nuse_sim_time: false\n' >"$OUT/robot.yaml"
+"$BIN" teach --source sim:table1_almost_straight --out "$OUT/driver_route" >"$OUT/t0.log" 2>&1 ||
+  { echo "teach.sh: teach on the simulator failed"; exit 1; }
+# The teach nodes are distinct ROS nodes: each gets its own node name through its own robot file.
+printf 'use_sim_time: false\nnode_name: teach_funnel\n' >"$OUT/teach_funnel.yaml"
+printf 'use_sim_time: false\nnode_name: teach_eigenspace\n' >"$OUT/teach_eigenspace.yaml"
+"$BIN" sim serve --scenario table1_almost_straight --robot "$OUT/robot.yaml" --like teach \
+  >"$OUT/serve.log" 2>&1 &
+PIDS+=($!)
+"$BIN" teach --robot "$OUT/teach_funnel.yaml" --out "$OUT/funnel" >"$OUT/t1.log" 2>&1 &
+T1=$!; PIDS+=("$T1")
+"$BIN" teach --robot "$OUT/teach_eigenspace.yaml" --method eigenspace --out "$OUT/eigenspace" \
+  >"$OUT/t2.log" 2>&1 &
+T2=$!; PIDS+=("$T2")
+sleep 1
+timeout 120 "$BIN" repeat --route "$OUT/driver_route" --robot "$OUT/robot.yaml" >"$OUT/driver.log" 2>&1 &
+DRIVER=$!; PIDS+=("$DRIVER")
+sleep "$SECONDS_TO_TEACH"
+kill -INT "$T1" "$T2"
+wait "$T1"; R1=$?
+wait "$T2"; R2=$?
+kill -INT "$DRIVER" 2>/dev/null
+FAILS=0
+if [ "$R1" = 130 ] && "$BIN" route info "$OUT/funnel" --json >"$OUT/info.json" 2>"$OUT/info.err" &&
+   grep -q '"complete": *true' "$OUT/info.json"; then
+  echo "ok   teach --robot (funnel): exit 130, complete route: $(grep -o '"keyframes": *[0-9]*' "$OUT/info.json")"
+else
+  echo "FAIL teach --robot (funnel): exit $R1"; tail -3 "$OUT/t1.log" "$OUT/info.err" 2>/dev/null; FAILS=$((FAILS + 1))
+fi
+if [ "$R2" = 130 ] && grep -q '"complete": true' "$OUT/eigenspace/appearance.json" &&
+   [ "$(ls "$OUT/eigenspace/images" | wc -l)" -ge 5 ]; then
+  echo "ok   teach --robot --method eigenspace: exit 130, complete route of $(ls "$OUT/eigenspace/images" | wc -l) images"
+else
+  echo "FAIL teach --robot --method eigenspace: exit $R2"; tail -3 "$OUT/t2.log"; FAILS=$((FAILS + 1))
+fi
+
+[ "$FAILS" = 0 ]
