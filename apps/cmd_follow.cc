@@ -87,11 +87,10 @@ void AddFollowCommand(CLI::App* app) {
       throw InputError("--source " + a->source + ": follow runs on sim:SCENARIO or --robot");
     const sim::Scenario scenario = sim::LoadScenario(a->source.substr(4));
     if (scenario.camera.model.width != size.width || scenario.camera.model.height != size.height)
-      throw InputError(a->source + ": the camera is " +
-                       std::to_string(scenario.camera.model.width) + "x" +
-                       std::to_string(scenario.camera.model.height) + ", the route " + a->route +
-                       " was taught at " + std::to_string(size.width) + "x" +
-                       std::to_string(size.height));
+      throw InputError(
+          a->source + ": the camera is " + std::to_string(scenario.camera.model.width) + "x" +
+          std::to_string(scenario.camera.model.height) + ", the route " + a->route +
+          " was taught at " + std::to_string(size.width) + "x" + std::to_string(size.height));
     eval::EigenspaceRunOptions options;
     options.seed = a->seed;
     options.motion_noise = a->motion_noise;

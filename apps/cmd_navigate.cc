@@ -6,12 +6,12 @@
 
 #include "cli_common.h"
 #include "interrupt.h"
-#include "mapless/robot/methods.h"
-#include "robot_run.h"
 #include "mapless/core/check.h"
 #include "mapless/eval/potential.h"
 #include "mapless/io/atomic_file.h"
 #include "mapless/io/limits.h"
+#include "mapless/robot/methods.h"
+#include "robot_run.h"
 
 namespace mapless::app {
 namespace {
@@ -23,17 +23,17 @@ constexpr double kNavigationMarginM = 5.0;
 
 namespace {
 struct NavigateArgs {
-    std::string scenario;
-    std::string destination;
-    int destination_index = -1;
-    bool homing = false;
-    std::string start;
-    std::string calibration;
-    std::string save_calibration;
-    std::string log;
-    std::uint64_t seed = 1;
-    double motion_noise = 0.1;
-    double image_noise = 2.0;
+  std::string scenario;
+  std::string destination;
+  int destination_index = -1;
+  bool homing = false;
+  std::string start;
+  std::string calibration;
+  std::string save_calibration;
+  std::string log;
+  std::uint64_t seed = 1;
+  double motion_noise = 0.1;
+  double image_noise = 2.0;
   std::string robot;
 };
 
@@ -41,8 +41,9 @@ struct NavigateArgs {
 void NavigateOnRobot(const NavigateArgs& a, bool by_index) {
   RefuseOutputOverInputs(a.log, "--log", {a.robot, a.calibration});
   if (a.calibration.empty())
-    throw InputError("navigate --robot needs --calibration FILE (the planar-flow calibration: "
-                     "`mapless navigate --scenario S --save-calibration FILE` on the simulator)");
+    throw InputError(
+        "navigate --robot needs --calibration FILE (the planar-flow calibration: "
+        "`mapless navigate --scenario S --save-calibration FILE` on the simulator)");
   const navigation::PlanarFlowCalibration calibration = navigation::CalibrationFromYaml(
       io::ReadFile(a.calibration, io::kMaxYamlFileBytes), a.calibration);
   std::optional<Eigen::Vector2d> destination;

@@ -52,11 +52,12 @@ void AddSimServeCommand(CLI::App* simcmd) {
       ->required();
   cmd->add_option("--robot", a->robot, "Robot file (YAML): topics, namespace, use_sim_time")
       ->required();
-  cmd->add_option("--like", a->like,
-                  "Set the robot up like a run of: teach (the teach start, no noise), repeat "
-                  "(the repeat start with a seeded offset and noise, as `mapless repeat`), "
-                  "navigate (the teach start and noise, as `mapless navigate`), follow (as `mapless "
-                  "follow`)")
+  cmd->add_option(
+         "--like", a->like,
+         "Set the robot up like a run of: teach (the teach start, no noise), repeat "
+         "(the repeat start with a seeded offset and noise, as `mapless repeat`), "
+         "navigate (the teach start and noise, as `mapless navigate`), follow (as `mapless "
+         "follow`)")
       ->capture_default_str();
   cmd->add_option("--seed", a->seed, "Seed (as in `mapless repeat --seed`)")
       ->capture_default_str()
@@ -79,6 +80,15 @@ void AddSimServeCommand(CLI::App* simcmd) {
                   "Write the run's ground truth (pose at the method's last decision) as JSON here");
   cmd->callback([a] {
     RefuseOutputOverInputs(a->summary, "--summary", {a->robot, a->scenario});
+    cv::Size size;
+    if (!a->size.empty()) {
+      int w = 0, h = 0;
+      char x = 0;
+      std::istringstream in(a->size);
+      if (!(in >> w >> x >> h) || x != 'x' || w < 16 || h < 16 || w > 4096 || h > 4096 || !in.eof())
+        throw InputError("--size " + a->size + ": expected WIDTHxHEIGHT, 16 to 4096 a side");
+      size = cv::Size(w, h);
+    }
     const robot::RobotFile file = robot::LoadRobotFile(a->robot);
     const sim::Scenario scenario = sim::LoadScenario(a->scenario);
     eval::SimSetup setup;
@@ -121,15 +131,7 @@ void AddSimServeCommand(CLI::App* simcmd) {
     options.interrupted = [] { return InterruptSignal() != 0; };
     options.log = [](const std::string& m) { spdlog::info("{}", m); };
     options.encoding = a->encoding;
-    if (!a->size.empty()) {
-      int w = 0, h = 0;
-      char x = 0;
-      std::istringstream in(a->size);
-      if (!(in >> w >> x >> h) || x != 'x' || w < 16 || h < 16 || w > 4096 || h > 4096 ||
-          !in.eof())
-        throw InputError("--size " + a->size + ": expected WIDTHxHEIGHT, 16 to 4096 a side");
-      options.size = cv::Size(w, h);
-    }
+    options.size = size;
     const ros1::ServeSummary s = ros1::ServeSimulation(sim, r, file, options);
     spdlog::info("sim serve: {} after {} frames, {} commands, {:.1f} s simulated{}", s.end,
                  s.frames, s.commands, s.sim_time_s, s.collided ? "; " + s.collision : "");
@@ -155,8 +157,9 @@ void AddSimServeCommand(CLI::App* simcmd) {
     ThrowIfInterrupted();
 #else
     (void)file;
-    throw InputError("sim serve needs a middleware: this mapless was built without ROS 1 "
-                     "(scripts/setup.sh --ros, then build again)");
+    throw InputError(
+        "sim serve needs a middleware: this mapless was built without ROS 1 "
+        "(scripts/setup.sh --ros, then build again)");
 #endif
   });
 }

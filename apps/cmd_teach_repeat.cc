@@ -11,18 +11,17 @@
 
 #include "cli_common.h"
 #include "interrupt.h"
-#include "teach.h"
-#include "robot_run.h"
-#include "mapless/robot/methods.h"
 #include "mapless/core/check.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/io/frame_source.h"
 #include "mapless/io/output_dir.h"
+#include "mapless/robot/methods.h"
 #include "mapless/route/route_store.h"
+#include "robot_run.h"
+#include "teach.h"
 
 namespace mapless::app {
 namespace {
-
 
 nlohmann::json StepJson(int frame, Timestamp t_ns, const navigation::RepeatStep& s) {
   nlohmann::json j;
@@ -53,15 +52,17 @@ void AddTeachRepeatCommands(CLI::App* app) {
       "Teach a route: keyframes from a video, an image folder, a camera or sim:SCENARIO. Ctrl-C "
       "stops it cleanly (exit 130): a camera teach ends there with a complete route, any other "
       "keeps its finished keyframes marked incomplete");
-  CLI::Option* teach_source =
-      teach->add_option("--source", t->source, "sim:SCENARIO, a video file, an image folder, camera:N");
-  teach->add_option("--robot", t->robot,
-                    "Teach on a robot (its robot file): a person drives it (teleop on cmd_vel), "
-                    "mapless records from the camera topic until Ctrl-C")
+  CLI::Option* teach_source = teach->add_option(
+      "--source", t->source, "sim:SCENARIO, a video file, an image folder, camera:N");
+  teach
+      ->add_option("--robot", t->robot,
+                   "Teach on a robot (its robot file): a person drives it (teleop on cmd_vel), "
+                   "mapless records from the camera topic until Ctrl-C")
       ->excludes(teach_source);
-  teach->add_option("--method", t->method,
-                    "funnel (keyframes, for `repeat`) or eigenspace (appearance route images, "
-                    "for `follow`)")
+  teach
+      ->add_option("--method", t->method,
+                   "funnel (keyframes, for `repeat`) or eigenspace (appearance route images, "
+                   "for `follow`)")
       ->capture_default_str();
   teach->add_option("--out", t->out, "Route directory to create")->required();
   teach->add_flag("--overwrite", t->overwrite,
@@ -94,12 +95,14 @@ void AddTeachRepeatCommands(CLI::App* app) {
   repeat->add_option("--route", r->route, "Route directory (from mapless teach)")->required();
   CLI::Option* source_opt = repeat->add_option(
       "--source", r->source, "sim:SCENARIO, a video file, an image folder, camera:N");
-  repeat->add_option("--robot", r->robot,
-                     "Drive a robot: its robot file (YAML: middleware, topics, limits)")
+  repeat
+      ->add_option("--robot", r->robot,
+                   "Drive a robot: its robot file (YAML: middleware, topics, limits)")
       ->excludes(source_opt);
-  repeat->add_option("--speed", r->speed,
-                     "Robot: forward speed of the funnel lanes, m/s (the simulator uses the "
-                     "scenario's teach speed, at most 0.2)")
+  repeat
+      ->add_option("--speed", r->speed,
+                   "Robot: forward speed of the funnel lanes, m/s (the simulator uses the "
+                   "scenario's teach speed, at most 0.2)")
       ->capture_default_str()
       ->check(FiniteIn(0.01, 5.0));
   repeat->add_option("--controller", r->controller, "sloped or standard")->capture_default_str();

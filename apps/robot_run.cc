@@ -20,9 +20,10 @@ std::unique_ptr<robot::RobotLink> OpenRobotLink(const robot::RobotFile& robot, c
   if (robot.middleware == robot::Middleware::kRos1) {
 #ifdef MAPLESS_HAVE_ROS1
     ros1::StartNode(robot, robot.node_name);
-    return std::make_unique<ros1::Ros1Link>(robot, image_size, method, [](const std::string& m) {
-      spdlog::warn("{}", m);
-    });
+    auto link = std::make_unique<ros1::Ros1Link>(
+        robot, image_size, method, [](const std::string& m) { spdlog::warn("{}", m); });
+    link->Start();
+    return link;
 #else
     throw InputError(robot.source +
                      ": middleware ros1, but this mapless was built without ROS 1 (install it "

@@ -41,7 +41,8 @@ bool IsLive(const std::string& source) {
 class Teacher {
  public:
   virtual ~Teacher() = default;
-  virtual void Frame(const cv::Mat& image, Timestamp t_ns, const std::optional<Pose2>& odometry) = 0;
+  virtual void Frame(const cv::Mat& image, Timestamp t_ns,
+                     const std::optional<Pose2>& odometry) = 0;
   virtual void Finish() = 0;  // marks the route complete
   virtual int stored() const = 0;
   virtual int minimum() const = 0;  // a route needs at least this many
@@ -50,8 +51,8 @@ class Teacher {
 
 class KeyframeTeacher : public Teacher {
  public:
-  KeyframeTeacher(std::string dir, const std::string& detector) : dir_(std::move(dir)),
-                                                                  detector_(detector) {
+  KeyframeTeacher(std::string dir, const std::string& detector)
+      : dir_(std::move(dir)), detector_(detector) {
     options_.features.type = features::ParseDetectorType(detector);
     options_.Validate();
     session_ = std::make_unique<navigation::TeachSession>(options_);
@@ -97,8 +98,9 @@ class AppearanceTeacher : public Teacher {
       // A robot's first frames may come before its first odometry message: skip them, but not
       // for ever.
       if (++without_odometry_ < 30 && !no_odometry_source_) return;
-      throw InputError("teach --method eigenspace needs wheel odometry (route images are spaced "
-                       "by distance): teach on sim:SCENARIO or on a robot with an odometry topic");
+      throw InputError(
+          "teach --method eigenspace needs wheel odometry (route images are spaced "
+          "by distance): teach on sim:SCENARIO or on a robot with an odometry topic");
     }
     if (!writer_) {
       writer_ = std::make_unique<route::AppearanceRouteWriter>(
@@ -143,8 +145,9 @@ void Teach(const TeachArgs& t) {
   const std::filesystem::path out_path(t.out);
   if (!t.overwrite && (std::filesystem::exists(out_path / "manifest.json") ||
                        std::filesystem::exists(out_path / "appearance.json"))) {
-    throw InputError(t.out + ": already holds a route; choose another directory, or "
-                             "--overwrite to replace it");
+    throw InputError(t.out +
+                     ": already holds a route; choose another directory, or "
+                     "--overwrite to replace it");
   }
   if (t.overwrite && !io::IsEmptyOrMissing(t.out) && !std::filesystem::exists(out_path / marker)) {
     // Checked before the source is opened; io::OutputDirectory checks it again.
@@ -180,10 +183,9 @@ void Teach(const TeachArgs& t) {
   bool interrupted = false;
   try {
     if (scenario) {
-      const sim::DriveSummary summary =
-          sim::DriveTaughtPath(*scenario, sim::DriveOptions{}, [&](const sim::DriveFrame& f) {
-            frame_in(f.image, f.t_ns, f.odometry);
-          });
+      const sim::DriveSummary summary = sim::DriveTaughtPath(
+          *scenario, sim::DriveOptions{},
+          [&](const sim::DriveFrame& f) { frame_in(f.image, f.t_ns, f.odometry); });
       if (!summary.completed) {
         throw RunFailed("teach: the drive of '" + scenario->name +
                         "' did not complete: " + summary.status);

@@ -27,7 +27,7 @@ expect_exit() {
 }
 
 # Every subcommand answers --help with exit 0 and a usage text.
-for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench" "shift" "teach" "repeat" "route" "route info" "eval" "soak" "flow" "ground" "navigate" "localize"; do
+for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench" "shift" "teach" "repeat" "route" "route info" "eval" "soak" "flow" "ground" "navigate" "localize" "follow" "sim serve"; do
   # shellcheck disable=SC2086
   expect_exit "help: mapless $sub --help" 0 "$MAPLESS" $sub --help
   grep -qi "usage" "$TMP/out"; check "help text: mapless $sub" $?

@@ -274,6 +274,30 @@ probe "route whose descriptors are not its detector's" 2 "000000.yml: descriptor
 probe "route with no keyframes" 2 "the route has 0 keyframes" -- "$MAPLESS" route info "$FX/route_empty"
 probe "route whose time goes backwards" 2 "000002.yml: t_ns 1 is not after" -- "$MAPLESS" route info "$FX/route_backwards"
 
+# Robot files and appearance routes (issue 17); none of these reaches a middleware.
+printf 'topics: {imag: camera/image_raw}\n' >"$FX/robot_unknown.yaml"
+printf 'middleware: ros3\n' >"$FX/robot_ros3.yaml"
+printf '{}\n' >"$FX/robot_ok.yaml"
+printf 'limits: {max_speed_mps: .nan}\n' >"$FX/robot_nan.yaml"
+"$MAPLESS" teach --source sim:table1_almost_straight --method eigenspace --out "$FX/aroute" >/dev/null 2>&1
+cp -r "$FX/aroute" "$FX/aroute_bad_manifest" && printf '{"format": "mapless-appearance-route", "version": 1, "images": 3}' >"$FX/aroute_bad_manifest/appearance.json"
+cp -r "$FX/aroute" "$FX/aroute_cut_image" && head -c 60 "$FX/aroute/images/000001.png" >"$FX/aroute_cut_image/images/000001.png"
+cp -r "$FX/aroute" "$FX/aroute_wrong_size" && "$MAPLESS" sim render --scenario table1_almost_straight --pose 0,0,0 --out "$FX/aroute_wrong_size/images/000002.png" >/dev/null 2>&1
+probe "robot file with an unknown field" 2 "robot_unknown.yaml:1:16: topics.imag: unknown field" -- "$MAPLESS" repeat --route "$FX/route" --robot "$FX/robot_unknown.yaml"
+probe "robot file with an unknown middleware" 2 "middleware: 'ros3' is not one of ros1, ros2" -- "$MAPLESS" follow --route "$FX/aroute" --robot "$FX/robot_ros3.yaml"
+probe "robot file with a nan speed limit" 2 "limits.max_speed_mps: expected a number" -- "$MAPLESS" teach --robot "$FX/robot_nan.yaml" --out "$NEW/rt1"
+probe "robot file that is /dev/zero" 2 "zero.yaml: not a regular file" -- "$MAPLESS" repeat --route "$FX/route" --robot "$FX/zero.yaml"
+probe "repeat with neither --source nor --robot" 2 "give --source" -- "$MAPLESS" repeat --route "$FX/route"
+probe "teach with an unknown --method" 2 "--method keyframes: must be funnel or eigenspace" -- "$MAPLESS" teach --source "$FX/frames" --out "$NEW/t3" --method keyframes
+probe "eigenspace teach from a recording without odometry" 2 "needs wheel odometry" -- "$MAPLESS" teach --source "$FX/frames" --out "$NEW/t4" --method eigenspace
+probe "follow a directory with no appearance route" 2 "no appearance route here" -- "$MAPLESS" follow --route "$FX/route" --source sim:table1_almost_straight
+probe "follow a route whose manifest is wrong" 2 "appearance.json: image_width: missing" -- "$MAPLESS" follow --route "$FX/aroute_bad_manifest" --source sim:table1_almost_straight
+probe "follow a route with a cut image" 2 "000001.png" -- "$MAPLESS" follow --route "$FX/aroute_cut_image" --source sim:table1_almost_straight
+probe "follow a route with an image of the wrong size" 2 "000002.png: 320x240, the route's images are 64x64" -- "$MAPLESS" follow --route "$FX/aroute_wrong_size" --source sim:table1_almost_straight
+probe "navigate --robot without a calibration" 2 "needs --calibration" -- "$MAPLESS" navigate --robot "$FX/robot_ros3.yaml" --destination 1,1
+probe "sim serve --like an unknown run" 2 "--like dance" -- "$MAPLESS" sim serve --scenario table1_almost_straight --robot "$FX/robot_ok.yaml" --like dance
+probe "sim serve --size too small" 2 "--size 8x8" -- "$MAPLESS" sim serve --scenario table1_almost_straight --robot "$FX/robot_ok.yaml" --size 8x8
+
 # ---------------------------------------------------------------------------------------------
 echo "# two writers, and Ctrl-C"
 "$MAPLESS" teach --source sim:outdoor_70m --out "$NEW/locked" >"$TMP/first.out" 2>"$TMP/first.err" &

@@ -9,8 +9,8 @@
 //   safety_probe kill|int|estop PID LIMIT_S [NONZERO_COMMANDS]
 #include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
-#include <std_msgs/Bool.h>
 #include <signal.h>
+#include <std_msgs/Bool.h>
 
 #include <atomic>
 #include <chrono>
@@ -86,7 +86,8 @@ int main(int argc, char** argv) {
       }
     }
     if (Clock::now() > deadline) {
-      std::printf("{\"error\": \"the robot was never driven (%d non-zero commands)\"}\n", g_nonzero);
+      std::printf("{\"error\": \"the robot was never driven (%d non-zero commands)\"}\n",
+                  g_nonzero);
       return 1;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(1));

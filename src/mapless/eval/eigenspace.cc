@@ -76,7 +76,8 @@ Pose2 StartPose(const sim::Scenario& scenario, const EigenspaceRunOptions& optio
   return scenario.teach_start * options.start_offset;
 }
 
-sim::RobotOptions FollowerRobot(const sim::Scenario& scenario, const EigenspaceRunOptions& options) {
+sim::RobotOptions FollowerRobot(const sim::Scenario& scenario,
+                                const EigenspaceRunOptions& options) {
   sim::RobotOptions robot = scenario.robot;
   robot.motion_noise_v_frac = options.motion_noise;
   robot.motion_noise_omega_frac = options.motion_noise;
@@ -144,7 +145,8 @@ double FollowTimeoutS(const sim::Scenario& scenario, const EigenspaceRunOptions&
   return options.timeout_factor * nominal;
 }
 
-EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario, const EigenspaceRunOptions& options,
+EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario,
+                                  const EigenspaceRunOptions& options,
                                   const EigenspaceObserver& observer) {
   MAPLESS_CHECK(options.leader.incremental || !options.concurrent,
                 "eigenspace run: following while the leader teaches needs incremental PCA");
@@ -227,8 +229,8 @@ EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario, const Eigenspac
       follow = sim.AddRobot(StartPose(scenario, options), FollowerRobot(scenario, options));
     }
     if (follow >= 0) {
-      arrived = FollowerFrame(&sim, follow, &follower, &faulty_camera, *channel.Latest(), image_truth, options,
-                              observer, &metrics, &run);
+      arrived = FollowerFrame(&sim, follow, &follower, &faulty_camera, *channel.Latest(),
+                              image_truth, options, observer, &metrics, &run);
       if (arrived) break;
     }
     sim.Advance(period);
@@ -245,8 +247,8 @@ EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario, const Eigenspac
 std::vector<EigenspaceEntry> EigenspaceSuiteEntries() {
   std::vector<EigenspaceEntry> entries;
   for (const char* scenario : {"office_aliasing", "outdoor_70m"}) {
-    for (const char* experiment :
-         {"on-route", "off-route-left", "off-route-right", "batch-pca", "no-markov", "concurrent"}) {
+    for (const char* experiment : {"on-route", "off-route-left", "off-route-right", "batch-pca",
+                                   "no-markov", "concurrent"}) {
       entries.push_back({scenario, experiment});
     }
   }
@@ -277,7 +279,8 @@ EigenspaceRunOptions EigenspaceEntryOptions(const EigenspaceEntry& entry, std::u
   return options;
 }
 
-EigenspaceEntryResult RunEigenspaceEntry(const EigenspaceEntry& entry, int runs, std::uint64_t seed) {
+EigenspaceEntryResult RunEigenspaceEntry(const EigenspaceEntry& entry, int runs,
+                                         std::uint64_t seed) {
   MAPLESS_CHECK(runs >= 1, "eigenspace suite: runs = " << runs << "; must be >= 1");
   const sim::Scenario scenario = sim::LoadScenario(entry.scenario);
   EigenspaceEntryResult result;
@@ -289,13 +292,13 @@ EigenspaceEntryResult RunEigenspaceEntry(const EigenspaceEntry& entry, int runs,
   double lateral_sq = 0.0;
   std::vector<double> finals;
   for (int r = 0; r < runs; ++r) {
-    const EigenspaceRun run =
-        RunEigenspaceFollow(scenario, EigenspaceEntryOptions(entry, seed + static_cast<std::uint64_t>(r)));
+    const EigenspaceRun run = RunEigenspaceFollow(
+        scenario, EigenspaceEntryOptions(entry, seed + static_cast<std::uint64_t>(r)));
     result.successes += run.success;
     result.collisions += run.collided;
     if (!run.success) {
-      result.failures.push_back("seed " + std::to_string(seed + static_cast<std::uint64_t>(r)) + ": " +
-                                run.status);
+      result.failures.push_back("seed " + std::to_string(seed + static_cast<std::uint64_t>(r)) +
+                                ": " + run.status);
     }
     finals.push_back(run.final_error_m);
     final_sq += run.final_error_m * run.final_error_m;

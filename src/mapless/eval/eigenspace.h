@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "mapless/eval/suite.h"
+#include "mapless/eval/teach_repeat.h"
 #include "mapless/navigation/appearance.h"
 #include "mapless/sim/camera_faults.h"
-#include "mapless/eval/teach_repeat.h"
 #include "mapless/sim/scenario.h"
 
 namespace mapless::eval {
@@ -22,16 +22,17 @@ struct EigenspaceRunOptions {
   // Follower start relative to the taught start, in the start's frame: x forward (negative =
   // behind), y to the left, theta counter-clockwise.
   Pose2 start_offset;
-  bool concurrent = false;             // follow while the leader is still teaching
-  int follower_starts_after_images = 5;  // concurrent: the leader's images before the follower starts
-  double motion_noise = 0.0;           // follower motion noise fraction (both v and omega)
+  bool concurrent = false;  // follow while the leader is still teaching
+  int follower_starts_after_images =
+      5;                      // concurrent: the leader's images before the follower starts
+  double motion_noise = 0.0;  // follower motion noise fraction (both v and omega)
   // Metrics count after convergence: once the follower has driven convergence_m and come within
   // converged_lateral_m of the leader's path (a follower that starts off the route localizes
   // poorly until it is on it: Fig. 9 of the paper).
   double convergence_m = 3.0;
   double converged_lateral_m = 0.15;
-  double arrive_tolerance_m = 0.6;     // success: arrived within this distance of the route end
-  double timeout_factor = 3.0;         // give up after this many times the nominal duration
+  double arrive_tolerance_m = 0.6;  // success: arrived within this distance of the route end
+  double timeout_factor = 3.0;      // give up after this many times the nominal duration
   std::vector<sim::CameraFaultWindow> camera_faults;  // the follower's camera (sim/camera_faults.h)
   navigation::AppearanceLeaderOptions leader;
   navigation::AppearanceFollowerOptions follower;
@@ -48,22 +49,23 @@ struct EigenspaceRun {
   bool collided = false;
   std::string status;
   int route_images = 0;
-  double final_error_m = 0.0;        // follower's end to the taught end
-  double lateral_rms_m = 0.0;        // after convergence, to the leader's path
+  double final_error_m = 0.0;            // follower's end to the taught end
+  double lateral_rms_m = 0.0;            // after convergence, to the leader's path
   double localization_within_one = 0.0;  // fraction of frames after convergence (±1 image)
-  double nearest_within_one = 0.0;   // the same for the nearest projection alone
+  double nearest_within_one = 0.0;       // the same for the nearest projection alone
   int frames_after_convergence = 0;
   double convergence_distance_m = -1.0;  // driven before convergence (-1: never)
-  int stops = 0;                     // frames in which the follower stood still and said why
-  std::vector<Pose2> leader_path;    // ground truth
-  std::vector<Pose2> follower_path;  // ground truth
+  int stops = 0;                         // frames in which the follower stood still and said why
+  std::vector<Pose2> leader_path;        // ground truth
+  std::vector<Pose2> follower_path;      // ground truth
 };
 
 // Called for every follower frame (for logs and debugging).
 using EigenspaceObserver =
     std::function<void(const navigation::FollowerStep& step, const Pose2& truth)>;
 
-EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario, const EigenspaceRunOptions& options,
+EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario,
+                                  const EigenspaceRunOptions& options,
                                   const EigenspaceObserver& observer = {});
 
 // One line of `mapless eval eigenspace`.
@@ -83,6 +85,7 @@ struct EigenspaceEntryResult : EntryResult {
   int stops = 0;                         // total stop frames over runs
 };
 
-EigenspaceEntryResult RunEigenspaceEntry(const EigenspaceEntry& entry, int runs, std::uint64_t seed);
+EigenspaceEntryResult RunEigenspaceEntry(const EigenspaceEntry& entry, int runs,
+                                         std::uint64_t seed);
 
 }  // namespace mapless::eval

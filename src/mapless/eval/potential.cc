@@ -260,8 +260,8 @@ PotentialEntryResult RunPotentialEntry(const PotentialEntry& entry, int runs, st
     // its centre line.
     base.start_lateral_m = entry.scenario == "corridor_straight_3p5m" ? 0.4 : 0.0;
     const PotentialRun ref = RunPotential(scenario, calibration, base);
-    MAPLESS_CHECK(ref.success, "the clean corridor run of " << entry.scenario
-                                                            << " failed: " << ref.status);
+    MAPLESS_CHECK(ref.success,
+                  "the clean corridor run of " << entry.scenario << " failed: " << ref.status);
     clean = ref.path;
     // The paper's perturbations (Section 5.2): 20% of the dominant-plane map's pixels inverted
     // (on top of sensor noise), or 20% errors on T and R.
@@ -298,8 +298,8 @@ PotentialEntryResult RunPotentialEntry(const PotentialEntry& entry, int runs, st
       ++r.successes;
     } else {
       r.failures.push_back("run " + std::to_string(i) + " (seed " + std::to_string(o.seed) +
-                           "): " + run.status + ", " + std::to_string(run.final_error_m).substr(0, 4) +
-                           " m from the goal");
+                           "): " + run.status + ", " +
+                           std::to_string(run.final_error_m).substr(0, 4) + " m from the goal");
     }
     if (run.collided) ++r.collisions;
   }

@@ -34,9 +34,9 @@ struct PotentialRunOptions {
   // odometry starts there). Without one, corridor centring: the run ends when the robot passes
   // the end of the scenario's taught path.
   std::optional<Eigen::Vector2d> destination;
-  bool homing = false;              // return to the start after the destination
-  double timeout_factor = 3.0;      // of the path length at T_m (destination and back for homing)
-  double success_radius_m = 0.3;    // final distance to the goal (the issue: 0.3 m)
+  bool homing = false;            // return to the start after the destination
+  double timeout_factor = 3.0;    // of the path length at T_m (destination and back for homing)
+  double success_radius_m = 0.3;  // final distance to the goal (the issue: 0.3 m)
   std::vector<sim::CameraFaultWindow> camera_faults;  // hardening tests (sim/camera_faults.h)
   std::uint64_t seed = 1;
   void Validate() const;
@@ -48,7 +48,7 @@ struct PotentialRun {
   bool collided = false;
   double final_error_m = 0.0;  // to the goal (the start when homing); 0 in corridor mode
   double duration_s = 0.0;
-  int no_plane_frames = 0;     // frames on which the dominant plane was lost
+  int no_plane_frames = 0;  // frames on which the dominant plane was lost
   std::string status;
   std::vector<Pose2> path;  // ground truth, one per frame
 };
@@ -62,7 +62,8 @@ using PotentialObserver =
 
 PotentialRun RunPotential(const sim::Scenario& scenario,
                           const navigation::PlanarFlowCalibration& calibration,
-                          const PotentialRunOptions& options, const PotentialObserver& observer = {});
+                          const PotentialRunOptions& options,
+                          const PotentialObserver& observer = {});
 
 // Signed distance from a point to a polyline (positive to the left of its direction).
 double SignedDistanceToPath(const std::vector<Pose2>& path, double x_m, double y_m);

@@ -80,11 +80,10 @@ SimSetup RepeatSimSetup(const sim::Scenario& scenario, const RepeatRunOptions& o
   setup.robot = scenario.robot;
   setup.robot.motion_noise_v_frac = options.motion_noise_frac;
   setup.robot.motion_noise_omega_frac = options.motion_noise_frac;
-  setup.start =
-      scenario.repeat_start *
-      Pose2{rng.Uniform(-options.start_offset_m, options.start_offset_m),
-            rng.Uniform(-options.start_offset_m, options.start_offset_m),
-            DegToRad(rng.Uniform(-options.start_offset_deg, options.start_offset_deg))};
+  setup.start = scenario.repeat_start *
+                Pose2{rng.Uniform(-options.start_offset_m, options.start_offset_m),
+                      rng.Uniform(-options.start_offset_m, options.start_offset_m),
+                      DegToRad(rng.Uniform(-options.start_offset_deg, options.start_offset_deg))};
   setup.world = sim::ApplyVariant(scenario.world, scenario.repeat_variant);
   setup.seed = rng.NextU64();
   return setup;
@@ -104,15 +103,15 @@ RepeatRun RepeatOnSimulator(const sim::Scenario& scenario, const TaughtRoute& ta
   link_options.fault_seed = options.seed;
   robot::SimLink link(sim, r, link_options);
   RepeatRun run;
-  const robot::LoopResult result = robot::RunLoop(
-      method, link, robot::LoopOptions{},
-      [&](const robot::Observation& obs, const robot::Decision& decision) {
-        const auto& step = std::get<navigation::RepeatStep>(decision.detail);
-        run.path.push_back(link.truth());
-        if (observer) observer(link.truth(), obs.image, step);
-        run.steps.push_back(step);
-        return true;
-      });
+  const robot::LoopResult result =
+      robot::RunLoop(method, link, robot::LoopOptions{},
+                     [&](const robot::Observation& obs, const robot::Decision& decision) {
+                       const auto& step = std::get<navigation::RepeatStep>(decision.detail);
+                       run.path.push_back(link.truth());
+                       if (observer) observer(link.truth(), obs.image, step);
+                       run.steps.push_back(step);
+                       return true;
+                     });
   run.completed = result.finished;
   run.collided = sim.collided(r);
   run.status = result.reason;

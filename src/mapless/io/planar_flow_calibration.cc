@@ -17,12 +17,11 @@ void CheckModel(const cv::Mat& m, const char* field) {
 
 void PlanarFlowCalibration::Validate() const {
   MAPLESS_CHECK(width > 0 && height > 0, "PlanarFlowCalibration: width and height must be > 0");
-  MAPLESS_CHECK(period_s > 0.0, "PlanarFlowCalibration.period_s = " << period_s
-                                                                    << "; must be > 0");
-  MAPLESS_CHECK(speed_mps > 0.0, "PlanarFlowCalibration.speed_mps = " << speed_mps
-                                                                      << "; must be > 0");
-  MAPLESS_CHECK(omega_radps > 0.0, "PlanarFlowCalibration.omega_radps = " << omega_radps
-                                                                          << "; must be > 0");
+  MAPLESS_CHECK(period_s > 0.0, "PlanarFlowCalibration.period_s = " << period_s << "; must be > 0");
+  MAPLESS_CHECK(speed_mps > 0.0,
+                "PlanarFlowCalibration.speed_mps = " << speed_mps << "; must be > 0");
+  MAPLESS_CHECK(omega_radps > 0.0,
+                "PlanarFlowCalibration.omega_radps = " << omega_radps << "; must be > 0");
   CheckModel(translational, "translational");
   CheckModel(rotational, "rotational");
 }
@@ -49,8 +48,8 @@ std::string CalibrationToYaml(const PlanarFlowCalibration& c) {
 static PlanarFlowCalibration CalibrationFromYamlUnchecked(const std::string& text,
                                                           const std::string& source) {
   const YamlMap y = YamlMap::LoadString(text, source);
-  y.CheckKnownKeys({"format", "version", "width", "height", "period_s", "speed_mps",
-                    "omega_radps", "translational", "rotational"});
+  y.CheckKnownKeys({"format", "version", "width", "height", "period_s", "speed_mps", "omega_radps",
+                    "translational", "rotational"});
   if (y.GetString("format") != "mapless-planar-flow-calibration")
     y.Fail("format", "expected 'mapless-planar-flow-calibration'");
   if (y.GetInt("version") != 1) y.Fail("version", "unsupported version (this build reads 1)");

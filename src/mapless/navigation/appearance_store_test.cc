@@ -1,6 +1,8 @@
 // The appearance route store (route/appearance_store.h) with the leader that writes it: a route
 // read back and replayed through AppearanceLeader::AddStored gives exactly the leader's model, and
 // a teach cut short leaves a route that loads with every whole image.
+#include "mapless/route/appearance_store.h"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -8,10 +10,9 @@
 
 #include "mapless/core/check.h"
 #include "mapless/navigation/appearance.h"
-#include "mapless/route/appearance_store.h"
 #include "mapless/sim/driver.h"
-#include "mapless/sim/simulation.h"
 #include "mapless/sim/scenario.h"
+#include "mapless/sim/simulation.h"
 
 namespace mapless::navigation {
 namespace {
@@ -43,7 +44,8 @@ TEST(AppearanceStore, ARouteReadBackRebuildsTheLeadersModelExactly) {
   EXPECT_TRUE(stored.complete);
   ASSERT_EQ(static_cast<int>(stored.images.size()), original->size());
   AppearanceLeader replay;
-  for (const auto& image : stored.images) replay.AddStored(image.low, image.distance_m, image.odometry);
+  for (const auto& image : stored.images)
+    replay.AddStored(image.low, image.distance_m, image.odometry);
   replay.Finish();
   const auto rebuilt = replay.Snapshot();
   ASSERT_EQ(rebuilt->size(), original->size());

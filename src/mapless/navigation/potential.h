@@ -18,18 +18,18 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <optional>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "mapless/control/visual_potential.h"
-#include "mapless/navigation/camera_check.h"
 #include "mapless/core/pose.h"
 #include "mapless/core/rng.h"
 #include "mapless/flow/flow.h"
 #include "mapless/ground/dominant_plane.h"
 #include "mapless/io/planar_flow_calibration.h"
+#include "mapless/navigation/camera_check.h"
 
 namespace mapless::navigation {
 
@@ -43,7 +43,6 @@ using io::CalibrationToYaml;
 // Throws InputError when fewer than two frames are given or no pair shows a plane.
 cv::Mat CalibratePlanarModel(const std::vector<cv::Mat>& frames, const flow::FlowOptions& flow,
                              const ground::DominantPlaneOptions& plane);
-
 
 ground::DominantPlaneOptions DefaultPlaneOptions();
 inline flow::FlowOptions MediumFlow() {
@@ -92,27 +91,27 @@ struct PotentialNavOptions {
   // camera): the potential only needs the map at potential_width_px columns. PotentialStep's
   // plane_mask is at this scale.
   double plane_scale = 0.5;
-  int potential_width_px = 80;    // the potential field's grid (its mean is what drives)
-  double arrive_radius_m = 0.1;   // the destination is reached (by odometry) within this
+  int potential_width_px = 80;   // the potential field's grid (its mean is what drives)
+  double arrive_radius_m = 0.1;  // the destination is reached (by odometry) within this
   // Closer than this to the destination the speed falls in proportion to the distance (down to
   // the creep speed), so the turning circle shrinks and the robot cannot orbit the goal.
   double approach_radius_m = 0.6;
-  double creep_fraction = 0.25;   // of T_m: the one-frame step taken to see the ground move
-  double min_motion_m = 0.004;    // less translation between frames: the plane is unobservable
-  double search_step_rad = 0.6;   // no plane: turn in place by this much, then look again
+  double creep_fraction = 0.25;       // of T_m: the one-frame step taken to see the ground move
+  double min_motion_m = 0.004;        // less translation between frames: the plane is unobservable
+  double search_step_rad = 0.6;       // no plane: turn in place by this much, then look again
   double search_rate_fraction = 0.8;  // of R_m, while searching and turning round
-  int misses_before_search = 3;   // frames in a row without a plane before turning to search
-                                  // (before that the robot only stops and looks again)
-  int max_search_steps = 12;      // searched this often in a row without finding ground: give up
+  int misses_before_search = 3;       // frames in a row without a plane before turning to search
+                                      // (before that the robot only stops and looks again)
+  int max_search_steps = 12;  // searched this often in a row without finding ground: give up
   // Not in the paper: a first-order low-pass on the control force, f <- a f_new + (1 - a) f
   // (a = 1: none). A single frame's mask noise then cannot jerk the robot.
   double force_filter = 0.2;
-  bool allow_reverse = false;     // Eq. 17 gives T < 0 for a force pointing backwards; clamp to 0
+  bool allow_reverse = false;  // Eq. 17 gives T < 0 for a force pointing backwards; clamp to 0
   // Robustness experiments of Section 5.2 only: invert this fraction of the dominant-plane map's
   // pixels each frame ("an error of 20% to the detected dominant plane"), drawn from noise_seed.
   double plane_noise_fraction = 0.0;
   std::uint64_t noise_seed = 1;
-  bool homing = false;            // after the destination, turn round and return to the start
+  bool homing = false;  // after the destination, turn round and return to the start
   // Without a destination, attract along the measured planar flow (Eq. 11-12) instead of the
   // calibrated forward flow. Off by default: the measured flow contains the robot's own rotation,
   // and -u_hat of a left turn points left, so the turn feeds itself (on the simulator the robot
@@ -137,13 +136,13 @@ struct PotentialStep {
   PotentialStatus status = PotentialStatus::kDriving;
   std::string reason;
   bool plane_found = false;
-  double plane_fraction = 0.0;  // of the region of interest
-  double free_ahead = 1.0;      // plane fraction of the window just ahead (see min_free_ahead)
+  double plane_fraction = 0.0;   // of the region of interest
+  double free_ahead = 1.0;       // plane fraction of the window just ahead (see min_free_ahead)
   double ground_mismatch = 0.0;  // the plane's flow against the predicted ground flow
-  double theta_d_rad = 0.0;     // destination direction relative to the heading (0 without one)
-  double theta_rad = 0.0;       // direction of the control force (Eq. 16), positive to the left
-  cv::Vec2d force{0.0, 0.0};    // Eq. 15
-  int leg = 0;                  // 0: to the destination, 1: homing
+  double theta_d_rad = 0.0;      // destination direction relative to the heading (0 without one)
+  double theta_rad = 0.0;        // direction of the control force (Eq. 16), positive to the left
+  cv::Vec2d force{0.0, 0.0};     // Eq. 15
+  int leg = 0;                   // 0: to the destination, 1: homing
   Twist2 command;
   cv::Mat plane_mask;  // d(x, y, t) of this frame at plane_scale (empty when no flow was computed)
 };
@@ -173,7 +172,7 @@ class PotentialNavigator {
 
   PlanarFlowCalibration calibration_;
   PotentialNavOptions options_;
-  cv::Size work_size_;           // the potential's grid
+  cv::Size work_size_;          // the potential's grid
   cv::Mat translational_flow_;  // unit-mean-magnitude fields on that grid
   cv::Mat rotational_flow_;
   double flow_scale_ = 1.0;  // mean |u_t| of the calibration, pixels per frame

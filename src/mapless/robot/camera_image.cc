@@ -18,13 +18,20 @@ struct Layout {
 };
 
 bool LayoutOf(const std::string& e, Layout* out) {
-  if (e == "mono8" || e == "8UC1") *out = {1, 1, -1};
-  else if (e == "mono16" || e == "16UC1") *out = {1, 2, -1};
-  else if (e == "rgb8") *out = {3, 1, cv::COLOR_RGB2GRAY};
-  else if (e == "bgr8" || e == "8UC3") *out = {3, 1, cv::COLOR_BGR2GRAY};
-  else if (e == "rgba8") *out = {4, 1, cv::COLOR_RGBA2GRAY};
-  else if (e == "bgra8" || e == "8UC4") *out = {4, 1, cv::COLOR_BGRA2GRAY};
-  else return false;
+  if (e == "mono8" || e == "8UC1")
+    *out = {1, 1, -1};
+  else if (e == "mono16" || e == "16UC1")
+    *out = {1, 2, -1};
+  else if (e == "rgb8")
+    *out = {3, 1, cv::COLOR_RGB2GRAY};
+  else if (e == "bgr8" || e == "8UC3")
+    *out = {3, 1, cv::COLOR_BGR2GRAY};
+  else if (e == "rgba8")
+    *out = {4, 1, cv::COLOR_RGBA2GRAY};
+  else if (e == "bgra8" || e == "8UC4")
+    *out = {4, 1, cv::COLOR_BGRA2GRAY};
+  else
+    return false;
   return true;
 }
 
@@ -77,11 +84,10 @@ cv::Mat GreyFromRaw(const std::string& encoding, std::uint32_t width, std::uint3
 }
 
 cv::Mat GreyFromCompressed(const std::string& format, std::string_view data) {
-  MAPLESS_CHECK(format.find("jpeg") != std::string::npos ||
-                    format.find("jpg") != std::string::npos ||
-                    format.find("png") != std::string::npos || format.empty(),
-                "compressed image format '" << format.substr(0, 48)
-                                            << "' is not supported (jpeg, png)");
+  MAPLESS_CHECK(
+      format.find("jpeg") != std::string::npos || format.find("jpg") != std::string::npos ||
+          format.find("png") != std::string::npos || format.empty(),
+      "compressed image format '" << format.substr(0, 48) << "' is not supported (jpeg, png)");
   MAPLESS_CHECK(data.size() <= io::kMaxImageFileBytes,
                 "compressed image of " << data.size() << " bytes is over the limit");
   return io::DecodeImage(data, "compressed image", cv::IMREAD_GRAYSCALE, 16);
@@ -90,10 +96,18 @@ cv::Mat GreyFromCompressed(const std::string& format, std::string_view data) {
 cv::Mat PrepareFrame(const cv::Mat& grey, CameraMount mount, cv::Size size) {
   cv::Mat upright;
   switch (mount) {
-    case CameraMount::kUpright: upright = grey; break;
-    case CameraMount::kRotated180: cv::flip(grey, upright, -1); break;
-    case CameraMount::kMirrored: cv::flip(grey, upright, 1); break;
-    case CameraMount::kFlippedVertically: cv::flip(grey, upright, 0); break;
+    case CameraMount::kUpright:
+      upright = grey;
+      break;
+    case CameraMount::kRotated180:
+      cv::flip(grey, upright, -1);
+      break;
+    case CameraMount::kMirrored:
+      cv::flip(grey, upright, 1);
+      break;
+    case CameraMount::kFlippedVertically:
+      cv::flip(grey, upright, 0);
+      break;
   }
   if (size.area() == 0 || upright.size() == size) return upright;
   cv::Mat out;

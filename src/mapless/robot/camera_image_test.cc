@@ -22,19 +22,24 @@ TEST(CameraImage, ConvertsEveryEncodingToTheSameGrey) {
   cv::Mat rgb, bgra;
   cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
   cv::cvtColor(bgr, bgra, cv::COLOR_BGR2BGRA);
-  EXPECT_EQ(cv::norm(GreyFromRaw("bgr8", 24, 20, 72, false, Bytes(bgr)), expected, cv::NORM_INF), 0);
-  EXPECT_EQ(cv::norm(GreyFromRaw("rgb8", 24, 20, 72, false, Bytes(rgb)), expected, cv::NORM_INF), 0);
-  EXPECT_LE(cv::norm(GreyFromRaw("bgra8", 24, 20, 96, false, Bytes(bgra)), expected, cv::NORM_INF), 1);
-  EXPECT_EQ(cv::norm(GreyFromRaw("mono8", 24, 20, 24, false, Bytes(expected)), expected,
-                     cv::NORM_INF), 0);
+  EXPECT_EQ(cv::norm(GreyFromRaw("bgr8", 24, 20, 72, false, Bytes(bgr)), expected, cv::NORM_INF),
+            0);
+  EXPECT_EQ(cv::norm(GreyFromRaw("rgb8", 24, 20, 72, false, Bytes(rgb)), expected, cv::NORM_INF),
+            0);
+  EXPECT_LE(cv::norm(GreyFromRaw("bgra8", 24, 20, 96, false, Bytes(bgra)), expected, cv::NORM_INF),
+            1);
+  EXPECT_EQ(
+      cv::norm(GreyFromRaw("mono8", 24, 20, 24, false, Bytes(expected)), expected, cv::NORM_INF),
+      0);
   cv::Mat wide;
   expected.convertTo(wide, CV_16U, 256.0);
-  EXPECT_EQ(cv::norm(GreyFromRaw("mono16", 24, 20, 48, false, Bytes(wide)), expected, cv::NORM_INF), 0);
+  EXPECT_EQ(cv::norm(GreyFromRaw("mono16", 24, 20, 48, false, Bytes(wide)), expected, cv::NORM_INF),
+            0);
   // A padded step.
   cv::Mat padded(20, 32, CV_8UC1, cv::Scalar(9));
   expected.copyTo(padded(cv::Rect(0, 0, 24, 20)));
-  EXPECT_EQ(cv::norm(GreyFromRaw("mono8", 24, 20, 32, false, Bytes(padded)), expected,
-                     cv::NORM_INF), 0);
+  EXPECT_EQ(
+      cv::norm(GreyFromRaw("mono8", 24, 20, 32, false, Bytes(padded)), expected, cv::NORM_INF), 0);
 }
 
 TEST(CameraImage, RefusesWhatDoesNotFit) {

@@ -19,7 +19,8 @@ enum class LinkEventType {
   kFrame,    // a new camera frame (observation filled)
   kNoFrame,  // no frame within the link's camera timeout: the robot must stop
   kEStop,    // the emergency stop is engaged: the robot must stop
-  kClosed,   // the link is gone (shutdown, end of a recording, the simulation ended): reason says why
+  kClosed,   // the link is gone (shutdown, end of a recording, the simulation ended): reason says
+             // why
 };
 
 struct LinkEvent {

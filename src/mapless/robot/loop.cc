@@ -15,9 +15,9 @@ void LoopOptions::Validate() const {
                 "LoopOptions.max_turn_rate_radps = " << max_turn_rate_radps << "; must be > 0");
   MAPLESS_CHECK(std::isfinite(max_frame_age_s) && max_frame_age_s >= 0.0,
                 "LoopOptions.max_frame_age_s = " << max_frame_age_s << "; must be >= 0");
-  MAPLESS_CHECK(std::isfinite(give_up_without_frames_s) && give_up_without_frames_s >= 0.0,
-                "LoopOptions.give_up_without_frames_s = " << give_up_without_frames_s
-                                                          << "; must be >= 0");
+  MAPLESS_CHECK(
+      std::isfinite(give_up_without_frames_s) && give_up_without_frames_s >= 0.0,
+      "LoopOptions.give_up_without_frames_s = " << give_up_without_frames_s << "; must be >= 0");
 }
 
 Twist2 LimitCommand(const Twist2& command, const LoopOptions& options) {
@@ -64,15 +64,15 @@ LoopResult RunLoop(Method& method, RobotLink& link, const LoopOptions& options,
         link.Stop(event.reason.empty() ? "emergency stop" : event.reason);
         continue;
       case LinkEventType::kNoFrame: {
-        const double waited =
-            have_frame_time ? ToSeconds(link.now_ns() - last_frame_ns) : 0.0;
+        const double waited = have_frame_time ? ToSeconds(link.now_ns() - last_frame_ns) : 0.0;
         const std::string why = event.reason.empty() ? "no camera frame" : event.reason;
         if (options.give_up_without_frames_s > 0.0 && waited > options.give_up_without_frames_s)
           return end(false, why + " for " + Seconds(waited) + ": giving up");
         link.Stop(why);
         continue;
       }
-      case LinkEventType::kFrame: break;
+      case LinkEventType::kFrame:
+        break;
     }
     const Observation& obs = event.observation;
     have_frame_time = true;

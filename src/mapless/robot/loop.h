@@ -18,7 +18,7 @@
 namespace mapless::robot {
 
 struct LoopOptions {
-  double max_speed_mps = std::numeric_limits<double>::infinity();       // |v| limit
+  double max_speed_mps = std::numeric_limits<double>::infinity();        // |v| limit
   double max_turn_rate_radps = std::numeric_limits<double>::infinity();  // |omega| limit
   // A frame older than this (link clock minus frame stamp) is never acted on; 0: no check (the
   // simulator's frames are always fresh).
@@ -31,10 +31,11 @@ struct LoopOptions {
 
 struct LoopResult {
   bool finished = false;  // the method finished (kFinished)
-  bool failed = false;    // the method failed, the link closed or gave up, or the loop was interrupted
-  std::string reason;     // the last reason: why the loop ended
-  int frames = 0;         // frames the method decided on
-  int stale_frames = 0;   // frames refused as too old
+  bool failed =
+      false;           // the method failed, the link closed or gave up, or the loop was interrupted
+  std::string reason;  // the last reason: why the loop ended
+  int frames = 0;      // frames the method decided on
+  int stale_frames = 0;  // frames refused as too old
 };
 
 // Called on every frame the method decided on, before the command is sent. Returning false ends

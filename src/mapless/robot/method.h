@@ -6,8 +6,8 @@
 // visual-potential navigator (Ohnishi & Imiya) and the appearance route follower (Payá et al.).
 #pragma once
 
-#include <optional>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <variant>
 
@@ -27,8 +27,8 @@ struct Observation {
 };
 
 enum class MethodState {
-  kDriving,   // the command moves the robot
-  kStopped,   // the method holds the robot (waiting, searching, a camera fault): the reason says why
+  kDriving,  // the command moves the robot
+  kStopped,  // the method holds the robot (waiting, searching, a camera fault): the reason says why
   kFinished,  // the method is done and succeeded (route completed, destination reached)
   kFailed,    // the method gave up (aborted): the reason says why
 };
@@ -38,9 +38,9 @@ const char* MethodStateName(MethodState state);
 // and the debug image.
 struct Decision {
   MethodState state = MethodState::kStopped;
-  Twist2 command;          // zero unless kDriving
-  std::string status;      // the method's own state name ("driving", "searching", "waiting", ...)
-  std::string reason;      // why it stopped, finished or failed
+  Twist2 command;      // zero unless kDriving
+  std::string status;  // the method's own state name ("driving", "searching", "waiting", ...)
+  std::string reason;  // why it stopped, finished or failed
   std::variant<std::monostate, navigation::RepeatStep, navigation::PotentialStep,
                navigation::FollowerStep>
       detail;
@@ -50,9 +50,9 @@ struct Decision {
 class Method {
  public:
   virtual ~Method() = default;
-  virtual const char* name() const = 0;        // "repeat", "navigate", "follow"
-  virtual bool needs_odometry() const = 0;     // refuses to drive on frames without odometry
-  virtual cv::Size image_size() const = 0;     // the frame size the method works at (0x0: any)
+  virtual const char* name() const = 0;     // "repeat", "navigate", "follow"
+  virtual bool needs_odometry() const = 0;  // refuses to drive on frames without odometry
+  virtual cv::Size image_size() const = 0;  // the frame size the method works at (0x0: any)
   virtual Decision Step(const Observation& observation) = 0;
 };
 

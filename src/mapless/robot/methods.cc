@@ -8,10 +8,14 @@ namespace mapless::robot {
 
 const char* MethodStateName(MethodState state) {
   switch (state) {
-    case MethodState::kDriving: return "driving";
-    case MethodState::kStopped: return "stopped";
-    case MethodState::kFinished: return "finished";
-    case MethodState::kFailed: return "failed";
+    case MethodState::kDriving:
+      return "driving";
+    case MethodState::kStopped:
+      return "stopped";
+    case MethodState::kFinished:
+      return "finished";
+    case MethodState::kFailed:
+      return "failed";
   }
   return "?";
 }
@@ -45,10 +49,18 @@ Decision RepeatMethod::Step(const Observation& observation) {
   navigation::RepeatStep step = session_.Update(observation.image, observation.t_ns);
   MethodState state = MethodState::kDriving;
   switch (step.status) {
-    case navigation::RepeatStatus::kDriving: state = MethodState::kDriving; break;
-    case navigation::RepeatStatus::kWaiting: state = MethodState::kStopped; break;
-    case navigation::RepeatStatus::kCompleted: state = MethodState::kFinished; break;
-    case navigation::RepeatStatus::kAborted: state = MethodState::kFailed; break;
+    case navigation::RepeatStatus::kDriving:
+      state = MethodState::kDriving;
+      break;
+    case navigation::RepeatStatus::kWaiting:
+      state = MethodState::kStopped;
+      break;
+    case navigation::RepeatStatus::kCompleted:
+      state = MethodState::kFinished;
+      break;
+    case navigation::RepeatStatus::kAborted:
+      state = MethodState::kFailed;
+      break;
   }
   Decision d = Make(state, step.command, navigation::RepeatStatusName(step.status), step.reason);
   d.detail = std::move(step);
@@ -76,9 +88,15 @@ Decision PotentialMethod::Step(const Observation& observation) {
       // Searching and turning round move the robot too (in place, or one creeping frame).
       state = MethodState::kDriving;
       break;
-    case navigation::PotentialStatus::kArrived: state = MethodState::kFinished; break;
-    case navigation::PotentialStatus::kAborted: state = MethodState::kFailed; break;
-    case navigation::PotentialStatus::kCameraFault: state = MethodState::kStopped; break;
+    case navigation::PotentialStatus::kArrived:
+      state = MethodState::kFinished;
+      break;
+    case navigation::PotentialStatus::kAborted:
+      state = MethodState::kFailed;
+      break;
+    case navigation::PotentialStatus::kCameraFault:
+      state = MethodState::kStopped;
+      break;
   }
   Decision d = Make(state, step.command, navigation::PotentialStatusName(step.status), step.reason);
   d.detail = std::move(step);
@@ -99,14 +117,21 @@ Decision FollowMethod::Step(const Observation& observation) {
   if (!route || route->size() == 0) {
     return Make(MethodState::kStopped, {}, "waiting", "no route image yet: waiting for the leader");
   }
-  navigation::FollowerStep step = follower_.Update(observation.image, *observation.odometry, *route);
+  navigation::FollowerStep step =
+      follower_.Update(observation.image, *observation.odometry, *route);
   MethodState state = MethodState::kDriving;
   switch (step.state) {
     case navigation::FollowerState::kInitializing:
-    case navigation::FollowerState::kFollowing: state = MethodState::kDriving; break;
+    case navigation::FollowerState::kFollowing:
+      state = MethodState::kDriving;
+      break;
     case navigation::FollowerState::kStopped:
-    case navigation::FollowerState::kWaitingForLeader: state = MethodState::kStopped; break;
-    case navigation::FollowerState::kArrived: state = MethodState::kFinished; break;
+    case navigation::FollowerState::kWaitingForLeader:
+      state = MethodState::kStopped;
+      break;
+    case navigation::FollowerState::kArrived:
+      state = MethodState::kFinished;
+      break;
   }
   Decision d = Make(state, step.command, navigation::FollowerStateName(step.state), step.reason);
   d.detail = std::move(step);

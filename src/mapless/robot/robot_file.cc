@@ -14,10 +14,14 @@ const char* MiddlewareName(Middleware m) { return m == Middleware::kRos1 ? "ros1
 
 const char* CameraMountName(CameraMount m) {
   switch (m) {
-    case CameraMount::kUpright: return "upright";
-    case CameraMount::kRotated180: return "rotated_180";
-    case CameraMount::kMirrored: return "mirrored";
-    case CameraMount::kFlippedVertically: return "flipped_vertically";
+    case CameraMount::kUpright:
+      return "upright";
+    case CameraMount::kRotated180:
+      return "rotated_180";
+    case CameraMount::kMirrored:
+      return "mirrored";
+    case CameraMount::kFlippedVertically:
+      return "flipped_vertically";
   }
   return "?";
 }
@@ -98,8 +102,8 @@ RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
       map.Fail("node_name", "'" + r.node_name + "' is not a ROS node name");
     if (map.Has("topics")) {
       const io::YamlMap t = map.GetMap("topics");
-      t.CheckKnownKeys({"image", "compressed_image", "odometry", "cmd_vel", "status",
-                        "debug_image", "estop"});
+      t.CheckKnownKeys(
+          {"image", "compressed_image", "odometry", "cmd_vel", "status", "debug_image", "estop"});
       auto get = [&](const char* key, std::string* field, bool may_be_empty) {
         *field = t.GetString(key, *field);
         CheckTopic(t, key, *field, may_be_empty);
@@ -131,17 +135,17 @@ RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
         }
       }
       if (!found)
-        c.Fail("mount", "'" + mount +
-                            "' is not one of upright, rotated_180, mirrored, flipped_vertically");
+        c.Fail("mount",
+               "'" + mount + "' is not one of upright, rotated_180, mirrored, flipped_vertically");
     }
     if (map.Has("safety")) {
       const io::YamlMap s = map.GetMap("safety");
-      s.CheckKnownKeys({"camera_timeout_s", "max_frame_age_s", "give_up_without_frames_s",
-                        "connect_timeout_s"});
+      s.CheckKnownKeys(
+          {"camera_timeout_s", "max_frame_age_s", "give_up_without_frames_s", "connect_timeout_s"});
       r.camera_timeout_s = Positive(s, "camera_timeout_s", r.camera_timeout_s, 10.0);
       r.max_frame_age_s = Positive(s, "max_frame_age_s", r.max_frame_age_s, 60.0);
-      r.give_up_without_frames_s = s.GetDouble("give_up_without_frames_s",
-                                               r.give_up_without_frames_s);
+      r.give_up_without_frames_s =
+          s.GetDouble("give_up_without_frames_s", r.give_up_without_frames_s);
       if (!std::isfinite(r.give_up_without_frames_s) || r.give_up_without_frames_s < 0.0 ||
           r.give_up_without_frames_s > 3600.0)
         s.Fail("give_up_without_frames_s", "must be in [0, 3600] (0: wait for ever)");

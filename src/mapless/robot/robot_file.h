@@ -22,22 +22,22 @@ struct RobotTopics {
   std::string image = "camera/image_raw";  // sensor_msgs/Image (mono8, rgb8, bgr8, ...)
   // sensor_msgs/CompressedImage (JPEG or PNG); used instead of `image` when set.
   std::string compressed_image;
-  std::string odometry = "odom";                  // nav_msgs/Odometry; "" for a robot without
-  std::string cmd_vel = "cmd_vel";                // geometry_msgs/Twist
-  std::string status = "mapless/status";          // std_msgs/String, one JSON object per frame
+  std::string odometry = "odom";                    // nav_msgs/Odometry; "" for a robot without
+  std::string cmd_vel = "cmd_vel";                  // geometry_msgs/Twist
+  std::string status = "mapless/status";            // std_msgs/String, one JSON object per frame
   std::string debug_image = "mapless/debug_image";  // sensor_msgs/Image (bgr8); "" for none
-  std::string estop = "mapless/estop";            // std_msgs/Bool: true stops the robot
+  std::string estop = "mapless/estop";              // std_msgs/Bool: true stops the robot
 };
 
 struct RobotFile {
-  std::string source;                    // the file it came from (for messages)
+  std::string source;  // the file it came from (for messages)
   Middleware middleware = Middleware::kRos1;
-  std::string name = "robot";            // a name for logs
-  std::string ns;                        // namespace prefixed to relative topics ("/robot1")
-  std::string node_name = "mapless";     // the ROS node name
+  std::string name = "robot";         // a name for logs
+  std::string ns;                     // namespace prefixed to relative topics ("/robot1")
+  std::string node_name = "mapless";  // the ROS node name
   RobotTopics topics;
-  double max_speed_mps = 0.3;            // REP-103: m/s
-  double max_turn_rate_radps = 1.0;      // REP-103: rad/s
+  double max_speed_mps = 0.3;        // REP-103: m/s
+  double max_turn_rate_radps = 1.0;  // REP-103: rad/s
   CameraMount mount = CameraMount::kUpright;
   // Safety: zero velocity when no frame arrived for camera_timeout_s; a frame older than
   // max_frame_age_s (its stamp against the clock) is never acted on.
@@ -45,8 +45,8 @@ struct RobotFile {
   double max_frame_age_s = 0.5;
   // No frame for this long: the run ends (exit 1). 0: the robot waits stopped for ever.
   double give_up_without_frames_s = 30.0;
-  bool use_sim_time = false;             // ROS `use_sim_time`: the clock comes from /clock
-  double connect_timeout_s = 10.0;       // waiting for the master / the first subscriber
+  bool use_sim_time = false;        // ROS `use_sim_time`: the clock comes from /clock
+  double connect_timeout_s = 10.0;  // waiting for the master / the first subscriber
   // The full name of a topic: absolute topics stay, relative ones get the namespace.
   std::string Resolve(const std::string& topic) const;
   LoopOptions Loop() const;

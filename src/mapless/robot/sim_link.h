@@ -14,9 +14,9 @@
 namespace mapless::robot {
 
 struct SimLinkOptions {
-  double period_s = 0.1;         // one camera frame per period
-  double timeout_s = 1e9;        // simulated time after which the run is halted
-  bool odometry = true;          // frames carry the robot's wheel odometry
+  double period_s = 0.1;   // one camera frame per period
+  double timeout_s = 1e9;  // simulated time after which the run is halted
+  bool odometry = true;    // frames carry the robot's wheel odometry
   std::vector<sim::CameraFaultWindow> camera_faults;  // injected camera faults (hardening)
   std::uint64_t fault_seed = 1;
   void Validate() const;

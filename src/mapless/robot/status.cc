@@ -87,8 +87,8 @@ nlohmann::json StopJson(const char* method, Timestamp t_ns, const std::string& r
 }
 
 cv::Mat DebugImage(const Observation& observation, const Decision& decision) {
-  cv::Mat grey = observation.image.empty() ? cv::Mat(240, 320, CV_8UC1, cv::Scalar(0))
-                                           : observation.image;
+  cv::Mat grey =
+      observation.image.empty() ? cv::Mat(240, 320, CV_8UC1, cv::Scalar(0)) : observation.image;
   const double scale = grey.cols < 320 ? 320.0 / grey.cols : 1.0;
   cv::Mat big;
   if (scale != 1.0) {
@@ -133,7 +133,8 @@ cv::Mat DebugImage(const Observation& observation, const Decision& decision) {
           const double f = std::hypot(s.force[0], s.force[1]);
           if (f > 1e-9) {
             const double len = 0.3 * out.rows;
-            const cv::Point2d tip = centre + cv::Point2d(s.force[0] / f * len, -s.force[1] / f * len);
+            const cv::Point2d tip =
+                centre + cv::Point2d(s.force[0] / f * len, -s.force[1] / f * len);
             cv::arrowedLine(out, centre, tip, red, 2, cv::LINE_AA);
           }
           lines.push_back("plane " + Fixed(s.plane_fraction, 2) + "  ahead " +

@@ -82,6 +82,7 @@ LinkBenchResult BenchLink(const LinkBenchOptions& options) {
   LinkBenchResult result;
   {
     Ros1Link link(file, options.method, "bench", {});
+    link.Start();
     // Wait for both connections.
     const auto deadline = Clock::now() + std::chrono::seconds(10);
     while ((camera.getNumSubscribers() == 0 || listener.getNumPublishers() == 0) &&

@@ -13,9 +13,9 @@ namespace mapless::ros1 {
 struct LinkBenchOptions {
   int frames = 300;
   double rate_hz = 50.0;
-  cv::Size camera{320, 240};      // published size
+  cv::Size camera{320, 240};       // published size
   std::string encoding = "mono8";  // mono8 or rgb8
-  cv::Size method{320, 240};      // the size the method wants (resized by the link)
+  cv::Size method{320, 240};       // the size the method wants (resized by the link)
 };
 
 struct LinkBenchResult {

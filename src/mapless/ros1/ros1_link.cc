@@ -14,8 +14,8 @@
 #include <condition_variable>
 #include <deque>
 #include <map>
-#include <set>
 #include <mutex>
+#include <set>
 #include <thread>
 
 #include "mapless/core/check.h"
@@ -62,7 +62,10 @@ void StartNode(const robot::RobotFile& robot, const std::string& node_name) {
 class Ros1Link::Impl {
  public:
   Impl(const robot::RobotFile& robot, cv::Size size, std::string method, Logger warn)
-      : robot_(robot), size_(size), method_(std::move(method)), warn_(std::move(warn)),
+      : robot_(robot),
+        size_(size),
+        method_(std::move(method)),
+        warn_(std::move(warn)),
         spinner_(1) {
     ros::NodeHandle nh;
     const std::string image_topic = robot.topics.compressed_image.empty()
@@ -76,16 +79,20 @@ class Ros1Link::Impl {
       image_sub_ = nh.subscribe(image_topic, 2, &Impl::OnCompressed, this, hints);
     }
     if (!robot.topics.odometry.empty())
-      odom_sub_ = nh.subscribe(robot.Resolve(robot.topics.odometry), 50, &Impl::OnOdometry, this,
-                               hints);
+      odom_sub_ =
+          nh.subscribe(robot.Resolve(robot.topics.odometry), 50, &Impl::OnOdometry, this, hints);
     if (!robot.topics.estop.empty())
       estop_sub_ = nh.subscribe(robot.Resolve(robot.topics.estop), 5, &Impl::OnEStop, this, hints);
     cmd_pub_ = nh.advertise<geometry_msgs::Twist>(robot.Resolve(robot.topics.cmd_vel), 10);
     status_pub_ = nh.advertise<std_msgs::String>(robot.Resolve(robot.topics.status), 10);
     if (!robot.topics.debug_image.empty())
       debug_pub_ = nh.advertise<sensor_msgs::Image>(robot.Resolve(robot.topics.debug_image), 2);
+  }
+
+  void Start() {
     spinner_.start();
     last_event_ns_ = ToNs(ros::Time::now());
+    last_frame_steady_ns_ = SteadyNs();
   }
 
   ~Impl() {
@@ -99,7 +106,8 @@ class Ros1Link::Impl {
     std::unique_lock<std::mutex> lock(mutex_);
     while (true) {
       if (!ros::ok()) return {robot::LinkEventType::kClosed, {}, "ROS shut down"};
-      if (estop_) return {robot::LinkEventType::kEStop, {}, "emergency stop (" + estop_topic() + ")"};
+      if (estop_)
+        return {robot::LinkEventType::kEStop, {}, "emergency stop (" + estop_topic() + ")"};
       if (have_frame_) {
         have_frame_ = false;
         got_frame_ = true;
@@ -112,8 +120,7 @@ class Ros1Link::Impl {
         event.observation.odometry = OdometryAt(event.observation.t_ns);
         // The watchdog counts from the newest of the frame's stamp and its arrival: the clock
         // and the frame come on different connections, in either order.
-        last_event_ns_ =
-            std::max({last_event_ns_, ToNs(ros::Time::now()), event.observation.t_ns});
+        last_event_ns_ = std::max({last_event_ns_, ToNs(ros::Time::now()), event.observation.t_ns});
         return event;
       }
       const Timestamp now = ToNs(ros::Time::now());
@@ -134,9 +141,9 @@ class Ros1Link::Impl {
       // Before the first frame the camera has connect_timeout_s to appear (the robot is stopped
       // anyway); a zero Twist then would also be taken as the answer to a lockstep simulator's
       // first frame.
-      const double timeout = got_frame_ ? robot_.camera_timeout_s
-                                        : std::max(robot_.camera_timeout_s,
-                                                   robot_.connect_timeout_s);
+      const double timeout = got_frame_
+                                 ? robot_.camera_timeout_s
+                                 : std::max(robot_.camera_timeout_s, robot_.connect_timeout_s);
       if (ToSeconds(now - last_event_ns_) >= timeout) {
         last_event_ns_ = now;
         std::string why = "no camera frame on " + camera_topic_ + " for " +
@@ -238,8 +245,8 @@ class Ros1Link::Impl {
       return;
     }
     std::lock_guard<std::mutex> lock(mutex_);
-    odometry_.push_back({ToNs(msg->header.stamp), Pose2{p.position.x, p.position.y,
-                                                         Yaw(p.orientation)}});
+    odometry_.push_back(
+        {ToNs(msg->header.stamp), Pose2{p.position.x, p.position.y, Yaw(p.orientation)}});
     while (odometry_.size() > 200) odometry_.pop_front();
     cv_.notify_all();
   }
@@ -258,9 +265,8 @@ class Ros1Link::Impl {
     if (robot_.topics.odometry.empty()) return std::nullopt;
     std::unique_lock<std::mutex> lock(mutex_);
     if (robot_.use_sim_time) {
-      cv_.wait_for(lock, std::chrono::milliseconds(50), [&] {
-        return !odometry_.empty() && odometry_.back().first >= t_ns;
-      });
+      cv_.wait_for(lock, std::chrono::milliseconds(50),
+                   [&] { return !odometry_.empty() && odometry_.back().first >= t_ns; });
     }
     if (odometry_.empty()) return std::nullopt;
     const std::pair<Timestamp, Pose2>* best = &odometry_.back();
@@ -298,6 +304,7 @@ Ros1Link::Ros1Link(const robot::RobotFile& robot, cv::Size image_size, std::stri
                    Logger warn)
     : impl_(std::make_unique<Impl>(robot, image_size, std::move(method), std::move(warn))) {}
 Ros1Link::~Ros1Link() = default;
+void Ros1Link::Start() { impl_->Start(); }
 robot::LinkEvent Ros1Link::Next() { return impl_->Next(); }
 void Ros1Link::Send(const Twist2& c, const robot::Observation& o, const robot::Decision& d) {
   impl_->Send(c, o, d);

@@ -30,9 +30,12 @@ void StartNode(const robot::RobotFile& robot, const std::string& node_name);
 
 class Ros1Link : public robot::RobotLink {
  public:
-  // `image_size`: frames are resized to it (0x0: as they come). `method` names the status.
+  // Subscribes and advertises; nothing is received before Start(). `image_size`: frames are
+  // resized to it (0x0: as they come). `method` names the status.
   Ros1Link(const robot::RobotFile& robot, cv::Size image_size, std::string method, Logger warn);
   ~Ros1Link() override;
+  // Starts receiving (roscpp's spinner thread): call once, before Next().
+  void Start();
 
   robot::LinkEvent Next() override;
   void Send(const Twist2& command, const robot::Observation& observation,

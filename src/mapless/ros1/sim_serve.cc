@@ -49,9 +49,10 @@ class Server {
       odom_pub_ = nh.advertise<nav_msgs::Odometry>(file.Resolve(file.topics.odometry), 10);
     if (file.use_sim_time) clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
     cmd_sub_ = nh.subscribe(file.Resolve(file.topics.cmd_vel), 20, &Server::OnCommand, this, hints);
-    status_sub_ = nh.subscribe(file.Resolve(file.topics.status), 50, &Server::OnStatus, this, hints);
-    spinner_.start();
+    status_sub_ =
+        nh.subscribe(file.Resolve(file.topics.status), 50, &Server::OnStatus, this, hints);
   }
+  void Start() { spinner_.start(); }
   ~Server() { spinner_.stop(); }
 
   void Log(const std::string& m) const {
@@ -64,8 +65,8 @@ class Server {
   bool MethodConnected() const {
     return image_pub_.getNumSubscribers() > 0 &&
            (!odom_pub_ || odom_pub_.getNumSubscribers() > 0) &&
-           (!clock_pub_ || clock_pub_.getNumSubscribers() > 0) &&
-           cmd_sub_.getNumPublishers() > 0 && status_sub_.getNumPublishers() > 0;
+           (!clock_pub_ || clock_pub_.getNumSubscribers() > 0) && cmd_sub_.getNumPublishers() > 0 &&
+           status_sub_.getNumPublishers() > 0;
   }
 
   // Stamped with the simulated time in lockstep (it is the ROS clock there, via /clock), with
@@ -190,6 +191,7 @@ class Server {
 ServeSummary ServeSimulation(sim::Simulation& sim, int robot, const robot::RobotFile& file,
                              const ServeOptions& options) {
   Server server(file, options);
+  server.Start();
   ServeSummary summary;
   std::map<Timestamp, Pose2> truth_at;
   auto finish = [&](const std::string& why) {
@@ -208,7 +210,8 @@ ServeSummary ServeSimulation(sim::Simulation& sim, int robot, const robot::Robot
   if (file.use_sim_time) {
     server.Log("sim serve: lockstep in simulated time; waiting for a method to connect");
     while (!server.MethodConnected()) {
-      if (server.Interrupted() || !ros::ok()) return finish("interrupted before a method connected");
+      if (server.Interrupted() || !ros::ok())
+        return finish("interrupted before a method connected");
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
     server.Log("sim serve: a method connected");

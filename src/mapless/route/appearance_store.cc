@@ -95,9 +95,9 @@ StoredAppearanceRoute ParseAppearanceManifest(const std::string& text, const std
   };
   auto integer = [&](const char* key, int lo, int hi) {
     const double v = number(j, key, "");
-    MAPLESS_CHECK(v == std::floor(v) && v >= lo && v <= hi,
-                  name << ": " << key << " = " << v << "; must be a whole number in [" << lo
-                       << ", " << hi << "]");
+    MAPLESS_CHECK(v == std::floor(v) && v >= lo && v <= hi, name << ": " << key << " = " << v
+                                                                 << "; must be a whole number in ["
+                                                                 << lo << ", " << hi << "]");
     return static_cast<int>(v);
   };
   MAPLESS_CHECK(j.contains("format") && j["format"] == "mapless-appearance-route",
@@ -130,8 +130,8 @@ StoredAppearanceRoute ParseAppearanceManifest(const std::string& text, const std
     MAPLESS_CHECK(image.distance_m >= last_distance,
                   name << ": " << where << "distance_m goes backwards");
     last_distance = image.distance_m;
-    image.odometry = Pose2{number(e, "x_m", where), number(e, "y_m", where),
-                           number(e, "theta_rad", where)};
+    image.odometry =
+        Pose2{number(e, "x_m", where), number(e, "y_m", where), number(e, "theta_rad", where)};
     MAPLESS_CHECK(e.contains("file") && e["file"].is_string() &&
                       e["file"].get<std::string>() == ImageFile(static_cast<int>(i)),
                   name << ": " << where << "file: must be " << ImageFile(static_cast<int>(i)));

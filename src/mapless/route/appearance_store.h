@@ -25,13 +25,13 @@ namespace mapless::route {
 inline constexpr int kAppearanceRouteFormatVersion = 1;
 
 struct StoredAppearanceImage {
-  cv::Mat low;             // CV_8UC1, low_width x low_height
+  cv::Mat low;              // CV_8UC1, low_width x low_height
   double distance_m = 0.0;  // odometry distance from the route start
-  Pose2 odometry;          // the leader's odometry when it was taken
+  Pose2 odometry;           // the leader's odometry when it was taken
 };
 
 struct StoredAppearanceRoute {
-  int image_width = 0;   // the camera's frames
+  int image_width = 0;  // the camera's frames
   int image_height = 0;
   int low_width = 0;
   int low_height = 0;
