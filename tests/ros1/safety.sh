@@ -4,6 +4,7 @@
 #   - the camera publisher killed (SIGKILL): the watchdog;
 #   - Ctrl-C (SIGINT) to the method: the zero goes out before it leaves;
 #   - true on the e-stop topic: zero until false, then the robot is driven again.
+# First (mode topics) it checks the status (JSON per frame) and debug image topics while it drives.
 # A probe (safety_probe) waits until the robot is driven, acts, and times the first command after.
 # Exit 77 (skipped) without ROS 1.
 #   tests/ros1/safety.sh MAPLESS SAFETY_PROBE [RUNS]
@@ -24,7 +25,7 @@ printf 'name: real-time simulated robot\nuse_sim_time: false\n' >"$OUT/robot.yam
   { echo "safety.sh: teach failed"; exit 1; }
 FAILS=0
 TOTAL=0
-for mode in kill int estop; do
+for mode in topics kill int estop; do
   for k in $(seq 1 "$RUNS"); do
     "$BIN" sim serve --scenario table1_almost_straight --robot "$OUT/robot.yaml" --like repeat \
       --seed "$k" >"$OUT/serve.log" 2>&1 &
@@ -46,5 +47,5 @@ for mode in kill int estop; do
     kill -INT "$SERVE" 2>/dev/null; sleep 0.2; kill -9 "$SERVE" 2>/dev/null; wait "$SERVE" 2>/dev/null
   done
 done
-echo "safety.sh: $((TOTAL - FAILS))/$TOTAL runs published a zero Twist within 0.3 s"
+echo "safety.sh: $((TOTAL - FAILS))/$TOTAL runs passed (topics: status and debug image; kill, int, estop: a zero Twist within 0.3 s)"
 [ "$FAILS" = 0 ]

@@ -4,13 +4,17 @@
 //   kill PID    SIGKILL to the camera publisher (the watchdog)
 //   int PID     SIGINT to the method (Ctrl-C)
 //   estop       true on /mapless/estop; then false, and the robot must be driven again within 2 s
+//   topics      (no action) the status topic carries one JSON object per frame naming the method,
+//               and the debug image topic bgr8 pictures at least 320 wide
 // Prints one JSON line; exit 0 when the zero came within the limit, 1 when it came late, was not
 // zero, or never came (or, for estop, driving did not resume).
 //   safety_probe kill|int|estop PID LIMIT_S [NONZERO_COMMANDS]
 #include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
 #include <signal.h>
+#include <sensor_msgs/Image.h>
 #include <std_msgs/Bool.h>
+#include <std_msgs/String.h>
 
 #include <atomic>
 #include <chrono>
@@ -64,6 +68,58 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh;
   ros::Subscriber sub = nh.subscribe("/cmd_vel", 100, OnTwist, ros::TransportHints().tcpNoDelay());
   ros::Publisher estop = nh.advertise<std_msgs::Bool>("/mapless/estop", 1, true);
+  if (mode == "topics") {
+    std::mutex m;
+    int statuses = 0, good_statuses = 0, images = 0, good_images = 0;
+    ros::Subscriber status = nh.subscribe<std_msgs::String>(
+        "/mapless/status", 100, [&](const std_msgs::StringConstPtr& msg) {
+          std::lock_guard<std::mutex> lock(m);
+          ++statuses;
+          const std::string& t = msg->data;
+          if (t.size() > 2 && t.front() == '{' && t.back() == '}' &&
+              t.find("\"method\":\"repeat\"") != std::string::npos)
+            ++good_statuses;
+        });
+    ros::Subscriber debug = nh.subscribe<sensor_msgs::Image>(
+        "/mapless/debug_image", 10, [&](const sensor_msgs::ImageConstPtr& msg) {
+          std::lock_guard<std::mutex> lock(m);
+          ++images;
+          if (msg->encoding == "bgr8" && msg->width >= 320 &&
+              msg->data.size() == static_cast<std::size_t>(msg->step) * msg->height) {
+            ++good_images;
+            // For a person to look at: MAPLESS_DEBUG_IMAGE_OUT=FILE.ppm keeps the 20th picture.
+            const char* out = std::getenv("MAPLESS_DEBUG_IMAGE_OUT");
+            if (out != nullptr && good_images == 20) {
+              if (FILE* f = std::fopen(out, "wb")) {
+                std::fprintf(f, "P6\n%u %u\n255\n", msg->width, msg->height);
+                for (std::size_t i = 0; i + 2 < msg->data.size(); i += 3) {
+                  const unsigned char rgb[3] = {msg->data[i + 2], msg->data[i + 1], msg->data[i]};
+                  std::fwrite(rgb, 1, 3, f);
+                }
+                std::fclose(f);
+              }
+            }
+          }
+        });
+    ros::AsyncSpinner spinner(1);
+    spinner.start();
+    const auto until = Clock::now() + std::chrono::seconds(20);
+    while (Clock::now() < until) {
+      {
+        std::lock_guard<std::mutex> lock(m);
+        if (good_statuses >= 10 && good_images >= (std::getenv("MAPLESS_DEBUG_IMAGE_OUT") ? 25 : 5)) break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    std::lock_guard<std::mutex> lock(m);
+    std::printf("{\"mode\": \"topics\", \"statuses\": %d, \"good_statuses\": %d, "
+                "\"debug_images\": %d, \"good_debug_images\": %d}\n",
+                statuses, good_statuses, images, good_images);
+    (void)pid;
+    (void)limit;
+    (void)wanted;
+    return good_statuses >= 10 && good_images >= 5 && good_statuses == statuses ? 0 : 1;
+  }
   ros::AsyncSpinner spinner(1);
   spinner.start();
   const auto deadline = Clock::now() + std::chrono::seconds(60);
