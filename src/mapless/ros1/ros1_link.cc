@@ -96,9 +96,13 @@ class Ros1Link::Impl {
   }
 
   ~Impl() {
-    PublishTwist(Twist2{});
-    // Give the zero Twist time to leave before the connections close.
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    // A link that ever commanded the robot leaves it at zero velocity; one that only listened
+    // (teaching: a person drives) publishes nothing.
+    if (commanded_) {
+      PublishTwist(Twist2{});
+      // Give the zero Twist time to leave before the connections close.
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    }
     spinner_.stop();
   }
 
@@ -189,6 +193,7 @@ class Ros1Link::Impl {
   std::string estop_topic() const { return robot_.Resolve(robot_.topics.estop); }
 
   void PublishTwist(const Twist2& c) {
+    commanded_ = true;
     geometry_msgs::Twist t;
     t.linear.x = c.v_mps;
     t.angular.z = c.omega_radps;
@@ -298,6 +303,7 @@ class Ros1Link::Impl {
   Timestamp last_event_ns_ = 0;
   std::int64_t last_frame_steady_ns_ = SteadyNs();  // the last frame, or the start
   int frames_ = 0;
+  bool commanded_ = false;
 };
 
 Ros1Link::Ros1Link(const robot::RobotFile& robot, cv::Size image_size, std::string method,

@@ -7,8 +7,9 @@
 // Safety: Next() reports kNoFrame when no frame arrived for camera_timeout_s (by the ROS clock,
 // which is /clock under use_sim_time), kEStop while the e-stop topic says true, and kClosed on
 // shutdown; the loop then publishes a zero Twist. Bad input (an unsupported encoding, a frame that
-// does not decode) is logged once per kind and never acted on. The destructor publishes a zero
-// Twist before it leaves the ROS graph.
+// does not decode) is logged once per kind and never acted on. The destructor of a link that
+// commanded the robot publishes a zero Twist before it leaves the ROS graph; a link that only
+// listened (teaching) publishes nothing.
 #pragma once
 
 #include <functional>
