@@ -5,12 +5,20 @@
 #include <atomic>
 #include <csignal>
 #include <cstring>
+#include <ctime>
 
 namespace mapless::app {
 namespace {
 
 std::atomic<int> g_signal{0};
 std::atomic<bool> g_cooperative{false};
+std::atomic<long long> g_first_ns{0};  // CLOCK_MONOTONIC of the first signal
+
+long long MonotonicNs() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);  // async-signal-safe
+  return static_cast<long long>(ts.tv_sec) * 1000000000LL + ts.tv_nsec;
+}
 
 void Write(const char* text) {
   // write(2) is async-signal-safe; the result does not matter on the way out.
@@ -19,8 +27,14 @@ void Write(const char* text) {
 }
 
 extern "C" void OnSignal(int signal) {
+  const long long now = MonotonicNs();
   const bool first = g_signal.exchange(signal) == 0;
+  if (first) g_first_ns.store(now);
   if (first && g_cooperative.load()) return;  // the run stops at its next frame
+  // A repeat within a second is the same interrupt delivered twice (`timeout` sends its signal to
+  // the command and to the command's process group), not the user insisting: a robot must still
+  // get its zero velocity.
+  if (!first && g_cooperative.load() && now - g_first_ns.load() < 1000000000LL) return;
   Write(signal == SIGTERM ? "mapless: terminated (SIGTERM)\n" : "mapless: interrupted (SIGINT)\n");
   ::_exit(128 + signal);
 }

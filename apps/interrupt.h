@@ -4,7 +4,9 @@
 // StopCleanlyOnInterrupt() and then ThrowIfInterrupted() once per frame: the first signal makes
 // that call throw Interrupted, so the run unwinds through its writers (routes and logs are
 // finished, journals closed) and main() prints one line and exits with 130. Any other command, or
-// a second signal, ends the process at once with one line and exit code 130 (SIGINT) or 143
+// a second signal a second or more after the first (a repeat within the second is the same
+// interrupt delivered twice, as `timeout` does), ends the process at once with one line and exit
+// code 130 (SIGINT) or 143
 // (SIGTERM): nothing is half-written, since every file mapless writes is written atomically or
 // journaled (docs/hardening.md).
 #pragma once
