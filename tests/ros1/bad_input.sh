@@ -5,16 +5,8 @@
 #   tests/ros1/bad_input.sh MAPLESS
 set -uo pipefail
 BIN=$1
-command -v rosmaster >/dev/null 2>&1 || { echo "bad_input.sh: SKIPPED: no rosmaster (scripts/setup.sh --ros)"; exit 77; }
-OUT=$(mktemp -d /tmp/mapless_badinput.XXXXXX)
-PORT=$((20000 + ($$ + 13) % 20000))
-export ROS_MASTER_URI="http://127.0.0.1:$PORT" ROS_IP=127.0.0.1 ROS_HOSTNAME=127.0.0.1 ROS_HOME="$OUT/roshome"
-PIDS=()
-cleanup() { for p in "${PIDS[@]}"; do kill -9 "$p" 2>/dev/null; wait "$p" 2>/dev/null; done; rm -rf "$OUT"; }
-trap cleanup EXIT INT TERM
-rosmaster --core -p "$PORT" >"$OUT/master.log" 2>&1 &
-PIDS+=($!)
-for _ in $(seq 1 100); do (exec 3<>"/dev/tcp/127.0.0.1/$PORT") 2>/dev/null && break; sleep 0.1; done
+# shellcheck source=master.sh
+source "$(dirname "$0")/master.sh" bad_input.sh
 "$BIN" teach --source sim:table1_almost_straight --out "$OUT/route" >"$OUT/teach.log" 2>&1 ||
   { echo "bad_input.sh: teach failed"; exit 1; }
 FAILS=0

@@ -7,16 +7,8 @@
 #   tests/ros1/teach.sh MAPLESS [SECONDS]
 set -uo pipefail
 BIN=$1; SECONDS_TO_TEACH=${2:-15}
-command -v rosmaster >/dev/null 2>&1 || { echo "teach.sh: SKIPPED: no rosmaster (scripts/setup.sh --ros)"; exit 77; }
-OUT=$(mktemp -d /tmp/mapless_teach.XXXXXX)
-PORT=$((20000 + ($$ + 23) % 20000))
-export ROS_MASTER_URI="http://127.0.0.1:$PORT" ROS_IP=127.0.0.1 ROS_HOSTNAME=127.0.0.1 ROS_HOME="$OUT/roshome"
-PIDS=()
-cleanup() { for p in "${PIDS[@]}"; do kill -9 "$p" 2>/dev/null; wait "$p" 2>/dev/null; done; rm -rf "$OUT"; }
-trap cleanup EXIT INT TERM
-rosmaster --core -p "$PORT" >"$OUT/master.log" 2>&1 &
-PIDS+=($!)
-for _ in $(seq 1 100); do (exec 3<>"/dev/tcp/127.0.0.1/$PORT") 2>/dev/null && break; sleep 0.1; done
+# shellcheck source=master.sh
+source "$(dirname "$0")/master.sh" teach.sh
 printf 'name: real-time simulated robot\nuse_sim_time: false\n' >"$OUT/robot.yaml"
 "$BIN" teach --source sim:table1_almost_straight --out "$OUT/driver_route" >"$OUT/t0.log" 2>&1 ||
   { echo "teach.sh: teach on the simulator failed"; exit 1; }
