@@ -19,6 +19,9 @@
 #include "mapless/ros1/ros1_link.h"
 #include "mapless/ros1/sim_serve.h"
 #endif
+#ifdef MAPLESS_HAVE_ROS2
+#include "mapless/ros2/sim_serve.h"
+#endif
 
 namespace mapless::app {
 
@@ -118,31 +121,49 @@ void AddSimServeCommand(CLI::App* simcmd) {
     } else {
       throw InputError("--like " + a->like + ": must be teach, repeat, navigate or follow");
     }
-#ifdef MAPLESS_HAVE_ROS1
-    if (file.middleware != robot::Middleware::kRos1)
-      throw InputError(a->robot + ": sim serve speaks ros1 in this build");
     sim::Simulation sim(setup.world, setup.camera, {}, setup.seed);
     const int r = sim.AddRobot(setup.start, setup.robot);
     StopCleanlyOnInterrupt();
-    ros1::StartNode(file, "mapless_sim");
-    ros1::ServeOptions options;
+    robot::ServeOptions options;
     options.period_s = 1.0 / scenario.camera.rate_hz;
     options.timeout_s = a->timeout_s;
     options.interrupted = [] { return InterruptSignal() != 0; };
     options.log = [](const std::string& m) { spdlog::info("{}", m); };
     options.encoding = a->encoding;
     options.size = size;
-    const ros1::ServeSummary s = ros1::ServeSimulation(sim, r, file, options);
-    spdlog::info("sim serve: {} after {} frames, {} commands, {:.1f} s simulated{}", s.end,
-                 s.frames, s.commands, s.sim_time_s, s.collided ? "; " + s.collision : "");
+    robot::ServeSummary s;
+    if (file.middleware == robot::Middleware::kRos1) {
+#ifdef MAPLESS_HAVE_ROS1
+      ros1::StartNode(file, "mapless_sim");
+      s = ros1::ServeSimulation(sim, r, file, options);
+#else
+      throw InputError(a->robot +
+                       ": middleware ros1, but this mapless was built without ROS 1 "
+                       "(scripts/setup.sh --ros, then build again)");
+#endif
+    } else {
+#ifdef MAPLESS_HAVE_ROS2
+      s = ros2::ServeSimulation(sim, r, file, options);
+#else
+      throw InputError(a->robot +
+                       ": middleware ros2, but this mapless was built without Cyclone DDS "
+                       "(scripts/setup.sh --ros, then build again)");
+#endif
+    }
+    spdlog::info("sim serve: {} after {} frames, {} commands{}, {:.1f} s simulated{}", s.end,
+                 s.frames, s.commands,
+                 s.resent > 0 ? ", " + std::to_string(s.resent) + " frames sent again" : "",
+                 s.sim_time_s, s.collided ? "; " + s.collision : "");
     if (!a->summary.empty()) {
       nlohmann::json j;
       j["scenario"] = scenario.name;
       j["like"] = a->like;
       j["seed"] = a->seed;
+      j["middleware"] = robot::MiddlewareName(file.middleware);
       j["end"] = s.end;
       j["frames"] = s.frames;
       j["commands"] = s.commands;
+      j["resent"] = s.resent;
       j["sim_time_s"] = s.sim_time_s;
       j["collided"] = s.collided;
       if (s.collided) j["collision"] = s.collision;
@@ -155,12 +176,6 @@ void AddSimServeCommand(CLI::App* simcmd) {
       io::WriteFileAtomic(a->summary, j.dump(2) + "\n");
     }
     ThrowIfInterrupted();
-#else
-    (void)file;
-    throw InputError(
-        "sim serve needs a middleware: this mapless was built without ROS 1 "
-        "(scripts/setup.sh --ros, then build again)");
-#endif
   });
 }
 

@@ -12,6 +12,9 @@
 #ifdef MAPLESS_HAVE_ROS1
 #include "mapless/ros1/ros1_link.h"
 #endif
+#ifdef MAPLESS_HAVE_ROS2
+#include "mapless/ros2/ros2_link.h"
+#endif
 
 namespace mapless::app {
 
@@ -28,6 +31,18 @@ std::unique_ptr<robot::RobotLink> OpenRobotLink(const robot::RobotFile& robot, c
     throw InputError(robot.source +
                      ": middleware ros1, but this mapless was built without ROS 1 (install it "
                      "with scripts/setup.sh --ros and build again)");
+#endif
+  }
+  if (robot.middleware == robot::Middleware::kRos2) {
+#ifdef MAPLESS_HAVE_ROS2
+    auto link = std::make_unique<ros2::Ros2Link>(
+        robot, image_size, method, [](const std::string& m) { spdlog::warn("{}", m); });
+    link->Start();
+    return link;
+#else
+    throw InputError(robot.source +
+                     ": middleware ros2, but this mapless was built without Cyclone DDS (install "
+                     "it with scripts/setup.sh --ros and build again)");
 #endif
   }
   throw InputError(robot.source + ": middleware " + robot::MiddlewareName(robot.middleware) +

@@ -2,8 +2,9 @@
 # Installs every Debian package mapless needs to build, test and benchmark.
 # Idempotent: packages already installed are skipped; nothing is done when all are present.
 # Usage: scripts/setup.sh            (as root, or with sudo available)
-#        scripts/setup.sh --ros      also ROS 1 (roscpp, the message packages, roscore): the robot
-#                                    link over ROS 1 is built when they are present. About 170
+#        scripts/setup.sh --ros      also ROS 1 (roscpp, the message packages, roscore) and Cyclone
+#                                    DDS for ROS 2: the robot links over ROS 1 and ROS 2 are built
+#                                    when they are present. About 180
 #                                    Debian packages, so the demo (README command 1) does without;
 #                                    the test command (command 2) and robot users take them.
 set -euo pipefail
@@ -33,6 +34,8 @@ if [ "$WITH_ROS" = "1" ]; then
     libroscpp-dev          # ROS 1 client library (Noetic level in Debian 12)
     libsensor-msgs-dev libgeometry-msgs-dev libnav-msgs-dev libstd-msgs-dev
     ros-core-dev           # roscore / rosmaster, for `mapless sim serve` and the tests
+    cyclonedds-dev cyclonedds-tools   # ROS 2 over DDS (Cyclone 0.10, as in Humble and Jazzy)
+    libsodium-dev          # SHA-256 of the ROS 2 type descriptions (the RIHS01 type hash)
   )
 fi
 

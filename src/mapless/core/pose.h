@@ -15,6 +15,10 @@ double WrapAngle(double angle_rad);
 
 inline double DegToRad(double deg) { return deg * kPi / 180.0; }
 inline double RadToDeg(double rad) { return rad * 180.0 / kPi; }
+// The yaw (rotation about z) of a unit quaternion, and the quaternion of a yaw (REP-103: z up).
+inline double YawFromQuaternion(double x, double y, double z, double w) {
+  return std::atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z));
+}
 
 // Pose of a frame on the plane: world_from_robot maps robot coordinates to world coordinates.
 struct Pose2 {

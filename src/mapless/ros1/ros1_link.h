@@ -17,12 +17,13 @@
 #include <opencv2/core.hpp>
 #include <string>
 
+#include "mapless/robot/inbox.h"
 #include "mapless/robot/link.h"
 #include "mapless/robot/robot_file.h"
 
 namespace mapless::ros1 {
 
-using Logger = std::function<void(const std::string&)>;
+using Logger = robot::Logger;
 
 // Starts roscpp once per process under the robot file's node name (no SIGINT handler: the app's
 // own stops the loop). Sets /use_sim_time on the master when the robot file asks for it. Throws
