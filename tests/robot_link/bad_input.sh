@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
-# Bad input on the robot link (issue 17): each case must end with one clear line naming the field,
+# Bad input on the robot link (issues 17, 18): each case must end with one clear line naming the field,
 # topic or encoding, the robot stopped (exit 1) or the input refused (exit 2), never a crash; and a
-# camera of another size or a compressed camera is converted, not refused. Exit 77 without ROS 1.
-#   tests/ros1/bad_input.sh MAPLESS
+# camera of another size or a compressed camera is converted, not refused. Exit 77 without the
+# middleware.
+#   tests/robot_link/bad_input.sh MAPLESS ros1|ros2
 set -uo pipefail
-BIN=$1
-# shellcheck source=master.sh
-source "$(dirname "$0")/master.sh" bad_input.sh
+BIN=$1; MW=$2
+# shellcheck source=env.sh
+source "$(dirname "$0")/env.sh" bad_input.sh "$MW"
 "$BIN" teach --source sim:table1_almost_straight --out "$OUT/route" >"$OUT/teach.log" 2>&1 ||
   { echo "bad_input.sh: teach failed"; exit 1; }
 FAILS=0
@@ -32,12 +33,12 @@ serve() {  # robot.yaml extra-args...
 stop_serve() { kill -INT "$SERVE" 2>/dev/null; sleep 0.3; kill -9 "$SERVE" 2>/dev/null; wait "$SERVE" 2>/dev/null; }
 
 # 1. A robot file with an unknown field: refused before anything connects.
-printf 'use_sim_time: true\ntopics: {imag: camera/image_raw}\n' >"$OUT/unknown.yaml"
+printf 'middleware: %s\nuse_sim_time: true\ntopics: {imag: camera/image_raw}\n' "$MW" >"$OUT/unknown.yaml"
 timeout 30 "$BIN" repeat --route "$OUT/route" --robot "$OUT/unknown.yaml" 2>"$OUT/e1" >/dev/null
 check "robot file with an unknown field" 2 $? "$OUT/e1" "topics.imag"
 
 # 2. A wrong encoding: one warning, the robot stopped, giving up after 2 s.
-printf 'use_sim_time: true\nsafety: {give_up_without_frames_s: 2}\n' >"$OUT/giveup.yaml"
+printf 'middleware: %s\nuse_sim_time: true\nsafety: {give_up_without_frames_s: 2}\n' "$MW" >"$OUT/giveup.yaml"
 serve "$OUT/giveup.yaml" --encoding yuv422
 timeout 30 "$BIN" repeat --route "$OUT/route" --robot "$OUT/giveup.yaml" 2>"$OUT/e2" >/dev/null
 check "camera in an unsupported encoding" 1 $? "$OUT/e2" "encoding 'yuv422' is not supported"
@@ -46,12 +47,12 @@ check "camera in an unsupported encoding" 1 $? "$OUT/e2" "encoding 'yuv422' is n
 stop_serve
 
 # 3. A missing topic: nobody publishes the camera the robot file names.
-printf 'use_sim_time: false\ntopics: {image: front_camera/image_raw}\nsafety: {give_up_without_frames_s: 2, connect_timeout_s: 1}\n' >"$OUT/missing.yaml"
+printf 'middleware: %s\nuse_sim_time: false\ntopics: {image: front_camera/image_raw}\nsafety: {give_up_without_frames_s: 2, connect_timeout_s: 1}\n' "$MW" >"$OUT/missing.yaml"
 timeout 30 "$BIN" repeat --route "$OUT/route" --robot "$OUT/missing.yaml" 2>"$OUT/e3" >/dev/null
 check "camera topic with no publisher" 1 $? "$OUT/e3" "/front_camera/image_raw.*no publisher"
 
 # 4. A camera of another size, JPEG-compressed: converted and resized, the repeat completes.
-printf 'use_sim_time: true\ntopics: {compressed_image: camera/image_raw/compressed}\n' >"$OUT/jpeg.yaml"
+printf 'middleware: %s\nuse_sim_time: true\ntopics: {compressed_image: camera/image_raw/compressed}\n' "$MW" >"$OUT/jpeg.yaml"
 serve "$OUT/jpeg.yaml" --encoding jpeg --size 640x480
 timeout 120 "$BIN" repeat --route "$OUT/route" --robot "$OUT/jpeg.yaml" 2>"$OUT/e4" >/dev/null
 RC=$?
@@ -63,7 +64,7 @@ fi
 stop_serve
 
 # 5. An RGB camera: converted to grey, the decisions are those of the mono8 camera.
-printf 'use_sim_time: true\n' >"$OUT/rgb.yaml"
+printf 'middleware: %s\nuse_sim_time: true\n' "$MW" >"$OUT/rgb.yaml"
 for enc in mono8 rgb8; do
   serve "$OUT/rgb.yaml" --encoding "$enc" --seed 3
   timeout 120 "$BIN" repeat --route "$OUT/route" --robot "$OUT/rgb.yaml" --log "$OUT/$enc.jsonl" \

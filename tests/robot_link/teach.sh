@@ -1,20 +1,20 @@
 #!/usr/bin/env bash
-# Teaching on a robot (issue 17): `mapless teach --robot` records while the robot is driven by
+# Teaching on a robot (issues 17, 18): `mapless teach --robot` records while the robot is driven by
 # someone else — here `mapless repeat --robot` of a route taught on the simulator stands in for the
 # person with the joystick — and Ctrl-C ends the teach with a complete route that loads. Both route
 # kinds at once: keyframes (funnel lanes) and appearance route images (eigenspace). Exit 77
-# (skipped) without ROS 1.
-#   tests/ros1/teach.sh MAPLESS [SECONDS]
+# (skipped) without the middleware.
+#   tests/robot_link/teach.sh MAPLESS ros1|ros2 [SECONDS]
 set -uo pipefail
-BIN=$1; SECONDS_TO_TEACH=${2:-15}
-# shellcheck source=master.sh
-source "$(dirname "$0")/master.sh" teach.sh
-printf 'name: real-time simulated robot\nuse_sim_time: false\n' >"$OUT/robot.yaml"
+BIN=$1; MW=$2; SECONDS_TO_TEACH=${3:-15}
+# shellcheck source=env.sh
+source "$(dirname "$0")/env.sh" teach.sh "$MW"
+printf 'middleware: %s\nname: real-time simulated robot\nuse_sim_time: false\n' "$MW" >"$OUT/robot.yaml"
 "$BIN" teach --source sim:table1_almost_straight --out "$OUT/driver_route" >"$OUT/t0.log" 2>&1 ||
   { echo "teach.sh: teach on the simulator failed"; exit 1; }
 # The teach nodes are distinct ROS nodes: each gets its own node name through its own robot file.
-printf 'use_sim_time: false\nnode_name: teach_funnel\n' >"$OUT/teach_funnel.yaml"
-printf 'use_sim_time: false\nnode_name: teach_eigenspace\n' >"$OUT/teach_eigenspace.yaml"
+printf 'middleware: %s\nuse_sim_time: false\nnode_name: teach_funnel\n' "$MW" >"$OUT/teach_funnel.yaml"
+printf 'middleware: %s\nuse_sim_time: false\nnode_name: teach_eigenspace\n' "$MW" >"$OUT/teach_eigenspace.yaml"
 "$BIN" sim serve --scenario table1_almost_straight --robot "$OUT/robot.yaml" --like teach \
   >"$OUT/serve.log" 2>&1 &
 PIDS+=($!)

@@ -1,16 +1,17 @@
 #!/usr/bin/env bash
-# Closed loop through ROS 1 on loopback (issue 17): a ROS master, `mapless sim serve` as the robot
-# and the method as a second process, in simulated time (lockstep), compared run by run with the
-# same run driven directly on the simulator (same scenario, seed and options).
+# Closed loop through ROS 1 or ROS 2 on loopback (issues 17, 18): `mapless sim serve` as the robot
+# and the method as a second process (with a private ROS master for ROS 1, a domain of its own on
+# loopback for ROS 2), in simulated time (lockstep), compared run by run with the same run driven
+# directly on the simulator (same scenario, seed and options).
 #
-#   tests/ros1/closed_loop.sh [--runs N] [--methods repeat,navigate,follow] [--seed S] [--out DIR]
-#                             [--mapless BIN] [--port P]
+#   tests/robot_link/closed_loop.sh [--middleware ros1|ros2] [--runs N]
+#       [--methods repeat,navigate,follow] [--seed S] [--out DIR] [--mapless BIN]
 #
 # Per line: runs that completed through ROS, runs that completed directly, the largest distance
 # between the final poses of the two (the pose at the method's last decision), collisions. A line
 # passes when every run completed both ways, without a collision, and every pair of final poses
 # lies within 0.05 m. Exit 0 when every line passes, 1 otherwise, 2 on bad usage; 77 (skipped)
-# when ROS 1 or the adapter is absent.
+# when the middleware or its adapter is absent.
 set -uo pipefail
 cd "$(dirname "$0")/../.."
 RUNS=10
@@ -18,7 +19,7 @@ METHODS=repeat,navigate,follow
 SEED=1
 OUT=""
 BIN=build/release/apps/mapless
-PORT=$((20000 + $$ % 20000))
+MW=ros1
 while [ $# -gt 0 ]; do
   case "$1" in
     --runs) RUNS="$2"; shift 2 ;;
@@ -26,42 +27,22 @@ while [ $# -gt 0 ]; do
     --seed) SEED="$2"; shift 2 ;;
     --out) OUT="$2"; shift 2 ;;
     --mapless) BIN="$2"; shift 2 ;;
-    --port) PORT="$2"; shift 2 ;;
+    --middleware) MW="$2"; shift 2 ;;
     *) echo "closed_loop.sh: unknown option $1" >&2; exit 2 ;;
   esac
 done
 case "$RUNS" in ''|*[!0-9]*) echo "closed_loop.sh: --runs $RUNS: not a number" >&2; exit 2 ;; esac
-if ! command -v rosmaster >/dev/null 2>&1; then
-  echo "closed_loop.sh: SKIPPED: rosmaster not found (scripts/setup.sh --ros installs ROS 1)"
-  exit 77
-fi
 if ! "$BIN" sim serve --help >/dev/null 2>&1 || ! "$BIN" sim serve --help | grep -q -- --robot; then
   echo "closed_loop.sh: SKIPPED: $BIN has no sim serve" ; exit 77
 fi
 BIN=$(realpath "$BIN")
-[ -n "$OUT" ] || OUT=$(mktemp -d /tmp/mapless_ros1.XXXXXX)
-mkdir -p "$OUT"
-OUT=$(realpath "$OUT")
-
-export ROS_MASTER_URI="http://127.0.0.1:$PORT" ROS_IP=127.0.0.1 ROS_HOSTNAME=127.0.0.1
-export ROS_HOME="$OUT/roshome" ROS_LOG_DIR="$OUT/roshome/log"
-PIDS=()
-cleanup() {
-  for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null; done
-  sleep 0.2
-  for p in "${PIDS[@]}"; do kill -9 "$p" 2>/dev/null; wait "$p" 2>/dev/null; done
-}
-trap cleanup EXIT INT TERM
-rosmaster --core -p "$PORT" >"$OUT/master.log" 2>&1 &
-PIDS+=($!)
-for _ in $(seq 1 100); do
-  grep -q "started" "$OUT/master.log" 2>/dev/null && break
-  (exec 3<>"/dev/tcp/127.0.0.1/$PORT") 2>/dev/null && break
-  sleep 0.1
-done
+[ -n "$OUT" ] || OUT=$(mktemp -d /tmp/mapless_closed_loop.XXXXXX)  # kept: the runs are in it
+# shellcheck source=env.sh
+source "$(dirname "$0")/env.sh" closed_loop "$MW"
 
 cat >"$OUT/robot.yaml" <<YAML
-# The simulated robot over ROS 1, in simulated time (lockstep with the method). The limits are
+middleware: $MW
+# The simulated robot over the middleware, in simulated time (lockstep with the method). The limits are
 # the simulated robot's own (sim::RobotOptions), so that they clamp nothing the direct run does not.
 name: simulated
 use_sim_time: true

@@ -1,18 +1,19 @@
 #!/usr/bin/env bash
-# Safety on the ROS 1 link (issue 17): while `mapless repeat --robot` drives a simulated robot
+# Safety on the robot link, ROS 1 or ROS 2 (issues 17, 18): while `mapless repeat --robot` drives a simulated robot
 # (`mapless sim serve`, real time), each of these must give a zero Twist within 0.3 s:
 #   - the camera publisher killed (SIGKILL): the watchdog;
 #   - Ctrl-C (SIGINT) to the method: the zero goes out before it leaves;
 #   - true on the e-stop topic: zero until false, then the robot is driven again.
 # First (mode topics) it checks the status (JSON per frame) and debug image topics while it drives.
 # A probe (safety_probe) waits until the robot is driven, acts, and times the first command after.
-# Exit 77 (skipped) without ROS 1.
-#   tests/ros1/safety.sh MAPLESS SAFETY_PROBE [RUNS]
+# Exit 77 (skipped) without the middleware. The probe is the middleware's own (tests/ros1,
+# tests/ros2: safety_probe.cc).
+#   tests/robot_link/safety.sh MAPLESS SAFETY_PROBE ros1|ros2 [RUNS]
 set -uo pipefail
-BIN=$1; PROBE=$2; RUNS=${3:-3}
-# shellcheck source=master.sh
-source "$(dirname "$0")/master.sh" safety.sh
-printf 'name: real-time simulated robot\nuse_sim_time: false\n' >"$OUT/robot.yaml"
+BIN=$1; PROBE=$2; MW=$3; RUNS=${4:-3}
+# shellcheck source=env.sh
+source "$(dirname "$0")/env.sh" safety.sh "$MW"
+printf 'middleware: %s\nname: real-time simulated robot\nuse_sim_time: false\n' "$MW" >"$OUT/robot.yaml"
 "$BIN" teach --source sim:table1_almost_straight --out "$OUT/route" >"$OUT/teach.log" 2>&1 ||
   { echo "safety.sh: teach failed"; exit 1; }
 FAILS=0

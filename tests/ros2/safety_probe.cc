@@ -1,0 +1,175 @@
+// The ROS 2 safety tests' probe (issue 18), the DDS twin of tests/ros1/safety_probe.cc: reads
+// cmd_vel (rt/cmd_vel), waits until the robot is being driven (N non-zero commands), then does one
+// thing and measures the time until the method publishes a zero Twist:
+//   kill PID    SIGKILL to the camera publisher (the watchdog)
+//   int PID     SIGINT to the method (Ctrl-C)
+//   estop       true on /mapless/estop; then false, and the robot must be driven again within 2 s
+//   topics      (no action) the status topic carries one JSON object per frame naming the method,
+//               and the debug image topic bgr8 pictures at least 320 wide
+// Prints one JSON line; exit 0 when the zero came within the limit, 1 otherwise.
+//   safety_probe kill|int|estop|topics PID LIMIT_S [NONZERO_COMMANDS]
+#include <signal.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "mapless/ros2/dds.h"
+#include "mapless/ros2/messages.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using namespace mapless::ros2;  // NOLINT: a test program
+
+std::mutex g_mutex;
+int g_nonzero = 0;
+bool g_acted = false;
+Clock::time_point g_act_time;
+bool g_after = false;
+bool g_after_zero = false;
+double g_after_s = 0.0;
+bool g_released = false;
+int g_nonzero_after_release = 0;
+int g_nonzero_during_stop = 0;  // must stay 0 while the e-stop is on
+int g_statuses = 0, g_good_statuses = 0, g_images = 0, g_good_images = 0;
+
+void OnTwist(dds_entity_t reader, void*) {
+  TakeAll<geometry_msgs_msg_dds__Twist_>(reader, [](const geometry_msgs_msg_dds__Twist_& t) {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    const bool zero = t.linear.x == 0.0 && t.angular.z == 0.0;
+    if (!g_acted) {
+      if (!zero) ++g_nonzero;
+      return;
+    }
+    if (g_released && !zero) ++g_nonzero_after_release;
+    if (!g_released && !zero) ++g_nonzero_during_stop;
+    if (g_after) return;
+    g_after = true;
+    g_after_zero = zero;
+    g_after_s = std::chrono::duration<double>(Clock::now() - g_act_time).count();
+  });
+}
+
+void OnStatus(dds_entity_t reader, void*) {
+  TakeAll<std_msgs_msg_dds__String_>(reader, [](const std_msgs_msg_dds__String_& s) {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    ++g_statuses;
+    const std::string t = s.data ? s.data : "";
+    if (t.size() > 2 && t.front() == '{' && t.back() == '}' &&
+        t.find("\"method\":\"repeat\"") != std::string::npos)
+      ++g_good_statuses;
+  });
+}
+
+void OnDebug(dds_entity_t reader, void*) {
+  TakeAll<sensor_msgs_msg_dds__Image_>(reader, [](const sensor_msgs_msg_dds__Image_& m) {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    ++g_images;
+    if (m.encoding != nullptr && std::string(m.encoding) == "bgr8" && m.width >= 320 &&
+        m.data._length == static_cast<std::size_t>(m.step) * m.height)
+      ++g_good_images;
+  });
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 4) {
+    std::fprintf(stderr, "usage: safety_probe kill|int|estop|topics PID LIMIT_S [NONZERO]\n");
+    return 2;
+  }
+  const std::string mode = argv[1];
+  const int pid = std::atoi(argv[2]);
+  const double limit = std::atof(argv[3]);
+  const int wanted = argc > 4 ? std::atoi(argv[4]) : 10;
+  dds_listener_t* listener = dds_create_listener(nullptr);
+  dds_lset_data_available(listener, OnTwist);
+  MakeReader(&geometry_msgs_msg_dds__Twist__desc, "/cmd_vel", "geometry_msgs/msg/Twist",
+             Qos::kDefault, listener);
+  const dds_entity_t estop = MakeWriter(&std_msgs_msg_dds__Bool__desc, "/mapless/estop",
+                                        "std_msgs/msg/Bool", Qos::kDefault);
+  if (mode == "topics") {
+    dds_lset_data_available(listener, OnStatus);
+    MakeReader(&std_msgs_msg_dds__String__desc, "/mapless/status", "std_msgs/msg/String",
+               Qos::kDefault, listener);
+    dds_lset_data_available(listener, OnDebug);
+    MakeReader(&sensor_msgs_msg_dds__Image__desc, "/mapless/debug_image", "sensor_msgs/msg/Image",
+               Qos::kSensorData, listener);
+    const auto until = Clock::now() + std::chrono::seconds(20);
+    while (Clock::now() < until) {
+      {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        if (g_good_statuses >= 10 && g_good_images >= 5) break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    std::lock_guard<std::mutex> lock(g_mutex);
+    std::printf("{\"mode\": \"topics\", \"statuses\": %d, \"good_statuses\": %d, "
+                "\"debug_images\": %d, \"good_debug_images\": %d}\n",
+                g_statuses, g_good_statuses, g_images, g_good_images);
+    std::fflush(stdout);
+    const bool ok = g_good_statuses >= 10 && g_good_images >= 5 && g_good_statuses == g_statuses;
+    std::_Exit(ok ? 0 : 1);  // no DDS teardown while listeners may run
+  }
+  const auto deadline = Clock::now() + std::chrono::seconds(60);
+  while (true) {
+    {
+      std::lock_guard<std::mutex> lock(g_mutex);
+      if (g_nonzero >= wanted) {
+        g_acted = true;
+        g_act_time = Clock::now();
+        if (mode == "kill") {
+          kill(pid, SIGKILL);
+        } else if (mode == "int") {
+          kill(pid, SIGINT);
+        } else {
+          WriteBool(estop, true);
+        }
+        break;
+      }
+    }
+    if (Clock::now() > deadline) {
+      std::printf("{\"error\": \"the robot was never driven (%d non-zero commands)\"}\n",
+                  g_nonzero);
+      std::fflush(stdout);
+      std::_Exit(1);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  const auto wait_until = Clock::now() + std::chrono::seconds(3);
+  while (Clock::now() < wait_until) {
+    {
+      std::lock_guard<std::mutex> lock(g_mutex);
+      if (g_after) break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  bool resumed = true;
+  if (mode == "estop") {
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    {
+      std::lock_guard<std::mutex> lock(g_mutex);
+      g_released = true;
+      if (g_nonzero_during_stop > 0) resumed = false;
+    }
+    WriteBool(estop, false);
+    std::this_thread::sleep_for(std::chrono::seconds(2));
+    std::lock_guard<std::mutex> lock(g_mutex);
+    resumed = resumed && g_nonzero_after_release > 0;
+  }
+  std::lock_guard<std::mutex> lock(g_mutex);
+  if (!g_after) {
+    std::printf("{\"mode\": \"%s\", \"error\": \"no command within 3 s\"}\n", mode.c_str());
+    std::fflush(stdout);
+    std::_Exit(1);
+  }
+  std::printf("{\"mode\": \"%s\", \"zero\": %s, \"after_s\": %.4f, \"limit_s\": %.3f%s}\n",
+              mode.c_str(), g_after_zero ? "true" : "false", g_after_s, limit,
+              mode == "estop" ? (resumed ? ", \"resumed\": true" : ", \"resumed\": false") : "");
+  std::fflush(stdout);
+  std::_Exit(g_after_zero && g_after_s <= limit && resumed ? 0 : 1);
+}
