@@ -11,6 +11,7 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "cli_common.h"
+#include "mapless/core/check.h"
 #include "mapless/appearance/image.h"
 #include "mapless/appearance/pca.h"
 #include "mapless/appearance/subwindow.h"
@@ -23,7 +24,8 @@
 
 namespace mapless::app {
 
-void BenchRos1(nlohmann::json* j);  // bench_ros1.cc
+void BenchRos1(nlohmann::json* j);  // bench_links.cc
+void BenchRos2(nlohmann::json* j);  // bench_links.cc
 
 namespace {
 
@@ -266,12 +268,35 @@ void BenchEigenspace(int repeats, nlohmann::json* j) {
 
 }  // namespace
 
+// The robot-link rows of the table (issues 17, 18), for the middlewares that were measured.
+static void PrintLinkRows(const nlohmann::json& j) {
+  for (const char* mw : {"ros1", "ros2"}) {
+    const std::string prefix = std::string(mw) + "_link";
+    if (j.contains(prefix)) {
+      std::printf("%-34s %s\n", prefix.c_str(), j[prefix].get<std::string>().c_str());
+      continue;
+    }
+    for (const char* cam : {"320x240_mono8", "640x480_rgb8"}) {
+      const std::string k = prefix + "_" + cam;
+      if (!j.contains(k + "_adapter_median_ms")) continue;
+      std::printf("%-34s %10.3f  p99 %.3f  (issues 17, 18: p99 <= 5)\n",
+                  (std::string(mw) + " adapter " + cam).c_str(),
+                  j[k + "_adapter_median_ms"].get<double>(), j[k + "_adapter_p99_ms"].get<double>());
+      std::printf("%-34s %10.3f  p99 %.3f\n", (std::string(mw) + " end to end " + cam).c_str(),
+                  j[k + "_end_to_end_median_ms"].get<double>(),
+                  j[k + "_end_to_end_p99_ms"].get<double>());
+    }
+  }
+}
+
 void AddBenchCommand(CLI::App* app) {
   struct Args {
     bool json = false;
     int repeats = 100;
     std::string scenario;  // empty: the default mix of indoor, outdoor and aliasing scenes
     bool ros1 = false;
+    bool ros2 = false;
+    bool links_only = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* bench = app->add_subcommand(
@@ -287,7 +312,25 @@ void AddBenchCommand(CLI::App* app) {
   bench->add_flag("--ros1", args->ros1,
                   "Also the ROS 1 adapter's latency, frame received to command published "
                   "(starts a ROS master on loopback)");
+  bench->add_flag("--ros2", args->ros2,
+                  "Also the ROS 2 (DDS) adapter's latency, frame received to command published "
+                  "(a DDS domain of its own on loopback)");
+  bench->add_flag("--links-only", args->links_only,
+                  "Only the robot-link rows (with --ros1 and/or --ros2), not the method stages");
   bench->callback([args] {
+    if (args->links_only) {
+      if (!args->ros1 && !args->ros2) throw InputError("--links-only: add --ros1 and/or --ros2");
+      nlohmann::json j;
+      if (args->ros1) BenchRos1(&j);
+    if (args->ros2) BenchRos2(&j);
+      if (args->ros2) BenchRos2(&j);
+      if (args->json) {
+        std::cout << j.dump() << "\n";
+      } else {
+        PrintLinkRows(j);
+      }
+      return;
+    }
     cv::setNumThreads(1);
     const std::vector<std::string> names =
         args->scenario.empty()
@@ -366,6 +409,7 @@ void AddBenchCommand(CLI::App* app) {
     BenchPotential(args->repeats, &j);
     BenchEigenspace(args->repeats, &j);
     if (args->ros1) BenchRos1(&j);
+    if (args->ros2) BenchRos2(&j);
     if (args->json) {
       std::cout << j.dump() << "\n";
       return;
@@ -395,20 +439,7 @@ void AddBenchCommand(CLI::App* app) {
       std::printf("%-34s %10.2f  (issue 5: <= 1.5)\n", (std::string(key) + " / dis_fast").c_str(),
                   j[std::string(key) + "_over_dis_fast"].get<double>());
     }
-    if (j.contains("ros1_link")) {
-      std::printf("%-34s %s\n", "ros1_link", j["ros1_link"].get<std::string>().c_str());
-    } else if (args->ros1) {
-      for (const char* cam : {"320x240_mono8", "640x480_rgb8"}) {
-        const std::string k = std::string("ros1_link_") + cam;
-        std::printf("%-34s %10.3f  p99 %.3f  (issue 17: p99 <= 5)\n",
-                    ("ros1 adapter " + std::string(cam)).c_str(),
-                    j[k + "_adapter_median_ms"].get<double>(),
-                    j[k + "_adapter_p99_ms"].get<double>());
-        std::printf("%-34s %10.3f  p99 %.3f\n", ("ros1 end to end " + std::string(cam)).c_str(),
-                    j[k + "_end_to_end_median_ms"].get<double>(),
-                    j[k + "_end_to_end_p99_ms"].get<double>());
-      }
-    }
+    PrintLinkRows(j);
   });
 }
 

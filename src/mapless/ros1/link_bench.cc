@@ -22,33 +22,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Answers every frame at once with a command that encodes the frame's stamp (so that the
-// listener can pair command and frame).
-class EchoMethod : public robot::Method {
- public:
-  explicit EchoMethod(cv::Size size) : size_(size) {}
-  const char* name() const override { return "bench"; }
-  bool needs_odometry() const override { return false; }
-  cv::Size image_size() const override { return size_; }
-  robot::Decision Step(const robot::Observation& o) override {
-    robot::Decision d;
-    d.state = robot::MethodState::kDriving;
-    d.status = "driving";
-    d.command = Twist2{0.1, static_cast<double>(o.t_ns % 1000000000) * 1e-9};
-    return d;
-  }
-
- private:
-  cv::Size size_;
-};
-
-double Percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const auto i = static_cast<std::size_t>(std::min<double>(v.size() - 1, p * (v.size() - 1) + 0.5));
-  return v[i];
-}
-
 }  // namespace
 
 LinkBenchResult BenchLink(const LinkBenchOptions& options) {
@@ -78,7 +51,7 @@ LinkBenchResult BenchLink(const LinkBenchOptions& options) {
   ros::AsyncSpinner spinner(1);
   spinner.start();
 
-  EchoMethod method(options.method);
+  robot::EchoMethod method(options.method);
   LinkBenchResult result;
   {
     Ros1Link link(file, options.method, "bench", {});
@@ -122,12 +95,12 @@ LinkBenchResult BenchLink(const LinkBenchOptions& options) {
     std::vector<double> adapter;
     for (const std::int64_t ns : link.latencies_ns()) adapter.push_back(ns * 1e-6);
     result.frames = static_cast<int>(adapter.size());
-    result.adapter_median_ms = Percentile(adapter, 0.5);
-    result.adapter_p99_ms = Percentile(adapter, 0.99);
+    result.adapter_median_ms = robot::Percentile(adapter, 0.5);
+    result.adapter_p99_ms = robot::Percentile(adapter, 0.99);
   }
   std::lock_guard<std::mutex> lock(mutex);
-  result.end_to_end_median_ms = Percentile(end_to_end, 0.5);
-  result.end_to_end_p99_ms = Percentile(end_to_end, 0.99);
+  result.end_to_end_median_ms = robot::Percentile(end_to_end, 0.5);
+  result.end_to_end_p99_ms = robot::Percentile(end_to_end, 0.99);
   spinner.stop();
   return result;
 }
