@@ -150,6 +150,20 @@ ddsrt_iovec_t Iov(const std::string& bytes) {
   return iov;
 }
 
+// CDR bytes decoded by Cyclone into mapless's type, written as ROS fields to `path`; false when
+// Cyclone refuses them.
+bool DecodeToJson(const Kind& k, const ddsi_sertype* type, const std::string& bytes,
+                  const std::string& path) {
+  ddsrt_iovec_t iov = Iov(bytes);
+  ddsi_serdata* d = ddsi_serdata_from_ser_iov(type, SDK_DATA, 1, &iov, bytes.size());
+  void* sample = dds_alloc(k.desc->m_size);
+  const bool ok = d != nullptr && ddsi_serdata_to_sample(d, sample, nullptr, nullptr);
+  if (ok) WriteFile(path, k.print(sample).dump(1) + "\n");
+  dds_sample_free(sample, k.desc, DDS_FREE_ALL);
+  if (d) ddsi_serdata_unref(d);
+  return ok;
+}
+
 // Writes one sample with mapless's writer and takes it off a reader of the same topic as raw CDR.
 // Also returns the sertype (for decoding).
 std::string Capture(const Kind& k, const ddsi_sertype** type) {
@@ -193,13 +207,7 @@ int main(int argc, char** argv) {
     }
     if (mode == "encode") {
       // What was written, read back through Cyclone's own decoder: the values as ROS fields.
-      ddsrt_iovec_t iov = Iov(bytes);
-      ddsi_serdata* d = ddsi_serdata_from_ser_iov(type, SDK_DATA, 1, &iov, bytes.size());
-      void* sample = dds_alloc(k.desc->m_size);
-      const bool ok = d != nullptr && ddsi_serdata_to_sample(d, sample, nullptr, nullptr);
-      if (ok) WriteFile(dir + "/" + k.name + ".json", k.print(sample).dump(1) + "\n");
-      dds_sample_free(sample, k.desc, DDS_FREE_ALL);
-      if (d) ddsi_serdata_unref(d);
+      const bool ok = DecodeToJson(k, type, bytes, dir + "/" + k.name + ".json");
       WriteFile(dir + "/" + k.name + ".cdr", bytes);
       WriteFile(dir + "/" + k.name + ".msg", ConcatenatedDefinition(k.ros_type));
       WriteFile(dir + "/" + k.name + ".type", k.ros_type);
@@ -210,13 +218,7 @@ int main(int argc, char** argv) {
     const std::string in = dir + "/" + k.name + ".in.cdr";
     const std::string foreign = ReadFile(in);
     if (foreign.empty()) continue;  // not a type the other side encodes
-    ddsrt_iovec_t iov = Iov(foreign);
-    ddsi_serdata* d = ddsi_serdata_from_ser_iov(type, SDK_DATA, 1, &iov, foreign.size());
-    void* sample = dds_alloc(k.desc->m_size);
-    const bool ok = d != nullptr && ddsi_serdata_to_sample(d, sample, nullptr, nullptr);
-    if (ok) WriteFile(dir + "/" + k.name + ".in.decoded.json", k.print(sample).dump(1) + "\n");
-    dds_sample_free(sample, k.desc, DDS_FREE_ALL);
-    if (d) ddsi_serdata_unref(d);
+    const bool ok = DecodeToJson(k, type, foreign, dir + "/" + k.name + ".in.decoded.json");
     std::printf("%s %s: %zu bytes decoded by Cyclone\n", ok ? "ok  " : "FAIL", k.name.c_str(),
                 foreign.size());
     failures += ok ? 0 : 1;
