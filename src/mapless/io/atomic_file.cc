@@ -41,7 +41,7 @@ OutputKind KindOfOutput(const std::string& path) {
   return S_ISREG(st.st_mode) ? OutputKind::kNewOrRegular : OutputKind::kStream;
 }
 
-void WriteFileAtomic(const std::string& path, std::string_view bytes) {
+void WriteFileAtomic(const std::string& path, std::string_view bytes, bool sync) {
   if (KindOfOutput(path) == OutputKind::kStream) {
     // A device or a pipe (/dev/stdout, /dev/null): written to, never replaced by a file.
     const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | O_NOCTTY);
@@ -62,7 +62,7 @@ void WriteFileAtomic(const std::string& path, std::string_view bytes) {
     ::unlink(tmp.c_str());
     throw InputError(path + ": cannot write: " + why);
   }
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+  if ((sync && ::fsync(fd) != 0) || ::close(fd) != 0) {
     const std::string why = std::strerror(errno);
     ::unlink(tmp.c_str());
     throw InputError(path + ": cannot write: " + why);
@@ -74,9 +74,17 @@ void WriteFileAtomic(const std::string& path, std::string_view bytes) {
   }
 }
 
-void WriteImageAtomic(const std::string& path, const cv::Mat& image) {
-  const std::string ext = std::filesystem::path(path).extension().string();
-  if (ext.empty()) throw InputError(path + ": image file name needs an extension such as .png");
+void SyncFile(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0 || ::fsync(fd) != 0) {
+    const std::string why = std::strerror(errno);
+    if (fd >= 0) ::close(fd);
+    throw InputError(path + ": cannot flush to disk: " + why);
+  }
+  ::close(fd);
+}
+
+std::string EncodeImage(const cv::Mat& image, const std::string& ext, const std::string& name) {
   std::vector<uchar> buffer;
   bool ok = false;
   try {
@@ -84,9 +92,14 @@ void WriteImageAtomic(const std::string& path, const cv::Mat& image) {
   } catch (const cv::Exception&) {
     ok = false;
   }
-  if (!ok) throw InputError(path + ": cannot encode an image as '" + ext + "'");
-  WriteFileAtomic(path,
-                  std::string_view(reinterpret_cast<const char*>(buffer.data()), buffer.size()));
+  if (!ok) throw InputError(name + ": cannot encode an image as '" + ext + "'");
+  return std::string(reinterpret_cast<const char*>(buffer.data()), buffer.size());
+}
+
+void WriteImageAtomic(const std::string& path, const cv::Mat& image) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext.empty()) throw InputError(path + ": image file name needs an extension such as .png");
+  WriteFileAtomic(path, EncodeImage(image, ext, path));
 }
 
 std::string ReadFile(const std::string& path, std::size_t max_bytes) {

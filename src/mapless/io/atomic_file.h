@@ -16,8 +16,15 @@ enum class OutputKind { kNewOrRegular, kStream };
 OutputKind KindOfOutput(const std::string& path);
 
 // Writes `bytes` to `path` atomically (a stream is written to directly); throws InputError naming
-// the path on failure.
-void WriteFileAtomic(const std::string& path, std::string_view bytes);
+// the path on failure. `sync` false: the file is renamed into place before it is on disk; call
+// SyncFile() before anything that refers to it is written (many files, one wait: a follower
+// catching up on a route).
+void WriteFileAtomic(const std::string& path, std::string_view bytes, bool sync = true);
+// Flushes a written file to disk; throws InputError naming the path on failure.
+void SyncFile(const std::string& path);
+
+// An image encoded as `ext` (".png", ...); throws InputError naming `name` when it cannot be.
+std::string EncodeImage(const cv::Mat& image, const std::string& ext, const std::string& name);
 
 // Encodes an image by the extension of `path` (.png, .jpg, ...) and writes it atomically.
 void WriteImageAtomic(const std::string& path, const cv::Mat& image);

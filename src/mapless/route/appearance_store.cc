@@ -40,22 +40,46 @@ AppearanceRouteWriter::AppearanceRouteWriter(std::string dir, int image_width, i
   WriteManifest();
 }
 
+std::unique_ptr<AppearanceRouteWriter> AppearanceRouteWriter::Reopen(const std::string& dir) {
+  const std::string manifest = (fs::path(dir) / kManifest).string();
+  std::unique_ptr<AppearanceRouteWriter> writer(new AppearanceRouteWriter());
+  writer->dir_ = dir;
+  writer->header_ =
+      ParseAppearanceManifest(io::ReadFile(manifest, io::kMaxManifestBytes), manifest, nullptr);
+  writer->entries_ = std::move(writer->header_.images);
+  writer->header_.images.clear();
+  return writer;
+}
+
 void AppearanceRouteWriter::Append(const StoredAppearanceImage& image) {
   MAPLESS_CHECK(image.low.type() == CV_8UC1 && image.low.cols == header_.low_width &&
                     image.low.rows == header_.low_height,
                 "AppearanceRouteWriter: a route image must be 8-bit " << header_.low_width << "x"
                                                                       << header_.low_height);
-  const int index = images();
-  io::WriteImageAtomic((fs::path(dir_) / ImageFile(index)).string(), image.low);
-  StoredAppearanceImage entry = image;
-  entry.low = cv::Mat();
-  entries_.push_back(entry);
+  AppendEncoded(image, io::EncodeImage(image.low, ".png", dir_));
+  Flush();
+}
+
+void AppearanceRouteWriter::AppendEncoded(const StoredAppearanceImage& entry,
+                                          std::string_view png) {
+  MAPLESS_CHECK(!header_.complete, "AppearanceRouteWriter: an image after the route's end");
+  const std::string path = (fs::path(dir_) / ImageFile(images())).string();
+  io::WriteFileAtomic(path, png, /*sync=*/false);
+  pending_.push_back(path);
+  StoredAppearanceImage e = entry;
+  e.low = cv::Mat();
+  entries_.push_back(e);
+}
+
+void AppearanceRouteWriter::Flush() {
+  for (const std::string& path : pending_) io::SyncFile(path);
+  pending_.clear();
   WriteManifest();
 }
 
 void AppearanceRouteWriter::Finish() {
   header_.complete = true;
-  WriteManifest();
+  Flush();
 }
 
 void AppearanceRouteWriter::WriteManifest() const {
@@ -79,6 +103,35 @@ void AppearanceRouteWriter::WriteManifest() const {
   }
   j["images"] = images;
   io::WriteFileAtomic((fs::path(dir_) / kManifest).string(), j.dump(1) + "\n");
+}
+
+std::string AppearanceImageFile(int index) { return ImageFile(index); }
+
+std::string AppearanceEntryJson(const StoredAppearanceImage& image) {
+  nlohmann::json j;
+  j["distance_m"] = image.distance_m;
+  j["x_m"] = image.odometry.x_m;
+  j["y_m"] = image.odometry.y_m;
+  j["theta_rad"] = image.odometry.theta_rad;
+  return j.dump();
+}
+
+StoredAppearanceImage ParseAppearanceEntry(const std::string& text, const std::string& name) {
+  const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+  MAPLESS_CHECK(!j.is_discarded() && j.is_object(), name << ": not a JSON object");
+  auto number = [&](const char* key) {
+    MAPLESS_CHECK(j.contains(key) && j[key].is_number(),
+                  name << ": " << key << ": missing or not a number");
+    const double v = j[key].get<double>();
+    MAPLESS_CHECK(std::isfinite(v) && std::abs(v) <= 1e7,
+                  name << ": " << key << " = " << v << ": out of range");
+    return v;
+  };
+  StoredAppearanceImage image;
+  image.distance_m = number("distance_m");
+  MAPLESS_CHECK(image.distance_m >= 0.0, name << ": distance_m is negative");
+  image.odometry = Pose2{number("x_m"), number("y_m"), number("theta_rad")};
+  return image;
 }
 
 StoredAppearanceRoute ParseAppearanceManifest(const std::string& text, const std::string& name,

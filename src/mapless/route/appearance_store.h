@@ -15,7 +15,9 @@
 #pragma once
 
 #include <opencv2/core.hpp>
+#include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "mapless/core/pose.h"
@@ -45,16 +47,33 @@ class AppearanceRouteWriter {
   // holds a route.
   AppearanceRouteWriter(std::string dir, int image_width, int image_height, int low_width,
                         int low_height);
+  // Goes on writing a route an interrupted teach (or a follower's copy) left in DIR.
+  static std::unique_ptr<AppearanceRouteWriter> Reopen(const std::string& dir);
   void Append(const StoredAppearanceImage& image);
-  void Finish();
+  // The same from the image's PNG bytes (a leader's record): nothing lists it until Flush(), which
+  // flushes the new files to disk and then writes the manifest.
+  void AppendEncoded(const StoredAppearanceImage& entry, std::string_view png);
+  void Flush();
+  void Finish();  // marks the route complete (and flushes)
   int images() const { return static_cast<int>(entries_.size()); }
+  bool complete() const { return header_.complete; }
+  const StoredAppearanceRoute& header() const { return header_; }  // without images
 
  private:
+  AppearanceRouteWriter() = default;
   void WriteManifest() const;
   std::string dir_;
   StoredAppearanceRoute header_;
   std::vector<StoredAppearanceImage> entries_;  // low images dropped after writing
+  std::vector<std::string> pending_;            // written, not yet flushed
 };
+
+// A route image's manifest entry without its file (distance and odometry), as a JSON object, and
+// back (checked like the manifest; errors name `name`).
+std::string AppearanceEntryJson(const StoredAppearanceImage& image);
+StoredAppearanceImage ParseAppearanceEntry(const std::string& text, const std::string& name);
+// Where route image `index` lives in the route directory ("images/NNNNNN.png").
+std::string AppearanceImageFile(int index);
 
 // Loads a stored appearance route; throws InputError naming the file and what is wrong.
 StoredAppearanceRoute LoadAppearanceRoute(const std::string& dir);

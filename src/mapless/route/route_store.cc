@@ -25,7 +25,7 @@ std::string KeyframeStem(int index) {
   return name;
 }
 
-std::string SerializeKeyframe(const Keyframe& kf) {
+std::string SerializeKeyframeYaml(const Keyframe& kf) {
   cv::FileStorage fs(
       ".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
   fs << "format"
@@ -130,21 +130,62 @@ RouteWriter::RouteWriter(std::string dir, std::string detector, int image_width,
   WriteManifest();
 }
 
+RouteWriter::RouteWriter(std::string dir, const Manifest& manifest)
+    : dir_(std::move(dir)),
+      detector_(manifest.detector),
+      width_(manifest.image_width),
+      height_(manifest.image_height),
+      complete_(manifest.complete) {
+  for (const ManifestEntry& e : manifest.keyframes) entries_.push_back({e.index, e.t_s});
+}
+
+std::unique_ptr<RouteWriter> RouteWriter::Reopen(const std::string& dir) {
+  const std::string path = (std::filesystem::path(dir) / "manifest.json").string();
+  const Manifest manifest = ParseManifest(io::ReadFile(path, io::kMaxManifestBytes), path);
+  for (std::size_t i = 0; i < manifest.keyframes.size(); ++i) {
+    const ManifestEntry& e = manifest.keyframes[i];
+    if (e.data != KeyframeStem(e.index) + ".yml" || e.thumbnail != KeyframeStem(e.index) + ".png")
+      throw InputError(path + ": keyframe " + std::to_string(i) +
+                       ": files are not where a mapless teach writes them");
+  }
+  return std::unique_ptr<RouteWriter>(new RouteWriter(dir, manifest));
+}
+
+std::string KeyframeFileStem(int index) { return KeyframeStem(index); }
+
+std::string SerializeKeyframe(const Keyframe& keyframe) { return SerializeKeyframeYaml(keyframe); }
+
 void RouteWriter::Append(const Keyframe& keyframe) {
-  MAPLESS_CHECK(keyframe.index == keyframes(),
-                "RouteWriter: keyframe index " << keyframe.index << ", expected " << keyframes());
   MAPLESS_CHECK(!keyframe.thumbnail.empty(),
                 "RouteWriter: keyframe " << keyframe.index << " has no image");
-  const std::filesystem::path base = std::filesystem::path(dir_) / KeyframeStem(keyframe.index);
-  io::WriteFileAtomic(base.string() + ".yml", SerializeKeyframe(keyframe));
-  io::WriteImageAtomic(base.string() + ".png", keyframe.thumbnail);
-  entries_.push_back({keyframe.index, keyframe.t_ns});
+  const std::string base = (std::filesystem::path(dir_) / KeyframeStem(keyframe.index)).string();
+  AppendEncoded(keyframe.index, keyframe.t_ns, SerializeKeyframe(keyframe),
+                io::EncodeImage(keyframe.thumbnail, ".png", base + ".png"));
+  Flush();
+}
+
+void RouteWriter::AppendEncoded(int index, Timestamp t_ns, std::string_view yml,
+                                std::string_view png) {
+  MAPLESS_CHECK(index == keyframes(),
+                "RouteWriter: keyframe index " << index << ", expected " << keyframes());
+  MAPLESS_CHECK(!complete_, "RouteWriter: keyframe " << index << " after the route's end");
+  const std::filesystem::path base = std::filesystem::path(dir_) / KeyframeStem(index);
+  io::WriteFileAtomic(base.string() + ".yml", yml, /*sync=*/false);
+  io::WriteFileAtomic(base.string() + ".png", png, /*sync=*/false);
+  pending_.push_back(base.string() + ".yml");
+  pending_.push_back(base.string() + ".png");
+  entries_.push_back({index, ToSeconds(t_ns)});
+}
+
+void RouteWriter::Flush() {
+  for (const std::string& path : pending_) io::SyncFile(path);
+  pending_.clear();
   WriteManifest();
 }
 
 void RouteWriter::Finish() {
   complete_ = true;
-  WriteManifest();
+  Flush();
 }
 
 void RouteWriter::WriteManifest() const {
@@ -158,7 +199,7 @@ void RouteWriter::WriteManifest() const {
   j["keyframes"] = nlohmann::json::array();
   for (const Entry& e : entries_) {
     j["keyframes"].push_back({{"index", e.index},
-                              {"t_s", ToSeconds(e.t_ns)},
+                              {"t_s", e.t_s},
                               {"data", KeyframeStem(e.index) + ".yml"},
                               {"thumbnail", KeyframeStem(e.index) + ".png"}});
   }
@@ -313,6 +354,36 @@ Manifest ParseManifest(const std::string& text, const std::string& name) {
                      std::to_string(io::kMaxImageSide) + " a side)");
   }
   return m;
+}
+
+Keyframe DecodeKeyframe(const std::string& yml, const std::string& png, const Manifest& header,
+                        int index, Timestamp after_t_ns, const std::string& name) {
+  features::DetectorType detector = features::DetectorType::kOrb;
+  try {
+    detector = features::ParseDetectorType(header.detector);
+  } catch (const InputError& e) {
+    throw InputError(name + ": detector: " + e.what());
+  }
+  Keyframe kf = ParseKeyframe(yml, name + ".yml");
+  if (kf.index != index) {
+    throw InputError(name + ".yml: keyframe index " + std::to_string(kf.index) + ", expected " +
+                     std::to_string(index));
+  }
+  ManifestEntry entry;
+  entry.index = index;
+  entry.t_s = ToSeconds(kf.t_ns);
+  CheckKeyframe(kf, entry, header, features::DescriptorLayoutOf(detector), name + ".yml");
+  if (index > 0 && kf.t_ns <= after_t_ns) {
+    throw InputError(name + ".yml: t_ns " + std::to_string(kf.t_ns) +
+                     " is not after the previous keyframe's (" + std::to_string(after_t_ns) +
+                     "): time goes backwards");
+  }
+  kf.thumbnail = io::DecodeImage(png, name + ".png", cv::IMREAD_GRAYSCALE);
+  if (kf.thumbnail.cols > header.image_width || kf.thumbnail.rows > header.image_height) {
+    throw InputError(name + ".png: keyframe image of " + std::to_string(kf.thumbnail.cols) + "x" +
+                     std::to_string(kf.thumbnail.rows) + " is larger than the route's images");
+  }
+  return kf;
 }
 
 Route LoadRoute(const std::string& dir) {

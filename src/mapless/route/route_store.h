@@ -13,7 +13,10 @@
 // every keyframe completed before the kill; `complete` is false until the teach finished.
 #pragma once
 
+#include <memory>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "mapless/route/route.h"
 
@@ -21,23 +24,35 @@ namespace mapless::route {
 
 inline constexpr int kRouteFormatVersion = 1;
 
+struct Manifest;
+
 class RouteWriter {
  public:
   // Creates DIR (and DIR/keyframes) and writes an empty manifest. Throws InputError when DIR
   // already holds a route: replacing a route is io::OutputDirectory's business (the old one stays
   // whole until the new one is done).
   RouteWriter(std::string dir, std::string detector, int image_width, int image_height);
+  // Goes on writing a route an interrupted teach (or a follower's copy) left in DIR; throws
+  // InputError naming the manifest when it cannot be read.
+  static std::unique_ptr<RouteWriter> Reopen(const std::string& dir);
   // Writes one keyframe, then the manifest that lists it.
   void Append(const Keyframe& keyframe);
-  // Marks the route complete.
+  // The same from the bytes of its two files (SerializeKeyframe, PNG), e.g. a leader's record.
+  // Nothing lists them until Flush(), which flushes them to disk and then writes the manifest:
+  // many keyframes, one manifest (a follower catching up).
+  void AppendEncoded(int index, Timestamp t_ns, std::string_view yml, std::string_view png);
+  void Flush();
+  // Marks the route complete (and flushes).
   void Finish();
   int keyframes() const { return static_cast<int>(entries_.size()); }
+  bool complete() const { return complete_; }
 
  private:
+  RouteWriter(std::string dir, const Manifest& manifest);
   void WriteManifest() const;
   struct Entry {
     int index;
-    Timestamp t_ns;
+    double t_s;
   };
   std::string dir_;
   std::string detector_;
@@ -45,7 +60,13 @@ class RouteWriter {
   int height_;
   bool complete_ = false;
   std::vector<Entry> entries_;
+  std::vector<std::string> pending_;  // written, not yet flushed
 };
+
+// A keyframe's data file, as the route store writes it (deterministic), and where a keyframe's
+// files live in the route directory ("keyframes/NNNNNN", without extension).
+std::string SerializeKeyframe(const Keyframe& keyframe);
+std::string KeyframeFileStem(int index);
 
 // Loads a route; throws InputError naming the file and what is wrong (missing, truncated,
 // corrupt, wrong version, over a limit of io/limits.h, or inconsistent: an unknown detector,
@@ -72,5 +93,11 @@ struct Manifest {
 Manifest ParseManifest(const std::string& text, const std::string& name);
 // A keyframe's data file (everything but its image).
 Keyframe ParseKeyframe(const std::string& text, const std::string& name);
+// A keyframe from the bytes of its two files (a leader's record), checked as LoadRoute checks a
+// stored one against the route's `header` (detector, image size; its keyframe list is not used):
+// its index must be `index` and, unless it is the first, its time after `after_t_ns`. Errors name
+// `name` (".yml" / ".png" appended).
+Keyframe DecodeKeyframe(const std::string& yml, const std::string& png, const Manifest& header,
+                        int index, Timestamp after_t_ns, const std::string& name);
 
 }  // namespace mapless::route

@@ -1,0 +1,57 @@
+// The follower's side of the fleet link: keeps a local copy of the leader's route (RouteCopy) in
+// step with the leader's log over ZeroMQ (a DEALER socket).
+//
+// The follower asks for the records from its copy's next sequence number on; applies each record
+// only when it is the next one (an older one is a duplicate and is dropped, a newer one means a
+// gap: it is dropped and the follower asks again from the number it needs), so nothing is applied
+// twice and nothing is skipped. When the leader has been silent for resubscribe_s (it sends a
+// heartbeat every second), the follower asks again: after a link outage, a leader restart or a
+// follower restart, the copy goes on from its last whole record.
+//
+// Runs its own thread. A malformed record is rejected with one log line and changes nothing.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mapless/fleet/curve.h"
+#include "mapless/fleet/route_log.h"
+#include "mapless/fleet/server.h"
+
+namespace mapless::fleet {
+
+struct ClientOptions {
+  std::string connect = "tcp://127.0.0.1:5600";
+  FollowerSecurity security;
+  double resubscribe_s = 2.0;
+  std::size_t max_batch = 256;  // records applied (and flushed to disk) together
+};
+
+struct ClientStats {
+  std::uint64_t received = 0;          // records taken off the link
+  std::uint64_t applied = 0;           // ... and applied to the copy (each exactly once)
+  std::uint64_t duplicates_dropped = 0;  // older than the next one needed (sent again)
+  std::uint64_t ahead_dropped = 0;       // newer than the next one needed (a gap, asked again)
+  std::uint64_t rejected = 0;            // malformed or refused by the copy
+  std::uint64_t subscriptions = 0;       // "from n" sent
+  std::uint64_t leader_records = 0;      // the leader's log size at its last heartbeat
+  bool leader_complete = false;
+  double silent_s = 0.0;                 // since the last message from the leader
+  std::vector<double> latency_ms;        // live records: leader's write to this receive
+};
+
+class FollowerClient {
+ public:
+  // `copy` must outlive the client.
+  FollowerClient(RouteCopy& copy, ClientOptions options, FleetLogger log_line);
+  ~FollowerClient();
+  ClientStats stats() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace mapless::fleet

@@ -1,0 +1,275 @@
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <thread>
+
+#include "mapless/core/check.h"
+#include "mapless/core/rng.h"
+#include "mapless/fleet/client.h"
+#include "mapless/fleet/record.h"
+#include "mapless/fleet/route_log.h"
+#include "mapless/fleet/server.h"
+#include "mapless/io/atomic_file.h"
+#include "mapless/io/limits.h"
+
+namespace mapless::fleet {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string FreshDir(const std::string& name) {
+  const std::string dir = ::testing::TempDir() + "mapless_fleet_" + name;
+  fs::remove_all(dir);
+  return dir;
+}
+
+route::Keyframe MakeKeyframe(int index) {
+  Rng rng(static_cast<std::uint64_t>(index) + 1);
+  route::Keyframe kf;
+  kf.index = index;
+  kf.t_ns = 100'000'000LL * (index + 1);
+  kf.thumbnail = cv::Mat(60, 80, CV_8UC1, cv::Scalar(10 * index));
+  for (int i = 0; i < 40; ++i)
+    kf.keypoints.emplace_back(static_cast<float>(rng.Uniform(0, 320)),
+                              static_cast<float>(rng.Uniform(0, 240)), 31.0f);
+  kf.descriptors = cv::Mat(40, 32, CV_8UC1);
+  for (int r = 0; r < 40; ++r)
+    for (int c = 0; c < 32; ++c)
+      kf.descriptors.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(rng.UniformInt(256));
+  return kf;
+}
+
+route::StoredAppearanceImage MakeImage(int index) {
+  Rng rng(static_cast<std::uint64_t>(index) + 7);
+  route::StoredAppearanceImage image;
+  image.low = cv::Mat(64, 64, CV_8UC1);
+  for (int r = 0; r < 64; ++r)
+    for (int c = 0; c < 64; ++c)
+      image.low.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(rng.UniformInt(256));
+  image.distance_m = 0.2 * index;
+  image.odometry = Pose2{0.2 * index, 0.01 * index, 0.001 * index};
+  return image;
+}
+
+// A funnel route of `keyframes` keyframes as a leader's records (sequence numbers set).
+std::vector<Record> FunnelRecords(int keyframes, bool end) {
+  RouteHeader h;
+  h.kind = RouteKind::kFunnel;
+  h.image_width = 320;
+  h.image_height = 240;
+  std::vector<Record> records = {HeaderRecord(h)};
+  for (int i = 0; i < keyframes; ++i) records.push_back(KeyframeRecord(MakeKeyframe(i)));
+  if (end) records.push_back(EndRecord());
+  for (std::size_t i = 0; i < records.size(); ++i) records[i].sequence = i;
+  return records;
+}
+
+std::vector<Record> ImageRecords(int images, bool end) {
+  RouteHeader h;
+  h.kind = RouteKind::kEigenspace;
+  h.image_width = 320;
+  h.image_height = 240;
+  h.low_width = 64;
+  h.low_height = 64;
+  std::vector<Record> records = {HeaderRecord(h)};
+  for (int i = 0; i < images; ++i) records.push_back(ImageRecord(MakeImage(i)));
+  if (end) records.push_back(EndRecord());
+  for (std::size_t i = 0; i < records.size(); ++i) records[i].sequence = i;
+  return records;
+}
+
+// Every file of a directory, by relative path, with its bytes.
+std::map<std::string, std::string> Files(const std::string& dir) {
+  std::map<std::string, std::string> out;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (!e.is_regular_file()) continue;
+    out[fs::relative(e.path(), dir).string()] = io::ReadFile(e.path().string(), 1 << 26);
+  }
+  return out;
+}
+
+TEST(FleetRecord, RoundTripsAndRejectsMalformedBytesWithOneLine) {
+  Record r;
+  r.type = RecordType::kKeyframe;
+  r.sequence = 12;
+  r.written_ns = 123456789;
+  r.parts = {"yaml bytes", std::string("\0png\xff", 5)};
+  const std::string bytes = EncodeRecord(r);
+  const Record back = DecodeRecord(bytes);
+  EXPECT_EQ(back, r);
+  EXPECT_EQ(back.written_ns, r.written_ns);
+  // Every truncation is refused, none crashes.
+  for (std::size_t n = 0; n < bytes.size(); ++n)
+    EXPECT_THROW(DecodeRecord(std::string_view(bytes).substr(0, n)), InputError) << n;
+  std::string bad = bytes;
+  bad[0] = 'X';
+  EXPECT_THROW(DecodeRecord(bad), InputError);
+  bad = bytes;
+  bad[5] = 9;  // unknown type
+  EXPECT_THROW(DecodeRecord(bad), InputError);
+  bad = bytes + "x";  // trailing bytes
+  EXPECT_THROW(DecodeRecord(bad), InputError);
+  bad = bytes;
+  bad[24] = 3;  // three parts for a keyframe
+  EXPECT_THROW(DecodeRecord(bad), InputError);
+  EXPECT_THROW(DecodeRecord(std::string(kMaxMessageBytes + 1, 'M')), InputError);
+  EXPECT_EQ(DecodeSubscribe(EncodeSubscribe(41)), 41u);
+  EXPECT_THROW(DecodeSubscribe(EncodeSubscribe(41) + "x"), InputError);
+  EXPECT_THROW(DecodeSubscribe(EncodeSubscribe(kMaxSequence + 1)), InputError);
+}
+
+TEST(FleetRouteCopy, AFollowersCopyEqualsTheLeadersByteForByteAndResumes) {
+  for (const bool funnel : {true, false}) {
+    const std::vector<Record> records = funnel ? FunnelRecords(6, true) : ImageRecords(6, true);
+    const std::string leader_dir = FreshDir(funnel ? "leader_f" : "leader_e");
+    const std::string follower_dir = FreshDir(funnel ? "follower_f" : "follower_e");
+    {
+      RouteCopy leader(leader_dir);
+      for (const Record& r : records) leader.Apply({r});  // one at a time, as taught
+      EXPECT_TRUE(leader.complete());
+    }
+    {
+      RouteCopy follower(follower_dir);
+      follower.Apply({records.begin(), records.begin() + 4});
+      EXPECT_EQ(follower.next_sequence(), 4u);
+      EXPECT_FALSE(follower.complete());
+    }
+    // A restart: the copy goes on from record 4; a duplicate or a gap is refused unapplied.
+    RouteCopy follower(follower_dir);
+    ASSERT_EQ(follower.next_sequence(), 4u);
+    EXPECT_THROW(follower.Apply({records[3]}), InputError);
+    EXPECT_THROW(follower.Apply({records[5]}), InputError);
+    EXPECT_EQ(follower.next_sequence(), 4u);
+    follower.Apply({records.begin() + 4, records.end()});
+    EXPECT_TRUE(follower.complete());
+    EXPECT_EQ(Files(follower_dir), Files(leader_dir));
+    // The records a reloaded copy serves are the ones it was given.
+    const std::vector<Record> served = RouteCopy(leader_dir).RecordsFrom(0, 100);
+    ASSERT_EQ(served.size(), records.size());
+    for (std::size_t i = 0; i < served.size(); ++i) EXPECT_EQ(served[i], records[i]) << i;
+    if (funnel) {
+      ASSERT_NE(follower.FunnelRoute(), nullptr);
+      EXPECT_EQ(follower.FunnelRoute()->keyframes.size(), 6u);
+      EXPECT_TRUE(follower.FunnelRoute()->complete);
+    } else {
+      ASSERT_NE(follower.AppearanceRoute(), nullptr);
+      EXPECT_EQ(follower.AppearanceRoute()->size(), 6);
+      // The rebuilt eigenspace is the leader's, bit for bit.
+      navigation::AppearanceLeader model;
+      for (int i = 0; i < 6; ++i) {
+        const auto image = MakeImage(i);
+        model.AddStored(image.low, image.distance_m, image.odometry);
+      }
+      model.Finish();
+      const auto expected = model.Snapshot();
+      const auto got = follower.AppearanceRoute();
+      EXPECT_EQ(got->space.mean, expected->space.mean);
+      EXPECT_EQ(got->space.basis, expected->space.basis);
+      EXPECT_EQ(got->space.projections, expected->space.projections);
+    }
+  }
+}
+
+TEST(FleetRouteCopy, ABadRecordChangesNothing) {
+  const std::string dir = FreshDir("bad");
+  std::vector<Record> records = FunnelRecords(3, false);
+  RouteCopy copy(dir);
+  copy.Apply({records[0], records[1]});
+  const auto before = Files(dir);
+  Record bad = records[2];
+  bad.parts[0] = bad.parts[0].substr(0, bad.parts[0].size() / 2);  // truncated YAML
+  EXPECT_THROW(copy.Apply({bad}), InputError);
+  Record image = ImageRecords(1, false)[1];
+  image.sequence = 2;  // an eigenspace image in a funnel route
+  EXPECT_THROW(copy.Apply({image}), InputError);
+  EXPECT_EQ(copy.next_sequence(), 2u);
+  EXPECT_EQ(Files(dir), before);
+  copy.Apply({records[2]});
+  EXPECT_EQ(copy.next_sequence(), 3u);
+}
+
+// Waits (bounded) until `done` holds.
+bool WaitFor(const std::function<bool()>& done, double seconds) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < until) {
+    if (done()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return done();
+}
+
+TEST(FleetLink, AFollowerCatchesUpThenReceivesLiveRecordsOnLoopback) {
+  const std::vector<Record> records = ImageRecords(30, true);
+  RouteCopy leader(FreshDir("link_leader"));
+  leader.Apply({records.begin(), records.begin() + 20});
+  ServerOptions server_options;
+  server_options.bind = "tcp://127.0.0.1:*";
+  LeaderServer server(leader, server_options, nullptr);
+  RouteCopy follower(FreshDir("link_follower"));
+  ClientOptions client_options;
+  client_options.connect = server.endpoint();
+  FollowerClient client(follower, client_options, nullptr);
+  ASSERT_TRUE(WaitFor([&] { return follower.next_sequence() == 20; }, 10.0));
+  for (std::size_t i = 20; i < records.size(); ++i) {
+    leader.Apply({records[i]});
+    server.Notify();
+  }
+  ASSERT_TRUE(WaitFor([&] { return client.stats().applied == records.size(); }, 10.0));
+  EXPECT_TRUE(follower.complete());
+  EXPECT_EQ(Files(follower.dir()), Files(leader.dir()));
+  const ClientStats stats = client.stats();
+  EXPECT_EQ(stats.applied, records.size());
+  EXPECT_EQ(stats.rejected, 0u);
+  EXPECT_GE(stats.latency_ms.size(), 1u);  // the live ones
+}
+
+TEST(FleetLink, WithCurveAFollowerWithoutTheRightKeyReceivesNothing) {
+  if (!CurveAvailable()) GTEST_SKIP() << "libzmq without CURVE";
+  const std::string keys = FreshDir("keys");
+  fs::create_directories(keys);
+  const CurveKey leader_key = GenerateCurveKey(keys + "/leader.key");
+  const CurveKey good = GenerateCurveKey(keys + "/good.key");
+  const CurveKey stranger = GenerateCurveKey(keys + "/stranger.key");
+  EXPECT_EQ(LoadCurveKey(keys + "/leader.key", true).secret_key, leader_key.secret_key);
+  EXPECT_EQ(LoadCurveKey(keys + "/leader.key.pub", false).public_key, leader_key.public_key);
+  EXPECT_THROW(LoadCurveKey(keys + "/leader.key.pub", true), InputError);
+  EXPECT_EQ(fs::status(keys + "/leader.key").permissions() & fs::perms::others_read,
+            fs::perms::none);
+
+  const std::vector<Record> records = ImageRecords(5, true);
+  RouteCopy leader(FreshDir("curve_leader"));
+  leader.Apply(records);
+  ServerOptions server_options;
+  server_options.bind = "tcp://127.0.0.1:*";
+  server_options.security.key = leader_key;
+  server_options.security.allowed_public = {good.public_key};
+  std::vector<std::string> lines;
+  std::mutex lines_mutex;
+  LeaderServer server(leader, server_options, [&](const std::string& line) {
+    std::lock_guard<std::mutex> lock(lines_mutex);
+    lines.push_back(line);
+  });
+  const auto follow = [&](const CurveKey& key, const std::string& leader_public,
+                          const std::string& name) {
+    RouteCopy copy(FreshDir(name));
+    ClientOptions options;
+    options.connect = server.endpoint();
+    options.security.key = key;
+    options.security.leader_public = leader_public;
+    FollowerClient client(copy, options, nullptr);
+    WaitFor([&] { return copy.complete(); }, 2.0);
+    return client.stats().received;
+  };
+  EXPECT_EQ(follow(good, leader_key.public_key, "curve_good"), records.size());
+  EXPECT_EQ(follow(stranger, leader_key.public_key, "curve_stranger"), 0u);  // not admitted
+  EXPECT_EQ(follow(good, stranger.public_key, "curve_wrong_leader"), 0u);    // wrong leader key
+  EXPECT_GE(server.stats().refused, 2u);
+  std::lock_guard<std::mutex> lock(lines_mutex);
+  bool logged = false;
+  for (const std::string& l : lines) logged |= l.find("refused") != std::string::npos;
+  EXPECT_TRUE(logged);
+}
+
+}  // namespace
+}  // namespace mapless::fleet

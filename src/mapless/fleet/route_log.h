@@ -1,0 +1,95 @@
+// The route as a log of records (record.h), on both sides of the network.
+//
+// RouteCopy keeps a route directory in step with a log: a leader applies each record it makes to
+// its own route directory before it serves it, and a follower applies the records it receives to
+// its copy, with the same code, so the two directories are equal byte for byte. Records are
+// checked before anything is written (a bad record changes nothing), written with the route
+// store's crash safety (files flushed before the manifest that lists them), and a copy left by a
+// killed process is reopened where it stopped: its next sequence number follows from the files.
+//
+// For the eigenspace route the records carry the route images, not the model: the incremental PCA
+// is deterministic given the same images in the same order, so RouteCopy rebuilds exactly the
+// leader's eigenspace (navigation::AppearanceLeader::AddStored), one image per record.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mapless/fleet/record.h"
+#include "mapless/navigation/appearance.h"
+#include "mapless/route/appearance_store.h"
+#include "mapless/route/route.h"
+#include "mapless/route/route_store.h"
+
+namespace mapless::fleet {
+
+enum class RouteKind { kFunnel, kEigenspace };
+const char* RouteKindName(RouteKind kind);  // "funnel", "eigenspace"
+RouteKind ParseRouteKind(const std::string& name);
+
+// What the header record says.
+struct RouteHeader {
+  RouteKind kind = RouteKind::kFunnel;
+  int image_width = 0;  // the camera's frames
+  int image_height = 0;
+  std::string detector = "orb";  // funnel
+  int low_width = 0;             // eigenspace
+  int low_height = 0;
+};
+Record HeaderRecord(const RouteHeader& header);
+RouteHeader ParseHeader(const Record& record);  // throws InputError
+
+// The records of a leader's teach (sequence numbers are set by RouteCopy::Apply's caller).
+Record KeyframeRecord(const route::Keyframe& keyframe);
+Record ImageRecord(const route::StoredAppearanceImage& image);  // image.low: 8-bit
+Record EndRecord();
+
+class RouteCopy {
+ public:
+  // Opens DIR: the copy a previous run left there (resumed after its last whole record), or a new
+  // one when DIR is empty or missing. Throws InputError when DIR holds something else.
+  explicit RouteCopy(std::string dir);
+  ~RouteCopy();
+
+  // The next sequence number this copy needs (0: nothing yet).
+  std::uint64_t next_sequence() const;
+  bool complete() const;
+  std::optional<RouteHeader> header() const;
+  // Records held, for serving: record `sequence` as the leader encodes it (written_ns from when it
+  // was applied, or loaded from disk).
+  std::vector<Record> RecordsFrom(std::uint64_t from, std::size_t max) const;
+
+  // Applies records in order, starting at next_sequence(): each is checked, written, and the
+  // manifest that lists them is written once at the end (flushed). A record whose sequence is not
+  // the next one throws InputError before anything of it is written.
+  void Apply(const std::vector<Record>& records);
+
+  // The route as the methods see it (built when asked and cached until the next record): null
+  // until there are at least 2 keyframes / 1 route image.
+  std::shared_ptr<const route::Route> FunnelRoute() const;
+  std::shared_ptr<const route::AppearanceRoute> AppearanceRoute() const;
+
+  const std::string& dir() const { return dir_; }
+
+ private:
+  void ApplyOne(const Record& record);
+  void Load();
+
+  std::string dir_;
+  mutable std::mutex mutex_;
+  std::optional<RouteHeader> header_;
+  bool complete_ = false;
+  std::vector<Record> log_;  // every record held, in order (sequence = index)
+  std::unique_ptr<route::RouteWriter> keyframe_writer_;
+  std::unique_ptr<route::AppearanceRouteWriter> image_writer_;
+  std::vector<route::Keyframe> keyframes_;
+  std::unique_ptr<navigation::AppearanceLeader> model_;
+  mutable std::shared_ptr<const route::Route> funnel_cache_;
+  mutable std::shared_ptr<const route::AppearanceRoute> appearance_cache_;
+};
+
+}  // namespace mapless::fleet

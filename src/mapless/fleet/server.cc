@@ -1,0 +1,263 @@
+#include "mapless/fleet/server.h"
+
+#include <sys/eventfd.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <zmq.hpp>
+
+#include "mapless/core/check.h"
+#include "mapless/fleet/zmq_util.h"
+
+namespace mapless::fleet {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct Peer {
+  std::uint64_t next = 0;
+  Clock::time_point last_heard;
+  Clock::time_point last_sent;
+  std::string address;
+};
+
+}  // namespace
+
+struct LeaderServer::Impl {
+  const RouteCopy& log;
+  ServerOptions options;
+  FleetLogger log_line;
+  zmq::context_t context{1};
+  zmq::socket_t router{context, zmq::socket_type::router};
+  zmq::socket_t zap{context, zmq::socket_type::rep};
+  zmq::socket_t monitor{context, zmq::socket_type::pair};
+  int wake_fd = -1;
+  std::string endpoint;
+  std::atomic<bool> stop{false};
+  mutable std::mutex stats_mutex;
+  ServerStats stats;
+  std::map<std::string, Peer> peers;  // by ZeroMQ routing id
+  std::thread thread;
+
+  Impl(const RouteCopy& l, ServerOptions o, FleetLogger f)
+      : log(l), options(std::move(o)), log_line(std::move(f)) {}
+
+  void Log(const std::string& line) {
+    if (log_line) log_line(line);
+  }
+
+  void Count(std::uint64_t ServerStats::*field) {
+    std::lock_guard<std::mutex> lock(stats_mutex);
+    ++(stats.*field);
+  }
+
+  void HandleZap() {
+    std::vector<zmq::message_t> request;
+    if (!RecvAll(zap, &request)) return;
+    // ZAP 1.0: version, request id, domain, address, identity, mechanism, credentials...
+    if (request.size() < 6) return;
+    const std::string address = request[3].to_string();
+    std::string client_key;
+    if (request.size() >= 7 && request[6].size() == 32) {
+      char z85[41];
+      zmq_z85_encode(z85, static_cast<const std::uint8_t*>(request[6].data()), 32);
+      client_key = z85;
+    }
+    const auto& allowed = options.security.allowed_public;
+    const bool ok = request[5].to_string() == "CURVE" &&
+                    (allowed.empty() ||
+                     std::find(allowed.begin(), allowed.end(), client_key) != allowed.end());
+    if (!ok) {
+      Count(&ServerStats::refused);
+      Log("fleet: refused a follower from " + address + ": its key " + client_key +
+          " is not admitted (--curve-allow)");
+    }
+    std::vector<std::string> reply = {"1.0", request[1].to_string(), ok ? "200" : "400",
+                                      ok ? "OK" : "key not admitted", "", ""};
+    for (std::size_t i = 0; i < reply.size(); ++i) {
+      zap.send(zmq::buffer(reply[i]),
+               i + 1 < reply.size() ? zmq::send_flags::sndmore : zmq::send_flags::none);
+    }
+  }
+
+  void HandleMonitor() {
+    std::vector<zmq::message_t> event;
+    if (!RecvAll(monitor, &event) || event.size() < 2 || event[0].size() < 6) return;
+    std::uint16_t id = 0;
+    std::memcpy(&id, event[0].data(), 2);
+    if (id == ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL || id == ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL ||
+        id == ZMQ_EVENT_HANDSHAKE_FAILED_AUTH) {
+      if (id != ZMQ_EVENT_HANDSHAKE_FAILED_AUTH) Count(&ServerStats::refused);
+      if (id != ZMQ_EVENT_HANDSHAKE_FAILED_AUTH)  // an auth failure was logged by the ZAP handler
+        Log("fleet: refused a connection on " + event[1].to_string() +
+            ": the security handshake failed (a follower without the leader's key, or not "
+            "speaking CURVE)");
+    }
+  }
+
+  void HandleRouter() {
+    while (true) {
+      std::vector<zmq::message_t> msg;
+      if (!RecvAll(router, &msg, /*wait=*/false)) return;
+      if (msg.size() != 2) {
+        Count(&ServerStats::rejected);
+        Log("fleet: rejected a message of " + std::to_string(msg.size()) + " frames");
+        continue;
+      }
+      const std::string id = msg[0].to_string();
+      std::uint64_t from = 0;
+      try {
+        from = DecodeSubscribe(msg[1].to_string_view());
+      } catch (const InputError& e) {
+        Count(&ServerStats::rejected);
+        Log(std::string("fleet: rejected a message from a follower: ") + e.what());
+        continue;
+      }
+      Count(&ServerStats::subscriptions);
+      const bool known = peers.count(id) > 0;
+      Peer& peer = peers[id];
+      if (!known) {
+        const char* address = msg[1].gets("Peer-Address");
+        peer.address = address ? address : "?";
+        Log("fleet: a follower at " + peer.address + " asks for the route from record " +
+            std::to_string(from));
+      }
+      peer.next = from;
+      peer.last_heard = Clock::now();
+    }
+  }
+
+  // Sends what each follower lacks; true when some follower's pipe is full (retry soon).
+  bool SendRound() {
+    bool blocked = false;
+    const std::uint64_t size = log.next_sequence();
+    const auto now = Clock::now();
+    for (auto it = peers.begin(); it != peers.end();) {
+      Peer& peer = it->second;
+      if (now - peer.last_heard > std::chrono::duration<double>(options.forget_after_s)) {
+        it = peers.erase(it);
+        continue;
+      }
+      std::vector<std::string> out;
+      std::uint64_t first = peer.next;
+      if (peer.next < size) {
+        for (const Record& r : log.RecordsFrom(peer.next, options.batch)) out.push_back(EncodeRecord(r));
+      } else if (now - peer.last_sent >= std::chrono::duration<double>(options.heartbeat_s)) {
+        Record beat;
+        beat.type = RecordType::kHeartbeat;
+        beat.sequence = size;
+        beat.parts = {log.complete() ? "1" : "0"};
+        out.push_back(EncodeRecord(beat));
+        first = size;  // a heartbeat does not advance peer.next
+      }
+      bool gone = false;
+      std::size_t sent = 0;
+      for (const std::string& bytes : out) {
+        const SendResult result = SendTo(router, it->first, bytes);
+        if (result == SendResult::kFull) {
+          blocked = true;
+          break;
+        }
+        if (result == SendResult::kGone) {
+          gone = true;
+          break;
+        }
+        ++sent;
+        peer.last_sent = now;
+      }
+      if (peer.next < size) {
+        peer.next = first + sent;
+        std::lock_guard<std::mutex> lock(stats_mutex);
+        stats.records_sent += sent;
+      }
+      if (gone) {
+        it = peers.erase(it);
+        continue;
+      }
+      ++it;
+    }
+    std::lock_guard<std::mutex> lock(stats_mutex);
+    stats.followers = static_cast<int>(peers.size());
+    return blocked;
+  }
+
+  void Run() {
+    bool blocked = false;
+    while (!stop) {
+      std::vector<zmq::pollitem_t> items = {{router.handle(), 0, ZMQ_POLLIN, 0},
+                                            {nullptr, wake_fd, ZMQ_POLLIN, 0},
+                                            {monitor.handle(), 0, ZMQ_POLLIN, 0}};
+      if (options.security.enabled()) items.push_back({zap.handle(), 0, ZMQ_POLLIN, 0});
+      zmq::poll(items, std::chrono::milliseconds(blocked ? 2 : 100));
+      if (items[1].revents & ZMQ_POLLIN) {
+        std::uint64_t n = 0;
+        if (::read(wake_fd, &n, sizeof(n)) < 0) n = 0;
+      }
+      if (stop) break;
+      if (items[0].revents & ZMQ_POLLIN) HandleRouter();
+      if (items[2].revents & ZMQ_POLLIN) HandleMonitor();
+      if (items.size() > 3 && (items[3].revents & ZMQ_POLLIN)) HandleZap();
+      blocked = SendRound();
+    }
+  }
+};
+
+LeaderServer::LeaderServer(const RouteCopy& log, ServerOptions options, FleetLogger log_line)
+    : impl_(std::make_unique<Impl>(log, std::move(options), std::move(log_line))) {
+  Impl& s = *impl_;
+  s.wake_fd = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+  MAPLESS_CHECK(s.wake_fd >= 0, "fleet: cannot create an eventfd");
+  try {
+    if (s.options.security.enabled()) {
+      MAPLESS_CHECK(CurveAvailable(), "fleet: this libzmq was built without CURVE (libsodium)");
+      s.zap.bind("inproc://zeromq.zap.01");
+      s.router.set(zmq::sockopt::curve_server, 1);
+      s.router.set(zmq::sockopt::curve_secretkey, s.options.security.key.secret_key);
+      s.router.set(zmq::sockopt::zap_domain, "mapless");
+    }
+    s.router.set(zmq::sockopt::router_mandatory, 1);
+    // Subscriptions are 16 bytes: a larger message still reaches the decoder (and its log line) up
+    // to 64 KiB; beyond that ZeroMQ drops the connection.
+    s.router.set(zmq::sockopt::maxmsgsize, static_cast<std::int64_t>(64 << 10));
+    s.router.set(zmq::sockopt::sndhwm, 64);
+    s.router.set(zmq::sockopt::linger, 200);
+    SetHeartbeats(s.router);
+    zmq_socket_monitor(s.router.handle(), "inproc://mapless-fleet-monitor",
+                       ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL | ZMQ_EVENT_HANDSHAKE_FAILED_AUTH |
+                           ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL);
+    s.monitor.connect("inproc://mapless-fleet-monitor");
+    s.router.bind(s.options.bind);
+    s.endpoint = s.router.get(zmq::sockopt::last_endpoint);
+  } catch (const zmq::error_t& e) {
+    ::close(s.wake_fd);
+    throw InputError("--bind " + s.options.bind + ": " + e.what());
+  }
+  s.thread = std::thread([&s] { s.Run(); });
+}
+
+LeaderServer::~LeaderServer() {
+  impl_->stop = true;
+  Notify();
+  if (impl_->thread.joinable()) impl_->thread.join();
+  ::close(impl_->wake_fd);
+}
+
+void LeaderServer::Notify() {
+  const std::uint64_t one = 1;
+  if (::write(impl_->wake_fd, &one, sizeof(one)) < 0) {
+    // The counter is saturated: the thread is awake anyway.
+  }
+}
+
+std::string LeaderServer::endpoint() const { return impl_->endpoint; }
+
+ServerStats LeaderServer::stats() const {
+  std::lock_guard<std::mutex> lock(impl_->stats_mutex);
+  return impl_->stats;
+}
+
+}  // namespace mapless::fleet

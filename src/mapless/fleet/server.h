@@ -1,0 +1,61 @@
+// The leader's side of the fleet link: serves its route log (route_log.h) to any number of
+// followers over ZeroMQ (a ROUTER socket; TCP between machines, ipc:// or loopback on one).
+//
+// A follower says "from sequence n" (record.h); the leader sends it the records from n on, as fast
+// as the follower's connection takes them (ZeroMQ's high-water mark; nothing is dropped: a full
+// pipe is retried), then each new record as the teach appends it. A follower that says "from n"
+// again (it reconnected, or saw a gap) is served from n again. When a follower is up to date the
+// leader sends it a heartbeat every second with the number of records in the log, so the follower
+// knows the leader is there and whether it has everything.
+//
+// Runs its own thread; Notify() wakes it when a record was appended. With CURVE keys (curve.h) a
+// follower without the leader's public key, or with a key not admitted, gets nothing, and the
+// refusal is logged.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "mapless/fleet/curve.h"
+#include "mapless/fleet/route_log.h"
+
+namespace mapless::fleet {
+
+using FleetLogger = std::function<void(const std::string&)>;
+
+struct ServerOptions {
+  std::string bind = "tcp://127.0.0.1:5600";
+  LeaderSecurity security;
+  std::size_t batch = 64;        // records per follower per round
+  double heartbeat_s = 1.0;      // to an up-to-date follower
+  double forget_after_s = 60.0;  // a follower silent this long is forgotten (it resubscribes)
+};
+
+struct ServerStats {
+  std::uint64_t subscriptions = 0;  // "from n" messages taken
+  std::uint64_t records_sent = 0;
+  std::uint64_t refused = 0;   // handshakes failed or keys not admitted
+  std::uint64_t rejected = 0;  // malformed messages
+  int followers = 0;           // known now
+};
+
+class LeaderServer {
+ public:
+  // Binds (throws InputError naming the endpoint when it cannot) and starts serving `log`, which
+  // must outlive the server.
+  LeaderServer(const RouteCopy& log, ServerOptions options, FleetLogger log_line);
+  ~LeaderServer();
+  void Notify();                 // a record was appended to the log
+  std::string endpoint() const;  // as bound (a tcp port 0 / "*" resolved)
+  ServerStats stats() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace mapless::fleet
