@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include "cli_common.h"
+#include "fleet.h"
 #include "interrupt.h"
 #include "mapless/core/check.h"
 #include "mapless/eval/eigenspace.h"
@@ -55,13 +56,27 @@ void AddFollowCommand(CLI::App* app) {
     std::string log;
     std::uint64_t seed = 1;
     double motion_noise = 0.1;
+    FollowConnectArgs fleet;
   };
   auto a = std::make_shared<Args>();
   CLI::App* cmd = app->add_subcommand(
       "follow",
       "Follow an appearance route (teach --method eigenspace): initial localization, Markov "
       "localization and sub-window steering, on the simulator or a robot");
-  cmd->add_option("--route", a->route, "Appearance route directory")->required();
+  cmd->add_option("--route", a->route,
+                  "Appearance route directory; with --connect, where the copy of the leader's "
+                  "route is kept (resumed from when it exists)")
+      ->required();
+  cmd->add_option("--connect", a->fleet.connect,
+                  "Follow the route a leader serves (mapless lead --bind), while it is taught: "
+                  "funnel or eigenspace, as the leader teaches");
+  cmd->add_option("--rate", a->fleet.rate,
+                  "With --connect on the simulator: simulated seconds per wall-clock second")
+      ->capture_default_str()
+      ->check(FiniteIn(0.0, 100.0));
+  cmd->add_option("--summary", a->fleet.summary, "With --connect on the simulator: a JSON summary");
+  cmd->add_option("--curve-key", a->fleet.curve_key, "CURVE: this follower's key file");
+  cmd->add_option("--curve-leader", a->fleet.curve_leader, "CURVE: the leader's public key file");
   CLI::Option* source = cmd->add_option("--source", a->source, "sim:SCENARIO");
   cmd->add_option("--robot", a->robot, "Drive a robot: its robot file (YAML)")->excludes(source);
   cmd->add_option("--log", a->log, "Per-frame decisions as JSON lines (- for stdout)");
@@ -72,6 +87,18 @@ void AddFollowCommand(CLI::App* app) {
       ->capture_default_str()
       ->check(FiniteIn(0.0, 0.9));
   cmd->callback([a] {
+    if (!a->fleet.connect.empty()) {
+      FollowConnectArgs f = a->fleet;
+      f.route = a->route;
+      f.source = a->source;
+      f.robot = a->robot;
+      f.log = a->log;
+      f.seed = a->seed;
+      f.motion_noise = a->motion_noise;
+      RefuseOutputOverInputs(f.log, "--log", {SourceInput(f.source), f.robot});
+      FollowConnected(f);
+      return;
+    }
     if (a->source.empty() == a->robot.empty())
       throw InputError("follow: give one of --source sim:SCENARIO or --robot");
     RefuseOutputOverInputs(a->log, "--log", {a->route, SourceInput(a->source), a->robot});

@@ -11,6 +11,7 @@
 #include <opencv2/core/utils/logger.hpp>
 
 #include "cli_common.h"
+#include "fleet.h"
 #include "interrupt.h"
 #include "mapless/core/check.h"
 
@@ -58,6 +59,8 @@ int main(int argc, char** argv) {
   mapless::app::AddSimCommands(&app);
   mapless::app::AddTeachRepeatCommands(&app);
   mapless::app::AddFollowCommand(&app);
+  mapless::app::AddLeadCommand(&app);
+  mapless::app::AddFleetCommand(&app);
   mapless::app::AddShiftCommand(&app);
   mapless::app::AddFlowCommand(&app);
   mapless::app::AddGroundCommand(&app);

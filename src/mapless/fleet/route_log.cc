@@ -219,13 +219,22 @@ void RouteCopy::Apply(const std::vector<Record>& records) {
     if (keyframe_writer_) keyframe_writer_->Flush();
     if (image_writer_) image_writer_->Flush();
   };
+  const std::size_t first = log_.size();
+  // A leader's own records are stamped once they are on disk (their latency counts from there).
+  const auto stamp = [&] {
+    const std::int64_t now = WallNs();
+    for (std::size_t i = first; i < log_.size(); ++i)
+      if (log_[i].written_ns == 0) log_[i].written_ns = now;
+  };
   try {
     for (const Record& r : records) ApplyOne(r);
   } catch (...) {
     flush();
+    stamp();
     throw;
   }
   flush();
+  stamp();
 }
 
 void RouteCopy::ApplyOne(const Record& record) {
@@ -235,7 +244,6 @@ void RouteCopy::ApplyOne(const Record& record) {
     throw InputError(what + ": expected sequence " + std::to_string(log_.size()));
   if (complete_) throw InputError(what + ": after the end of the route");
   Record kept = record;
-  if (kept.written_ns == 0) kept.written_ns = WallNs();
   if (record.type == RecordType::kHeader) {
     const RouteHeader h = ParseHeader(record);  // sequence 0 (checked by the decoder)
     fs::create_directories(dir_);

@@ -110,6 +110,22 @@ RepeatSession::RepeatSession(std::shared_ptr<const route::Route> route, RepeatOp
   cx_ = 0.5 * (route_->image_width - 1);
 }
 
+void RepeatSession::Extend(std::shared_ptr<const route::Route> route) {
+  MAPLESS_CHECK(route != nullptr && route->keyframes.size() >= route_->keyframes.size() &&
+                    route->detector == route_->detector &&
+                    route->image_width == route_->image_width &&
+                    route->image_height == route_->image_height,
+                "RepeatSession::Extend: not a continuation of the route");
+  for (std::size_t i = keyframe_features_.size(); i < route->keyframes.size(); ++i) {
+    features::Features f;
+    f.keypoints = route->keyframes[i].keypoints;
+    f.descriptors = route->keyframes[i].descriptors;
+    f.binary = options_.features.type != features::DetectorType::kSift;
+    keyframe_features_.push_back(std::move(f));
+  }
+  route_ = std::move(route);
+}
+
 std::vector<control::FeaturePair> RepeatSession::Pairs() const {
   std::vector<control::FeaturePair> pairs;
   pairs.reserve(current_px_.size());
@@ -203,6 +219,28 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
                                            << " but the route was taught at " << route_->image_width
                                            << "x" << route_->image_height);
 
+  const int known = static_cast<int>(route_->keyframes.size());
+  if (waiting_for_route_) {
+    if (destination_ + 1 >= known) {
+      previous_.release();
+      current_px_.clear();
+      destination_px_.clear();
+      if (route_->complete)
+        return Stop(step, RepeatStatus::kCompleted, "route completed: passed the last keyframe");
+      return Stop(step, RepeatStatus::kWaiting,
+                  "waiting for the leader: keyframe " + std::to_string(destination_) +
+                      " is the last it has taught so far");
+    }
+    // The leader taught the next keyframe: switch to it as at any segment switch.
+    waiting_for_route_ = false;
+    ++destination_;
+    step.switched = true;
+    step.destination = destination_;
+    have_expected_dx_ = false;  // the robot stood still: no prediction from the last segment
+    current_px_.clear();
+    destination_px_.clear();
+  }
+
   // Periodic refresh (an option; see RepeatOptions::redetect_every_frames): no point tracking
   // features that are about to be replaced.
   ++frames_since_detect_;
@@ -285,6 +323,12 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
     if (destination_ >= static_cast<int>(route_->keyframes.size())) {
       destination_ = static_cast<int>(route_->keyframes.size()) - 1;
       step.destination = destination_;
+      if (!route_->complete && options_.wait_for_leader) {
+        waiting_for_route_ = true;
+        return Stop(step, RepeatStatus::kWaiting,
+                    "waiting for the leader: keyframe " + std::to_string(destination_) +
+                        " is the last it has taught so far");
+      }
       return Stop(step, RepeatStatus::kCompleted, "route completed: passed the last keyframe");
     }
     // Predict the displacement against the new destination: the current one against the old

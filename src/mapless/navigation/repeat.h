@@ -74,6 +74,10 @@ struct RepeatOptions {
   double guided_window_px = 40.0;
   double guided_release_s = 1.0;
   CameraCheckOptions camera;  // camera faults: the robot waits, the session carries on after
+  // At the last keyframe of an incomplete route: false, the repeat ends there (an interrupted
+  // teach read from disk); true, the robot waits for the leader that is still teaching it (fleet:
+  // see Extend()).
+  bool wait_for_leader = false;
   void Validate() const;
 };
 
@@ -107,6 +111,11 @@ class RepeatSession {
   // One control period. A camera fault (see camera_check.h) gives kWaiting with the fault as the
   // reason and a zero command; it does not count towards abort_after_s.
   RepeatStep Update(const cv::Mat& image, Timestamp t_ns);
+  // A longer snapshot of a route a leader is still teaching (fleet/): the same keyframes and
+  // more, or the same ones now complete. At the last keyframe of an incomplete route the robot
+  // stops (waiting for the leader) instead of completing, and goes on when the next keyframe
+  // arrives; the switching rules are those of a complete route.
+  void Extend(std::shared_ptr<const route::Route> route);
   bool finished() const {
     return status_ == RepeatStatus::kCompleted || status_ == RepeatStatus::kAborted;
   }
@@ -135,6 +144,7 @@ class RepeatSession {
   bool have_expected_dx_ = false;  // guided matching: a predicted x_current - x_destination
   double expected_dx_ = 0.0;
   int switch_votes_ = 0;
+  bool waiting_for_route_ = false;  // passed the last keyframe of an incomplete route
   int frames_since_detect_ = 0;
   bool waiting_ = false;
   Timestamp waiting_since_ns_ = 0;

@@ -43,10 +43,32 @@ Decision NoOdometry(const char* method) {
 
 RepeatMethod::RepeatMethod(std::shared_ptr<const route::Route> route,
                            navigation::RepeatOptions options)
-    : session_(route, options), size_(route->image_width, route->image_height) {}
+    : options_(options), route_(route), size_(route->image_width, route->image_height) {
+  session_.emplace(route, options);
+}
+
+RepeatMethod::RepeatMethod(RouteSource route, navigation::RepeatOptions options,
+                           cv::Size image_size)
+    : source_(std::move(route)), options_(options), size_(image_size) {
+  options_.wait_for_leader = true;
+}
 
 Decision RepeatMethod::Step(const Observation& observation) {
-  navigation::RepeatStep step = session_.Update(observation.image, observation.t_ns);
+  if (source_) {
+    std::shared_ptr<const route::Route> latest = source_();
+    if (latest && latest != route_) {
+      if (session_) {
+        session_->Extend(latest);
+      } else {
+        session_.emplace(latest, options_);
+      }
+      route_ = std::move(latest);
+    }
+    if (!session_)
+      return Make(MethodState::kStopped, Twist2{}, "waiting",
+                  "waiting for the leader: the route has fewer than 2 keyframes yet");
+  }
+  navigation::RepeatStep step = session_->Update(observation.image, observation.t_ns);
   MethodState state = MethodState::kDriving;
   switch (step.status) {
     case navigation::RepeatStatus::kDriving:

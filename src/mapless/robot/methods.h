@@ -16,13 +16,21 @@ namespace mapless::robot {
 class RepeatMethod : public Method {
  public:
   RepeatMethod(std::shared_ptr<const route::Route> route, navigation::RepeatOptions options);
+  // On a route a leader is still teaching (fleet/): `route` returns its latest snapshot (null
+  // while it has fewer than 2 keyframes: the robot waits); the robot waits at the last keyframe
+  // taught so far (RepeatOptions::wait_for_leader is set).
+  using RouteSource = std::function<std::shared_ptr<const route::Route>()>;
+  RepeatMethod(RouteSource route, navigation::RepeatOptions options, cv::Size image_size);
   const char* name() const override { return "repeat"; }
   bool needs_odometry() const override { return false; }
   cv::Size image_size() const override { return size_; }
   Decision Step(const Observation& observation) override;
 
  private:
-  navigation::RepeatSession session_;
+  RouteSource source_;
+  navigation::RepeatOptions options_;
+  std::shared_ptr<const route::Route> route_;  // the snapshot the session has
+  std::optional<navigation::RepeatSession> session_;
   cv::Size size_;
 };
 

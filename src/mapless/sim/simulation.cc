@@ -200,7 +200,8 @@ DriveSummary DriveTaughtPath(const Scenario& scenario, const DriveOptions& optio
     frame.t_ns = sim.now_ns();
     frame.truth = sim.robot(robot).pose();
     frame.odometry = sim.robot(robot).odometry();
-    if (options.render_frames) frame.image = sim.Render(robot);
+    if (options.render_frames && !(options.skip_render && options.skip_render(frame)))
+      frame.image = sim.Render(robot);
     if (on_frame) on_frame(frame);
     ++summary.frames;
     summary.distance_m += frame.truth.DistanceTo(last);

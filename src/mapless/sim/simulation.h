@@ -92,6 +92,9 @@ struct DriveOptions {
   double timeout_factor = 3.0;  // give up after this many times the nominal path duration
   bool stop_on_collision = true;
   bool render_frames = true;  // false: frames carry no image (fast, for path-only checks)
+  // Frames for which this returns true carry no image (a leader resuming an interrupted teach
+  // drives up to where it stopped without rendering).
+  std::function<bool(const DriveFrame&)> skip_render;
   SimulationOptions sim;
   void Validate() const;
 };
