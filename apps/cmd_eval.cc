@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
+#include "fleet.h"
 #include "mapless/core/check.h"
 #include "mapless/eval/eigenspace.h"
 #include "mapless/eval/potential.h"
@@ -154,11 +155,16 @@ void AddEvalCommand(CLI::App* app) {
     std::string end = "scale";
   };
   auto args = std::make_shared<Args>();
+  auto fleet = std::make_shared<FleetEvalArgs>();
   CLI::App* cmd = app->add_subcommand(
       "eval",
-      "Run an evaluation suite on the simulator (table1, funnel-scenarios, potential, eigenspace)");
-  cmd->add_option("SUITE", args->suite, "table1, funnel-scenarios, potential or eigenspace")
+      "Run an evaluation suite on the simulator (table1, funnel-scenarios, potential, eigenspace, "
+      "fleet)");
+  cmd->add_option("SUITE", args->suite,
+                  "table1, funnel-scenarios, potential, eigenspace or fleet (a leader and "
+                  "followers as processes)")
       ->required();
+  AddFleetEvalOptions(cmd, fleet.get());
   cmd->add_option("--runs", args->runs, "Repeats per scenario and controller")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
@@ -177,7 +183,13 @@ void AddEvalCommand(CLI::App* app) {
                   "table1, funnel-scenarios: the last keyframe by scale, or by the switching rule "
                   "(switching)")
       ->capture_default_str();
-  cmd->callback([args] {
+  cmd->callback([args, fleet] {
+    if (args->suite == "fleet") {
+      FleetEvalArgs f = *fleet;
+      f.seed = args->seed;
+      RunFleetEval(f, args->json);
+      return;
+    }
     const bool teach_repeat = args->suite != "potential" && args->suite != "eigenspace";
     if (!teach_repeat && (args->switching != "stdratio" || args->end != "scale"))
       throw InputError("--switching and --end apply to table1 and funnel-scenarios, not " +

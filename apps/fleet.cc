@@ -100,11 +100,11 @@ class LeaderTeacher {
   LeaderTeacher(fleet::RouteCopy& copy, fleet::LeaderServer& server, fleet::RouteKind kind,
                 const std::string& detector)
       : copy_(copy), server_(server), kind_(kind), detector_(detector),
-        resuming_(copy.next_sequence() > 1) {
+        resuming_(copy.next_sequence() > 1 && !copy.complete()) {
     teach_options_.features.type = features::ParseDetectorType(detector);
     teach_options_.Validate();
     session_ = std::make_unique<navigation::TeachSession>(teach_options_);
-    if (kind_ == fleet::RouteKind::kEigenspace && copy_.next_sequence() > 1) {
+    if (kind_ == fleet::RouteKind::kEigenspace && resuming_) {
       // Resume: the model as the interrupted leader had it.
       const route::StoredAppearanceRoute stored = route::LoadAppearanceRoute(copy_.dir());
       for (const auto& image : stored.images)

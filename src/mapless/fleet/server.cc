@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <map>
 #include <mutex>
 #include <zmq.hpp>
@@ -50,6 +51,28 @@ struct LeaderServer::Impl {
     if (log_line) log_line(line);
   }
 
+  // Bad input is logged, but at most one line a second (a peer sending garbage cannot flood the
+  // log): the lines held back are counted in the next one.
+  Clock::time_point last_reject_log;
+  int held_back = 0;
+  void LogRejection(const std::string& line) {
+    const auto now = Clock::now();
+    if (now - last_reject_log < std::chrono::seconds(1)) {
+      ++held_back;
+      return;
+    }
+    Log(line + (held_back > 0 ? " (and " + std::to_string(held_back) + " more since the last)" : ""));
+    held_back = 0;
+    last_reject_log = now;
+  }
+  void FlushRejections() {
+    if (held_back == 0 || Clock::now() - last_reject_log < std::chrono::seconds(1)) return;
+    Log("fleet: refused or rejected " + std::to_string(held_back) +
+        " more connections or messages in the last second");
+    held_back = 0;
+    last_reject_log = Clock::now();
+  }
+
   void Count(std::uint64_t ServerStats::*field) {
     std::lock_guard<std::mutex> lock(stats_mutex);
     ++(stats.*field);
@@ -84,18 +107,32 @@ struct LeaderServer::Impl {
     }
   }
 
+  // Connections by socket, from accepted until the handshake succeeded or failed: one that closes
+  // in between was refused (garbage, or a peer that is not a mapless follower).
+  std::map<std::uint32_t, bool> pending_handshakes;
+
   void HandleMonitor() {
     std::vector<zmq::message_t> event;
     if (!RecvAll(monitor, &event) || event.size() < 2 || event[0].size() < 6) return;
     std::uint16_t id = 0;
+    std::uint32_t fd = 0;
     std::memcpy(&id, event[0].data(), 2);
-    if (id == ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL || id == ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL ||
-        id == ZMQ_EVENT_HANDSHAKE_FAILED_AUTH) {
-      if (id != ZMQ_EVENT_HANDSHAKE_FAILED_AUTH) Count(&ServerStats::refused);
-      if (id != ZMQ_EVENT_HANDSHAKE_FAILED_AUTH)  // an auth failure was logged by the ZAP handler
-        Log("fleet: refused a connection on " + event[1].to_string() +
-            ": the security handshake failed (a follower without the leader's key, or not "
-            "speaking CURVE)");
+    std::memcpy(&fd, static_cast<const char*>(event[0].data()) + 2, 4);
+    const std::string where = event[1].to_string();
+    if (id == ZMQ_EVENT_ACCEPTED) {
+      pending_handshakes[fd] = true;
+    } else if (id == ZMQ_EVENT_HANDSHAKE_SUCCEEDED) {
+      pending_handshakes.erase(fd);
+    } else if (id == ZMQ_EVENT_HANDSHAKE_FAILED_AUTH) {
+      pending_handshakes.erase(fd);  // logged by the ZAP handler
+    } else if (id == ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL ||
+               id == ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL ||
+               (id == ZMQ_EVENT_DISCONNECTED && pending_handshakes.count(fd))) {
+      pending_handshakes.erase(fd);
+      Count(&ServerStats::refused);
+      LogRejection("fleet: refused a connection on " + where +
+                   ": the handshake failed (not a mapless follower, or one without the "
+                   "leader's CURVE key)");
     }
   }
 
@@ -105,7 +142,7 @@ struct LeaderServer::Impl {
       if (!RecvAll(router, &msg, /*wait=*/false)) return;
       if (msg.size() != 2) {
         Count(&ServerStats::rejected);
-        Log("fleet: rejected a message of " + std::to_string(msg.size()) + " frames");
+        LogRejection("fleet: rejected a message of " + std::to_string(msg.size()) + " frames");
         continue;
       }
       const std::string id = msg[0].to_string();
@@ -114,7 +151,7 @@ struct LeaderServer::Impl {
         from = DecodeSubscribe(msg[1].to_string_view());
       } catch (const InputError& e) {
         Count(&ServerStats::rejected);
-        Log(std::string("fleet: rejected a message from a follower: ") + e.what());
+        LogRejection(std::string("fleet: rejected a message from a follower: ") + e.what());
         continue;
       }
       Count(&ServerStats::subscriptions);
@@ -202,6 +239,7 @@ struct LeaderServer::Impl {
       if (items[2].revents & ZMQ_POLLIN) HandleMonitor();
       if (items.size() > 3 && (items[3].revents & ZMQ_POLLIN)) HandleZap();
       blocked = SendRound();
+      FlushRejections();
     }
   }
 };
@@ -228,7 +266,8 @@ LeaderServer::LeaderServer(const RouteCopy& log, ServerOptions options, FleetLog
     SetHeartbeats(s.router);
     zmq_socket_monitor(s.router.handle(), "inproc://mapless-fleet-monitor",
                        ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL | ZMQ_EVENT_HANDSHAKE_FAILED_AUTH |
-                           ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL);
+                           ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL | ZMQ_EVENT_ACCEPTED |
+                           ZMQ_EVENT_HANDSHAKE_SUCCEEDED | ZMQ_EVENT_DISCONNECTED);
     s.monitor.connect("inproc://mapless-fleet-monitor");
     s.router.bind(s.options.bind);
     s.endpoint = s.router.get(zmq::sockopt::last_endpoint);

@@ -1,0 +1,83 @@
+#!/usr/bin/env bash
+# Fleet integration test (issue 19): a leader and three followers as separate processes on loopback
+# (mapless eval fleet), for one method; with --faults, the leader is killed and restarted mid-route,
+# follower 1 is killed and restarted, and follower 3's link is down for 10 s. eval fleet exits
+# non-zero unless every follower completes the route, its copy equals the leader's byte for byte
+# and no record is missing or applied twice; this script checks the JSON as well. Then, on the
+# route taught: a follower with a wrong CURVE key receives nothing and the leader logs the refusal;
+# garbage sent to the leader's port is refused with a log line and the leader goes on serving.
+#
+#   fleet.sh MAPLESS funnel|eigenspace [--faults]
+set -euo pipefail
+mapless=$1
+method=$2
+faults=${3:-}
+work=$(mktemp -d /tmp/mapless-fleet-test-XXXXXX)
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill -INT "$p" 2>/dev/null || true; done
+  sleep 0.5
+  for p in "${pids[@]}"; do kill -KILL "$p" 2>/dev/null || true; done
+  rm -rf "$work"
+}
+trap cleanup EXIT
+fail() { echo "FAIL: $*"; for f in "$work"/run/*.log "$work"/*.log; do [ -f "$f" ] && { echo "== $f"; tail -20 "$f"; }; done; exit 1; }
+
+args=(eval fleet --followers 3 --method "$method" --json --keep "$work/run")
+if [ "$faults" = --faults ]; then
+  if [ "$method" = funnel ]; then
+    args+=(--kill-leader-at 5 --kill-follower-at 8 --link-down-at 6 --link-down-for 10)
+  else
+    args+=(--kill-leader-at 8 --kill-follower-at 12 --link-down-at 9 --link-down-for 10)
+  fi
+fi
+timeout 600 "$mapless" "${args[@]}" > "$work/eval.json" 2> "$work/eval.log" || fail "eval fleet: exit $?"
+json=$(cat "$work/eval.json")
+for i in 0 1 2; do
+  for check in '"completed": *true' '"copy_identical": *true' '"gaps": *0' '"duplicates_applied": *0'; do
+    node_json=$(echo "$json" | sed 's/},{/}\n{/g' | sed -n "$((i + 1))p")
+    echo "$node_json" | grep -Eq "$check" || fail "follower $((i + 1)): $check not in $node_json"
+  done
+done
+if [ "$faults" = --faults ]; then
+  echo "$json" | grep -q '"leader_restarts":1' || fail "the leader was not restarted"
+  echo "$json" | grep -q '"follower_restarts":1' || fail "follower 1 was not restarted"
+  grep -q "resuming the route" "$work/run/leader.log" || fail "the restarted leader did not resume"
+  grep -q "holds .* records of the route; asking for the rest" "$work/run/follower1.log" ||
+    fail "the restarted follower did not resume its copy"
+fi
+echo "eval fleet ($method ${faults:-plain}): 3/3 followers complete, copies identical"
+
+# CURVE: the taught route served with keys; a follower with a key not admitted gets nothing.
+"$mapless" fleet keygen "$work/leader.key" > /dev/null 2>&1
+"$mapless" fleet keygen "$work/good.key" > /dev/null 2>&1
+"$mapless" fleet keygen "$work/stranger.key" > /dev/null 2>&1
+port=$((20000 + RANDOM % 20000))
+"$mapless" lead --source sim:table1_almost_straight --method "$method" --route "$work/run/leader" \
+  --bind "tcp://127.0.0.1:$port" --curve-key "$work/leader.key" --curve-allow "$work/good.key.pub" \
+  > "$work/lead.log" 2>&1 &
+pids+=($!)
+for _ in $(seq 50); do grep -q "serving it" "$work/lead.log" && break; sleep 0.1; done
+grep -q "serving it" "$work/lead.log" || fail "the leader did not serve the taught route"
+follow() {  # KEY COPY: follow for 4 s (the robot never gets a route with a wrong key)
+  timeout -s INT 4 "$mapless" follow --connect "tcp://127.0.0.1:$port" --source sim:table1_almost_straight \
+    --route "$2" --rate 4 --curve-key "$1" --curve-leader "$work/leader.key.pub" > "$2.log" 2>&1 || true
+}
+follow "$work/stranger.key" "$work/stranger_copy"
+[ -z "$(ls -A "$work/stranger_copy" 2>/dev/null)" ] || fail "a follower with a wrong key received records"
+grep -q "refused a follower" "$work/lead.log" || fail "the leader did not log the refusal"
+follow "$work/good.key" "$work/good_copy"
+[ -f "$work/good_copy/manifest.json" ] || [ -f "$work/good_copy/appearance.json" ] ||
+  fail "a follower with the right key received nothing"
+echo "CURVE: a wrong key receives nothing (refusal logged); the right key receives the route"
+
+# Garbage on the leader's port: refused with a log line (not one per message); the leader goes on.
+before=$(wc -l < "$work/lead.log")
+printf 'GARBAGE\x00\x01\x02 not ZMTP at all %.0s' $(seq 200) > /dev/tcp/127.0.0.1/$port || true
+sleep 2.5
+after=$(wc -l < "$work/lead.log")
+tail -n +$((before + 1)) "$work/lead.log" | grep -Eq "refused a connection|rejected" ||
+  fail "garbage on the port was not logged"
+[ $((after - before)) -le 3 ] || fail "garbage flooded the log ($((after - before)) lines)"
+kill -0 "${pids[0]}" || fail "the leader died of garbage"
+echo "garbage on the leader's port: refused and logged; the leader serves on"
