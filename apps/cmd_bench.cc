@@ -26,6 +26,7 @@ namespace mapless::app {
 
 void BenchRos1(nlohmann::json* j);  // bench_links.cc
 void BenchRos2(nlohmann::json* j);  // bench_links.cc
+void BenchFleet(nlohmann::json* j);  // bench_fleet.cc
 
 namespace {
 
@@ -270,6 +271,20 @@ void BenchEigenspace(int repeats, nlohmann::json* j) {
 
 // The robot-link rows of the table (issues 17, 18), for the middlewares that were measured.
 static void PrintLinkRows(const nlohmann::json& j) {
+  for (const char* kind : {"eigenspace", "funnel"}) {
+    const std::string k = std::string("fleet_latency_") + kind;
+    if (!j.contains(k + "_median_ms")) continue;
+    std::printf("%-34s %10.3f  p99 %.3f  (issue 19: p99 <= 5)\n",
+                ("fleet record latency " + std::string(kind)).c_str(),
+                j[k + "_median_ms"].get<double>(), j[k + "_p99_ms"].get<double>());
+    std::printf("%-34s %10.3f  s (issue 19: <= 1 s; %d-byte records)\n",
+                ("fleet catch-up 1000 " + std::string(kind)).c_str(),
+                j[std::string("fleet_catch_up_1000_") + kind + "_s"].get<double>(),
+                j[std::string("fleet_record_bytes_") + kind].get<int>());
+    if (j.contains("fleet_model_rebuild_1000_s") && std::string(kind) == "eigenspace")
+      std::printf("%-34s %10.3f  s (the eigenspace of 1000 images, once caught up)\n",
+                  "fleet model rebuild 1000", j["fleet_model_rebuild_1000_s"].get<double>());
+  }
   for (const char* mw : {"ros1", "ros2"}) {
     const std::string prefix = std::string(mw) + "_link";
     if (j.contains(prefix)) {
@@ -297,6 +312,7 @@ void AddBenchCommand(CLI::App* app) {
     bool ros1 = false;
     bool ros2 = false;
     bool links_only = false;
+    bool fleet = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* bench = app->add_subcommand(
@@ -315,15 +331,19 @@ void AddBenchCommand(CLI::App* app) {
   bench->add_flag("--ros2", args->ros2,
                   "Also the ROS 2 (DDS) adapter's latency, frame received to command published "
                   "(a DDS domain of its own on loopback)");
+  bench->add_flag("--fleet", args->fleet,
+                  "Also the fleet link on loopback: record latency, leader's write to follower's "
+                  "receive, and a late follower's catch-up on a 1000-record route");
   bench->add_flag("--links-only", args->links_only,
-                  "Only the robot-link rows (with --ros1 and/or --ros2), not the method stages");
+                  "Only the link rows (with --ros1, --ros2 and/or --fleet), not the method stages");
   bench->callback([args] {
     if (args->links_only) {
-      if (!args->ros1 && !args->ros2) throw InputError("--links-only: add --ros1 and/or --ros2");
+      if (!args->ros1 && !args->ros2 && !args->fleet)
+        throw InputError("--links-only: add --ros1, --ros2 and/or --fleet");
       nlohmann::json j;
       if (args->ros1) BenchRos1(&j);
-    if (args->ros2) BenchRos2(&j);
       if (args->ros2) BenchRos2(&j);
+      if (args->fleet) BenchFleet(&j);
       if (args->json) {
         std::cout << j.dump() << "\n";
       } else {
@@ -410,6 +430,7 @@ void AddBenchCommand(CLI::App* app) {
     BenchEigenspace(args->repeats, &j);
     if (args->ros1) BenchRos1(&j);
     if (args->ros2) BenchRos2(&j);
+    if (args->fleet) BenchFleet(&j);
     if (args->json) {
       std::cout << j.dump() << "\n";
       return;

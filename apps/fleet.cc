@@ -366,11 +366,15 @@ void FollowConnected(const FollowConnectArgs& a) {
   int frame = 0;
   double lateral_sq = 0.0;
   int moving = 0;
+  int waited = 0;  // frames stopped at the end of the route taught so far
   const robot::LoopResult result = robot::RunLoop(
       *method, link, robot::LoopOptions{},
       [&](const robot::Observation& obs, const robot::Decision& decision) {
         ThrowIfInterrupted();
         const Pose2& truth = sim_link.truth();
+        if (decision.reason.rfind("waiting for the leader", 0) == 0 ||
+            decision.status == "waiting_for_leader")
+          ++waited;
         if (decision.state == robot::MethodState::kDriving) {
           const double d = eval::DistanceToPath(taught, truth.x_m, truth.y_m);
           lateral_sq += d * d;
@@ -409,6 +413,7 @@ void FollowConnected(const FollowConnectArgs& a) {
     j["final_error_m"] = final_error;
     j["lateral_rms_m"] = moving > 0 ? std::sqrt(lateral_sq / moving) : 0.0;
     j["frames"] = result.frames;
+    j["frames_waiting_for_leader"] = waited;
     j["records_received"] = stats.received;
     j["records_applied"] = stats.applied;
     j["duplicates_dropped"] = stats.duplicates_dropped;

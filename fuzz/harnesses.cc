@@ -5,9 +5,13 @@
 #include <filesystem>
 #include <fstream>
 #include <opencv2/core/utils/logger.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "mapless/core/check.h"
+#include "mapless/fleet/record.h"
+#include "mapless/fleet/route_log.h"
 #include "mapless/io/flo.h"
+#include "mapless/io/image_file.h"
 #include "mapless/io/frame_source.h"
 #include "mapless/io/tum.h"
 #include "mapless/navigation/potential.h"
@@ -187,6 +191,25 @@ void CameraMessage(const std::string& input) {
   });
 }
 
+void FleetRecord(const std::string& input) {
+  AcceptInputError([&] { fleet::DecodeSubscribe(input); });
+  AcceptInputError([&] {
+    const fleet::Record r = fleet::DecodeRecord(input);
+    if (r.type == fleet::RecordType::kHeader) {
+      fleet::ParseHeader(r);
+    } else if (r.type == fleet::RecordType::kImage) {
+      route::ParseAppearanceEntry(r.parts[0], "fuzz record");
+      io::DecodeImage(r.parts[1], "fuzz record", cv::IMREAD_GRAYSCALE);
+    } else if (r.type == fleet::RecordType::kKeyframe) {
+      route::Manifest header;
+      header.detector = "orb";
+      header.image_width = 320;
+      header.image_height = 240;
+      route::DecodeKeyframe(r.parts[0], r.parts[1], header, 0, 0, "fuzz record");
+    }
+  });
+}
+
 const std::vector<NamedHarness>& Harnesses() {
   static const std::vector<NamedHarness> harnesses = {{"route_manifest", RouteManifest},
                                                       {"route_keyframe", RouteKeyframe},
@@ -200,7 +223,8 @@ const std::vector<NamedHarness>& Harnesses() {
                                                       {"scenario_world", ScenarioWorld},
                                                       {"robot_file", RobotFile},
                                                       {"appearance_manifest", AppearanceManifest},
-                                                      {"camera_message", CameraMessage}};
+                                                      {"camera_message", CameraMessage},
+                                                      {"fleet_record", FleetRecord}};
   return harnesses;
 }
 

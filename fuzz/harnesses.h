@@ -46,6 +46,11 @@ void AppearanceManifest(const std::string& input);
 // 320x240 method, upright and turned.
 void CameraMessage(const std::string& input);
 
+// A message from the fleet link (fleet/record.h): a follower's subscription, or a leader's record
+// decoded and its contents checked as a follower checks them before storing them (the header, an
+// eigenspace route image and its entry, a keyframe's YAML and PNG against a 320x240 ORB route).
+void FleetRecord(const std::string& input);
+
 const std::vector<NamedHarness>& Harnesses();
 
 }  // namespace mapless::fuzz

@@ -71,7 +71,14 @@ struct FollowerClient::Impl {
     std::uint64_t next = copy.next_sequence();
     while (batch.size() < options.max_batch) {
       zmq::message_t msg;
-      if (!dealer.recv(msg, zmq::recv_flags::dontwait)) break;
+      if (!dealer.recv(msg, zmq::recv_flags::dontwait)) {
+        // Catching up, more records are on their way: wait a moment for them, so that many are
+        // written with one flush (a live record, alone, is applied at once).
+        if (batch.empty()) break;
+        zmq::pollitem_t item{dealer.handle(), 0, ZMQ_POLLIN, 0};
+        if (zmq::poll(&item, 1, std::chrono::milliseconds(2)) == 0) break;
+        continue;
+      }
       const std::int64_t now_ns = WallNs();
       last_heard = Clock::now();
       Record r;

@@ -10,7 +10,6 @@ namespace {
 
 constexpr char kRecordMagic[4] = {'M', 'L', 'F', 'R'};
 constexpr char kControlMagic[4] = {'M', 'L', 'F', 'C'};
-constexpr std::size_t kRecordHeaderBytes = 4 + 1 + 1 + 2 + 8 + 8 + 4;
 constexpr std::size_t kSubscribeBytes = 4 + 1 + 1 + 2 + 8;
 constexpr std::uint8_t kSubscribeType = 1;
 

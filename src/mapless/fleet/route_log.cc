@@ -167,7 +167,6 @@ void RouteCopy::Load() {
                   dir_ << ": route images are " << h.low_width << "x" << h.low_height
                        << ", this mapless builds its model at " << options.image.width << "x"
                        << options.image.height);
-    model_ = std::make_unique<navigation::AppearanceLeader>(options);
     const route::StoredAppearanceRoute route = route::LoadAppearanceRoute(dir_);
     for (int i = 0; i < static_cast<int>(route.images.size()); ++i) {
       const route::StoredAppearanceImage& image = route.images[static_cast<std::size_t>(i)];
@@ -176,11 +175,12 @@ void RouteCopy::Load() {
       r.parts = {route::AppearanceEntryJson(image),
                  io::ReadFile((fs::path(dir_) / route::AppearanceImageFile(i)).string(),
                               io::kMaxImageFileBytes)};
-      model_->AddStored(image.low, image.distance_m, image.odometry);
+      model_pending_.push_back(image);
+      ++images_;
+      last_distance_m_ = image.distance_m;
       log_.push_back(std::move(r));
     }
     complete_ = route.complete;
-    if (complete_) model_->Finish();
   }
   if (complete_) log_.push_back(EndRecord());
   const std::int64_t now = WallNs();
@@ -258,7 +258,6 @@ void RouteCopy::ApplyOne(const Record& record) {
                          << options.image.height);
       image_writer_ = std::make_unique<route::AppearanceRouteWriter>(
           dir_, h.image_width, h.image_height, h.low_width, h.low_height);
-      model_ = std::make_unique<navigation::AppearanceLeader>(options);
     }
     header_ = h;
   } else if (!header_) {
@@ -277,7 +276,7 @@ void RouteCopy::ApplyOne(const Record& record) {
     funnel_cache_.reset();
   } else if (record.type == RecordType::kImage) {
     MAPLESS_CHECK(header_->kind == RouteKind::kEigenspace, what << ": in a funnel route");
-    MAPLESS_CHECK(model_->images() < io::kMaxKeyframes,
+    MAPLESS_CHECK(images_ < static_cast<std::size_t>(io::kMaxKeyframes),
                   what << ": more than " << io::kMaxKeyframes << " route images");
     route::StoredAppearanceImage image = route::ParseAppearanceEntry(record.parts[0], what);
     image.low = io::DecodeImage(record.parts[1], what + " image", cv::IMREAD_GRAYSCALE);
@@ -285,19 +284,18 @@ void RouteCopy::ApplyOne(const Record& record) {
                   what << ": image is " << image.low.cols << "x" << image.low.rows
                        << ", the route's are " << header_->low_width << "x"
                        << header_->low_height);
-    MAPLESS_CHECK(model_->images() == 0 || image.distance_m >= model_->distance_m(),
+    MAPLESS_CHECK(images_ == 0 || image.distance_m >= last_distance_m_,
                   what << ": distance_m goes backwards");
     image_writer_->AppendEncoded(image, record.parts[1]);
-    model_->AddStored(image.low, image.distance_m, image.odometry);
-    appearance_cache_.reset();
+    last_distance_m_ = image.distance_m;
+    ++images_;
+    model_pending_.push_back(std::move(image));
   } else if (record.type == RecordType::kEnd) {
     if (keyframe_writer_) {
       keyframe_writer_->Finish();
       funnel_cache_.reset();
     } else {
       image_writer_->Finish();
-      model_->Finish();
-      appearance_cache_.reset();
     }
     complete_ = true;
   } else {
@@ -322,9 +320,24 @@ std::shared_ptr<const route::Route> RouteCopy::FunnelRoute() const {
 }
 
 std::shared_ptr<const route::AppearanceRoute> RouteCopy::AppearanceRoute() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (!model_ || model_->images() < 1) return nullptr;
-  if (!appearance_cache_) appearance_cache_ = model_->Snapshot();
+  std::lock_guard<std::mutex> model_lock(model_mutex_);
+  std::vector<route::StoredAppearanceImage> pending;
+  bool complete = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!header_ || header_->kind != RouteKind::kEigenspace || images_ < 1) return nullptr;
+    pending.swap(model_pending_);
+    complete = complete_;
+  }
+  if (!model_) model_ = std::make_unique<navigation::AppearanceLeader>();
+  for (const route::StoredAppearanceImage& image : pending)
+    model_->AddStored(image.low, image.distance_m, image.odometry);
+  const bool finish = complete && !model_finished_;
+  if (finish) {
+    model_->Finish();
+    model_finished_ = true;
+  }
+  if (!appearance_cache_ || !pending.empty() || finish) appearance_cache_ = model_->Snapshot();
   return appearance_cache_;
 }
 

@@ -69,7 +69,9 @@ class RouteCopy {
   void Apply(const std::vector<Record>& records);
 
   // The route as the methods see it (built when asked and cached until the next record): null
-  // until there are at least 2 keyframes / 1 route image.
+  // until there are at least 2 keyframes / 1 route image. The eigenspace is built here, from the
+  // route images applied since the last call (a follower catching up stores the records first
+  // and builds the model once, when its method asks).
   std::shared_ptr<const route::Route> FunnelRoute() const;
   std::shared_ptr<const route::AppearanceRoute> AppearanceRoute() const;
 
@@ -87,8 +89,14 @@ class RouteCopy {
   std::unique_ptr<route::RouteWriter> keyframe_writer_;
   std::unique_ptr<route::AppearanceRouteWriter> image_writer_;
   std::vector<route::Keyframe> keyframes_;
-  std::unique_ptr<navigation::AppearanceLeader> model_;
+  mutable std::vector<route::StoredAppearanceImage> model_pending_;  // applied, not in the model
+  std::size_t images_ = 0;
+  double last_distance_m_ = 0.0;
   mutable std::shared_ptr<const route::Route> funnel_cache_;
+  // The eigenspace, under its own lock (building it does not hold up Apply).
+  mutable std::mutex model_mutex_;
+  mutable std::unique_ptr<navigation::AppearanceLeader> model_;
+  mutable bool model_finished_ = false;
   mutable std::shared_ptr<const route::AppearanceRoute> appearance_cache_;
 };
 

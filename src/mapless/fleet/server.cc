@@ -261,7 +261,7 @@ LeaderServer::LeaderServer(const RouteCopy& log, ServerOptions options, FleetLog
     // Subscriptions are 16 bytes: a larger message still reaches the decoder (and its log line) up
     // to 64 KiB; beyond that ZeroMQ drops the connection.
     s.router.set(zmq::sockopt::maxmsgsize, static_cast<std::int64_t>(64 << 10));
-    s.router.set(zmq::sockopt::sndhwm, 64);
+    s.router.set(zmq::sockopt::sndhwm, 256);
     s.router.set(zmq::sockopt::linger, 200);
     SetHeartbeats(s.router);
     zmq_socket_monitor(s.router.handle(), "inproc://mapless-fleet-monitor",

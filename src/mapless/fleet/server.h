@@ -30,7 +30,7 @@ using FleetLogger = std::function<void(const std::string&)>;
 struct ServerOptions {
   std::string bind = "tcp://127.0.0.1:5600";
   LeaderSecurity security;
-  std::size_t batch = 64;        // records per follower per round
+  std::size_t batch = 256;       // records per follower per round
   double heartbeat_s = 1.0;      // to an up-to-date follower
   double forget_after_s = 60.0;  // a follower silent this long is forgotten (it resubscribes)
 };

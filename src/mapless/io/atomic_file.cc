@@ -74,6 +74,14 @@ void WriteFileAtomic(const std::string& path, std::string_view bytes, bool sync)
   }
 }
 
+void WriteNewFile(const std::string& path, std::string_view bytes) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NOFOLLOW, 0644);
+  if (fd < 0 || !WriteAll(fd, bytes) || ::close(fd) != 0) {
+    const std::string why = std::strerror(errno);
+    throw InputError(path + ": cannot write: " + why);
+  }
+}
+
 void SyncFile(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0 || ::fsync(fd) != 0) {
@@ -94,6 +102,20 @@ std::string EncodeImage(const cv::Mat& image, const std::string& ext, const std:
   }
   if (!ok) throw InputError(name + ": cannot encode an image as '" + ext + "'");
   return std::string(reinterpret_cast<const char*>(buffer.data()), buffer.size());
+}
+
+void SyncFiles(const std::vector<std::string>& paths) {
+  if (paths.size() <= 4) {
+    for (const std::string& path : paths) SyncFile(path);
+    return;
+  }
+  const int fd = ::open(paths.front().c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0 || ::syncfs(fd) != 0) {
+    const std::string why = std::strerror(errno);
+    if (fd >= 0) ::close(fd);
+    throw InputError(paths.front() + ": cannot flush to disk: " + why);
+  }
+  ::close(fd);
 }
 
 void WriteImageAtomic(const std::string& path, const cv::Mat& image) {

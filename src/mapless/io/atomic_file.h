@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace mapless::io {
 
@@ -20,8 +21,15 @@ OutputKind KindOfOutput(const std::string& path);
 // SyncFile() before anything that refers to it is written (many files, one wait: a follower
 // catching up on a route).
 void WriteFileAtomic(const std::string& path, std::string_view bytes, bool sync = true);
+// Writes a file that nothing refers to yet in place (created or truncated; no temporary file and
+// rename): a route's new keyframe or image before the manifest lists it. Flush it with
+// SyncFiles() before writing what refers to it; a crash before that leaves a file no one reads.
+void WriteNewFile(const std::string& path, std::string_view bytes);
 // Flushes a written file to disk; throws InputError naming the path on failure.
 void SyncFile(const std::string& path);
+// Flushes written files to disk: one by one when they are few, else the whole file system they
+// are on at once (syncfs: one journal commit instead of one per file).
+void SyncFiles(const std::vector<std::string>& paths);
 
 // An image encoded as `ext` (".png", ...); throws InputError naming `name` when it cannot be.
 std::string EncodeImage(const cv::Mat& image, const std::string& ext, const std::string& name);

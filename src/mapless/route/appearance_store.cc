@@ -64,7 +64,7 @@ void AppearanceRouteWriter::AppendEncoded(const StoredAppearanceImage& entry,
                                           std::string_view png) {
   MAPLESS_CHECK(!header_.complete, "AppearanceRouteWriter: an image after the route's end");
   const std::string path = (fs::path(dir_) / ImageFile(images())).string();
-  io::WriteFileAtomic(path, png, /*sync=*/false);
+  io::WriteNewFile(path, png);
   pending_.push_back(path);
   StoredAppearanceImage e = entry;
   e.low = cv::Mat();
@@ -72,7 +72,7 @@ void AppearanceRouteWriter::AppendEncoded(const StoredAppearanceImage& entry,
 }
 
 void AppearanceRouteWriter::Flush() {
-  for (const std::string& path : pending_) io::SyncFile(path);
+  io::SyncFiles(pending_);
   pending_.clear();
   WriteManifest();
 }

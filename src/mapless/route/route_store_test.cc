@@ -184,3 +184,44 @@ TEST(RouteStore, LoadingCatchesWhatARepeatWouldTripOn) {
 
 }  // namespace
 }  // namespace mapless::route
+
+namespace mapless::route {
+namespace {
+
+// ParseKeyframe reads a file as the route store writes it with a fast reader, and anything else
+// with yaml-cpp: both must give the same keyframe (a comment line makes the file non-canonical).
+TEST(RouteStore, TheFastKeyframeReaderAgreesWithYamlCpp) {
+  for (int index : {0, 1, 5}) {
+    Keyframe kf = MakeKeyframe(index);
+    if (index == 5) {
+      kf.keypoints.clear();
+      kf.descriptors = cv::Mat();
+      kf.segment_start_px.clear();
+      kf.segment_end_px.clear();
+    }
+    const std::string text = SerializeKeyframe(kf);
+    const Keyframe fast = ParseKeyframe(text, "fast");
+    const Keyframe general = ParseKeyframe(text + "# not canonical\n", "general");
+    ASSERT_EQ(fast.keypoints.size(), general.keypoints.size());
+    for (std::size_t i = 0; i < fast.keypoints.size(); ++i) {
+      EXPECT_EQ(fast.keypoints[i].pt, general.keypoints[i].pt);
+      EXPECT_EQ(fast.keypoints[i].size, general.keypoints[i].size);
+      EXPECT_EQ(fast.keypoints[i].angle, general.keypoints[i].angle);
+      EXPECT_EQ(fast.keypoints[i].response, general.keypoints[i].response);
+      EXPECT_EQ(fast.keypoints[i].octave, general.keypoints[i].octave);
+      EXPECT_EQ(fast.keypoints[i].class_id, general.keypoints[i].class_id);
+    }
+    EXPECT_EQ(fast.index, general.index);
+    EXPECT_EQ(fast.t_ns, general.t_ns);
+    EXPECT_EQ(cv::norm(fast.descriptors, general.descriptors, cv::NORM_INF), 0.0);
+    EXPECT_EQ(fast.descriptors.type(), general.descriptors.type());
+    EXPECT_EQ(fast.segment_start_px, general.segment_start_px);
+    EXPECT_EQ(fast.segment_end_px, general.segment_end_px);
+    // Cut anywhere, the file is refused (by one reader or the other), never half read.
+    for (std::size_t n = 0; n + 1 < text.size(); n += 97)
+      EXPECT_THROW(ParseKeyframe(text.substr(0, n), "cut"), InputError) << n;
+  }
+}
+
+}  // namespace
+}  // namespace mapless::route
