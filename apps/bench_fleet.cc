@@ -34,8 +34,8 @@ fleet::Record BenchRecord(fleet::RouteKind kind, int index) {
     image.low = cv::Mat(64, 64, CV_8UC1);
     for (int r = 0; r < 64; ++r)
       for (int c = 0; c < 64; ++c)
-        image.low.at<std::uint8_t>(r, c) =
-            static_cast<std::uint8_t>(128 + 60 * std::sin(0.3 * c + 0.1 * index) + rng.Uniform(-20, 20));
+        image.low.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(
+            128 + 60 * std::sin(0.3 * c + 0.1 * index) + rng.Uniform(-20, 20));
     image.distance_m = 0.2 * index;
     image.odometry = Pose2{0.2 * index, 0.0, 0.0};
     return fleet::ImageRecord(image);
@@ -73,7 +73,8 @@ fleet::RouteHeader BenchHeader(fleet::RouteKind kind) {
 
 bool WaitUntil(const std::function<bool()>& done, double seconds) {
   const auto until = Clock::now() + std::chrono::duration<double>(seconds);
-  while (!done() && Clock::now() < until) std::this_thread::sleep_for(std::chrono::microseconds(200));
+  while (!done() && Clock::now() < until)
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
   return done();
 }
 
@@ -86,9 +87,8 @@ double Percentile(std::vector<double> v, double p) {
 }  // namespace
 
 void BenchFleet(nlohmann::json* j) {
-  const std::string root = (fs::temp_directory_path() / ("mapless-bench-fleet-" +
-                                                         std::to_string(::getpid())))
-                               .string();
+  const std::string root =
+      (fs::temp_directory_path() / ("mapless-bench-fleet-" + std::to_string(::getpid()))).string();
   fs::remove_all(root);
   for (const fleet::RouteKind kind : {fleet::RouteKind::kEigenspace, fleet::RouteKind::kFunnel}) {
     const std::string name = fleet::RouteKindName(kind);
@@ -121,7 +121,8 @@ void BenchFleet(nlohmann::json* j) {
       (*j)["fleet_model_rebuild_1000_s"] =
           built ? std::chrono::duration<double>(Clock::now() - t0).count() : -1.0;
     }
-    (*j)["fleet_record_bytes_" + name] = records.back().parts[0].size() + records.back().parts[1].size();
+    (*j)["fleet_record_bytes_" + name] =
+        records.back().parts[0].size() + records.back().parts[1].size();
     // Latency: a caught-up follower, then 300 live records 10 ms apart.
     fleet::RouteCopy live(root + "/" + name + "_live");
     fleet::FollowerClient client(live, client_options, nullptr);

@@ -59,7 +59,8 @@ int FreePort() {
 // A process of this program, its output to a log file.
 class Child {
  public:
-  Child(std::vector<std::string> args, std::string log) : args_(std::move(args)), log_(std::move(log)) {}
+  Child(std::vector<std::string> args, std::string log)
+      : args_(std::move(args)), log_(std::move(log)) {}
   void Start() {
     pid_ = ::fork();
     MAPLESS_CHECK(pid_ >= 0, "eval fleet: cannot fork");
@@ -92,7 +93,8 @@ class Child {
   }
   void Wait(double seconds) {
     const auto t0 = Clock::now();
-    while (!Poll() && Since(t0) < seconds) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    while (!Poll() && Since(t0) < seconds)
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
     if (!Poll()) {
       Signal(SIGKILL);
       while (!Poll()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -135,7 +137,8 @@ class Relay {
     addr.sin_port = htons(static_cast<std::uint16_t>(listen_port_));
     if (::bind(listener_, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)) != 0 ||
         ::listen(listener_, 16) != 0)
-      throw InputError("eval fleet: the relay cannot listen on port " + std::to_string(listen_port_));
+      throw InputError("eval fleet: the relay cannot listen on port " +
+                       std::to_string(listen_port_));
   }
   int Dial() {
     const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
@@ -266,7 +269,7 @@ void AddFleetEvalOptions(CLI::App* eval, FleetEvalArgs* a) {
 void RunFleetEval(const FleetEvalArgs& a, bool json) {
   if (a.method != "funnel" && a.method != "eigenspace")
     throw InputError("--method " + a.method + ": must be funnel or eigenspace");
-  const std::string scenario = !a.scenario.empty() ? a.scenario
+  const std::string scenario = !a.scenario.empty()    ? a.scenario
                                : a.method == "funnel" ? "table1_almost_straight"
                                                       : "office_aliasing";
   std::string work = a.keep;
@@ -284,14 +287,15 @@ void RunFleetEval(const FleetEvalArgs& a, bool json) {
   if (a.curve) {
     fleet::GenerateCurveKey(work + "/leader.key");
     fleet::GenerateCurveKey(work + "/follower.key");
-    curve_leader = {"--curve-key", work + "/leader.key", "--curve-allow", work + "/follower.key.pub"};
+    curve_leader = {"--curve-key", work + "/leader.key", "--curve-allow",
+                    work + "/follower.key.pub"};
     curve_follower = {"--curve-key", work + "/follower.key", "--curve-leader",
                       work + "/leader.key.pub"};
   }
   const std::string rate = std::to_string(a.rate);
-  std::vector<std::string> lead_args = {"mapless", "lead", "--source", "sim:" + scenario, "--route",
-                                        work + "/leader", "--bind", endpoint, "--method", a.method,
-                                        "--rate", rate};
+  std::vector<std::string> lead_args = {"mapless",  "lead",           "--source", "sim:" + scenario,
+                                        "--route",  work + "/leader", "--bind",   endpoint,
+                                        "--method", a.method,         "--rate",   rate};
   lead_args.insert(lead_args.end(), curve_leader.begin(), curve_leader.end());
   Child leader(lead_args, work + "/leader.log");
   std::unique_ptr<Relay> relay;
@@ -305,10 +309,13 @@ void RunFleetEval(const FleetEvalArgs& a, bool json) {
     const std::string name = "follower" + std::to_string(i);
     const bool relayed = relay && i == a.followers;
     std::vector<std::string> args = {
-        "mapless", "follow", "--connect",
-        relayed ? "tcp://127.0.0.1:" + std::to_string(relay_port) : endpoint, "--source",
-        "sim:" + scenario, "--route", work + "/" + name, "--rate", rate, "--summary",
-        work + "/" + name + ".json", "--seed", std::to_string(a.seed + static_cast<std::uint64_t>(i))};
+        "mapless",   "follow",
+        "--connect", relayed ? "tcp://127.0.0.1:" + std::to_string(relay_port) : endpoint,
+        "--source",  "sim:" + scenario,
+        "--route",   work + "/" + name,
+        "--rate",    rate,
+        "--summary", work + "/" + name + ".json",
+        "--seed",    std::to_string(a.seed + static_cast<std::uint64_t>(i))};
     args.insert(args.end(), curve_follower.begin(), curve_follower.end());
     followers.emplace_back(args, work + "/" + name + ".log");
   }
@@ -420,8 +427,8 @@ void RunFleetEval(const FleetEvalArgs& a, bool json) {
     s["follower"] = i;
     s["restarted"] = follower_killed && i == 1;
     s["link_cut"] = relay_port && i == a.followers;
-    const bool good = s.value("completed", false) && identical && gaps == 0 &&
-                      s.value("rejected", 0) == 0;
+    const bool good =
+        s.value("completed", false) && identical && gaps == 0 && s.value("rejected", 0) == 0;
     ok = ok && good;
     std::fprintf(table, "%-10s %-9s %7.3fm %7.3fm %8d %8d %5d %5d %8s %7.2fms %7.2fms\n",
                  name.c_str(), s.value("completed", false) ? "yes" : "NO",
@@ -434,7 +441,9 @@ void RunFleetEval(const FleetEvalArgs& a, bool json) {
   j["ok"] = ok;
   if (json) std::cout << j.dump() << "\n";
   if (a.keep.empty()) fs::remove_all(work);
-  if (!ok) throw RunFailed("eval fleet: a follower failed or its copy differs (logs: rerun with --keep DIR)");
+  if (!ok)
+    throw RunFailed(
+        "eval fleet: a follower failed or its copy differs (logs: rerun with --keep DIR)");
 }
 
 }  // namespace mapless::app

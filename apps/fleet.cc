@@ -47,9 +47,8 @@ class Pacer {
       sim0_ = sim_ns;
       return;
     }
-    const auto due =
-        wall0_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                     std::chrono::duration<double>(ToSeconds(sim_ns - sim0_) / rate_));
+    const auto due = wall0_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                  std::chrono::duration<double>(ToSeconds(sim_ns - sim0_) / rate_));
     if (due > now) std::this_thread::sleep_until(due);
   }
 
@@ -99,7 +98,10 @@ class LeaderTeacher {
  public:
   LeaderTeacher(fleet::RouteCopy& copy, fleet::LeaderServer& server, fleet::RouteKind kind,
                 const std::string& detector)
-      : copy_(copy), server_(server), kind_(kind), detector_(detector),
+      : copy_(copy),
+        server_(server),
+        kind_(kind),
+        detector_(detector),
         resuming_(copy.next_sequence() > 1 && !copy.complete()) {
     teach_options_.features.type = features::ParseDetectorType(detector);
     teach_options_.Validate();
@@ -149,8 +151,9 @@ class LeaderTeacher {
       return;
     }
     if (!odometry)
-      throw InputError("lead --method eigenspace needs wheel odometry (route images are spaced by "
-                       "distance): lead on sim:SCENARIO or on a robot with an odometry topic");
+      throw InputError(
+          "lead --method eigenspace needs wheel odometry (route images are spaced by "
+          "distance): lead on sim:SCENARIO or on a robot with an odometry topic");
     if (leader_.Update(image, *odometry))
       Serve(fleet::ImageRecord({leader_.last_low(), leader_.distance_m(), *odometry}));
   }
@@ -220,7 +223,8 @@ void Lead(const LeadArgs& a) {
   server_options.security = LeaderKeys(a.curve_key, a.curve_allow);
   fleet::RouteCopy copy(a.route);  // resumes an interrupted leader's route
   if (copy.header() && copy.header()->kind != kind)
-    throw InputError(a.route + ": holds a " + std::string(fleet::RouteKindName(copy.header()->kind)) +
+    throw InputError(a.route + ": holds a " +
+                     std::string(fleet::RouteKindName(copy.header()->kind)) +
                      " route; this leader teaches " + a.method);
   fleet::LeaderServer server(copy, server_options, FleetLog);
   spdlog::info("lead: serving {} on {}{}", a.route, server.endpoint(),
@@ -248,8 +252,8 @@ void Lead(const LeadArgs& a) {
               teacher.Frame(f.image, f.t_ns, f.odometry);
             });
         if (!summary.completed)
-          throw RunFailed("lead: the drive of '" + scenario->name + "' did not complete: " +
-                          summary.status);
+          throw RunFailed("lead: the drive of '" + scenario->name +
+                          "' did not complete: " + summary.status);
         teacher.Finish();
       } else {
         std::unique_ptr<robot::RobotLink> link = OpenRobotLink(*robot_file, {}, "teach");
@@ -315,12 +319,13 @@ void FollowConnected(const FollowConnectArgs& a) {
     navigation::RepeatOptions repeat;
     repeat.features.type = features::ParseDetectorType(header.detector);
     if (scenario) {
-      const double speed = eval::RepeatSpeedFor(*scenario, eval::RepeatRunOptions{}.max_repeat_speed_mps);
+      const double speed =
+          eval::RepeatSpeedFor(*scenario, eval::RepeatRunOptions{}.max_repeat_speed_mps);
       repeat.sloped.max_speed_mps = speed;
       repeat.standard.forward_speed_mps = speed;
     }
-    method = std::make_unique<robot::RepeatMethod>([&copy] { return copy.FunnelRoute(); }, repeat,
-                                                   size);
+    method =
+        std::make_unique<robot::RepeatMethod>([&copy] { return copy.FunnelRoute(); }, repeat, size);
   } else {
     method = std::make_unique<robot::FollowMethod>([&copy] { return copy.AppearanceRoute(); },
                                                    navigation::AppearanceFollowerOptions{}, size);
@@ -367,37 +372,37 @@ void FollowConnected(const FollowConnectArgs& a) {
   double lateral_sq = 0.0;
   int moving = 0;
   int waited = 0;  // frames stopped at the end of the route taught so far
-  const robot::LoopResult result = robot::RunLoop(
-      *method, link, robot::LoopOptions{},
-      [&](const robot::Observation& obs, const robot::Decision& decision) {
-        ThrowIfInterrupted();
-        const Pose2& truth = sim_link.truth();
-        if (decision.reason.rfind("waiting for the leader", 0) == 0 ||
-            decision.status == "waiting_for_leader")
-          ++waited;
-        if (decision.state == robot::MethodState::kDriving) {
-          const double d = eval::DistanceToPath(taught, truth.x_m, truth.y_m);
-          lateral_sq += d * d;
-          ++moving;
-        }
-        if (!a.log.empty()) {
-          nlohmann::json j = robot::StatusJson(method->name(), frame, obs, decision);
-          j["x_m"] = truth.x_m;
-          j["y_m"] = truth.y_m;
-          j["theta_rad"] = truth.theta_rad;
-          log.Write(j);
-        }
-        ++frame;
-        return true;
-      });
+  const robot::LoopResult result =
+      robot::RunLoop(*method, link, robot::LoopOptions{},
+                     [&](const robot::Observation& obs, const robot::Decision& decision) {
+                       ThrowIfInterrupted();
+                       const Pose2& truth = sim_link.truth();
+                       if (decision.reason.rfind("waiting for the leader", 0) == 0 ||
+                           decision.status == "waiting_for_leader")
+                         ++waited;
+                       if (decision.state == robot::MethodState::kDriving) {
+                         const double d = eval::DistanceToPath(taught, truth.x_m, truth.y_m);
+                         lateral_sq += d * d;
+                         ++moving;
+                       }
+                       if (!a.log.empty()) {
+                         nlohmann::json j = robot::StatusJson(method->name(), frame, obs, decision);
+                         j["x_m"] = truth.x_m;
+                         j["y_m"] = truth.y_m;
+                         j["theta_rad"] = truth.theta_rad;
+                         log.Write(j);
+                       }
+                       ++frame;
+                       return true;
+                     });
   const double final_error = sim_link.truth().DistanceTo(taught.back());
   const double tolerance = header.kind == fleet::RouteKind::kFunnel
                                ? eval::RepeatRunOptions{}.success_radius_m
                                : eval::EigenspaceRunOptions{}.arrive_tolerance_m;
   const bool success = result.finished && !sim.collided(r) && final_error <= tolerance;
   const fleet::ClientStats stats = client.stats();
-  spdlog::info("follow: {} ({} frames); {:.2f} m from the route's end; {} records applied", result.reason,
-               result.frames, final_error, stats.applied);
+  spdlog::info("follow: {} ({} frames); {:.2f} m from the route's end; {} records applied",
+               result.reason, result.frames, final_error, stats.applied);
   if (!a.summary.empty()) {
     std::vector<double> latency = stats.latency_ms;
     std::sort(latency.begin(), latency.end());

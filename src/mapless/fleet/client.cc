@@ -38,7 +38,8 @@ struct FollowerClient::Impl {
   Clock::time_point last_subscribe;
   std::int64_t first_subscribe_ns = 0;
   std::uint64_t rejected_sequence = ~0ull;
-  bool unsent = false;  // the last subscription found no connection  // log a bad record once, not at every resend
+  bool unsent = false;  // the last subscription found no connection  // log a bad record once, not
+                        // at every resend
   std::thread thread;
 
   Impl(RouteCopy& c, ClientOptions o, FleetLogger f)

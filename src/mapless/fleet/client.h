@@ -30,16 +30,16 @@ struct ClientOptions {
 };
 
 struct ClientStats {
-  std::uint64_t received = 0;          // records taken off the link
-  std::uint64_t applied = 0;           // ... and applied to the copy (each exactly once)
+  std::uint64_t received = 0;            // records taken off the link
+  std::uint64_t applied = 0;             // ... and applied to the copy (each exactly once)
   std::uint64_t duplicates_dropped = 0;  // older than the next one needed (sent again)
   std::uint64_t ahead_dropped = 0;       // newer than the next one needed (a gap, asked again)
   std::uint64_t rejected = 0;            // malformed or refused by the copy
   std::uint64_t subscriptions = 0;       // "from n" sent
   std::uint64_t leader_records = 0;      // the leader's log size at its last heartbeat
   bool leader_complete = false;
-  double silent_s = 0.0;                 // since the last message from the leader
-  std::vector<double> latency_ms;        // live records: leader's write to this receive
+  double silent_s = 0.0;           // since the last message from the leader
+  std::vector<double> latency_ms;  // live records: leader's write to this receive
 };
 
 class FollowerClient {

@@ -32,8 +32,9 @@ CurveKey LoadCurveKey(const std::string& path, bool need_secret) {
     key.public_key = CheckedKey(map, "public_key", path);
     if (need_secret) {
       if (!map.Has("secret_key"))
-        throw InputError(path + ": secret_key: missing (this is a public key file; give the file "
-                                "`mapless fleet keygen` wrote without .pub)");
+        throw InputError(path +
+                         ": secret_key: missing (this is a public key file; give the file "
+                         "`mapless fleet keygen` wrote without .pub)");
       key.secret_key = CheckedKey(map, "secret_key", path);
       char derived[41];
       if (zmq_curve_public(derived, key.secret_key.c_str()) != 0 || key.public_key != derived)

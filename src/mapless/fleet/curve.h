@@ -27,12 +27,12 @@ CurveKey GenerateCurveKey(const std::string& path);
 bool CurveAvailable();  // libzmq was built with CURVE
 
 struct LeaderSecurity {
-  CurveKey key;                               // empty public_key: no CURVE
-  std::vector<std::string> allowed_public;    // empty: any follower that knows the leader's key
+  CurveKey key;                             // empty public_key: no CURVE
+  std::vector<std::string> allowed_public;  // empty: any follower that knows the leader's key
   bool enabled() const { return !key.public_key.empty(); }
 };
 struct FollowerSecurity {
-  CurveKey key;            // empty: no CURVE
+  CurveKey key;  // empty: no CURVE
   std::string leader_public;
   bool enabled() const { return !key.public_key.empty(); }
 };

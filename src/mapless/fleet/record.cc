@@ -131,8 +131,7 @@ Record DecodeRecord(std::string_view bytes) {
     r.parts.emplace_back(in.Take(length, "part"));
   }
   if (in.left() != 0)
-    throw InputError("fleet message: " + std::to_string(in.left()) +
-                     " bytes after the last part");
+    throw InputError("fleet message: " + std::to_string(in.left()) + " bytes after the last part");
   // The parts each type must have (their contents are checked where they are used).
   const std::size_t expected = r.type == RecordType::kHeader      ? 1
                                : r.type == RecordType::kKeyframe  ? 2
@@ -144,8 +143,8 @@ Record DecodeRecord(std::string_view bytes) {
                      std::to_string(r.parts.size()) + " parts (expected " +
                      std::to_string(expected) + ")");
   if (r.type == RecordType::kHeader && r.sequence != 0)
-    throw InputError("fleet message: a header record with sequence " +
-                     std::to_string(r.sequence) + " (it is always 0)");
+    throw InputError("fleet message: a header record with sequence " + std::to_string(r.sequence) +
+                     " (it is always 0)");
   return r;
 }
 

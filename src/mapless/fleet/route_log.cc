@@ -122,10 +122,12 @@ void RouteCopy::Load() {
   const bool eigen = fs::exists(fs::path(dir_) / "appearance.json");
   if (!funnel && !eigen) {
     if (fs::exists(dir_) && !fs::is_empty(dir_))
-      throw InputError(dir_ + ": holds something else than a route; choose a new or empty directory");
+      throw InputError(dir_ +
+                       ": holds something else than a route; choose a new or empty directory");
     return;
   }
-  MAPLESS_CHECK(!(funnel && eigen), dir_ << ": holds two routes (manifest.json and appearance.json)");
+  MAPLESS_CHECK(!(funnel && eigen),
+                dir_ << ": holds two routes (manifest.json and appearance.json)");
   // Records are rebuilt from the files and applied to an in-memory state; the files stay as they
   // are (Reopen keeps writing after them).
   std::vector<Record> records;
@@ -146,8 +148,9 @@ void RouteCopy::Load() {
       r.parts = {io::ReadFile((fs::path(dir_) / e.data).string(), io::kMaxKeyframeFileBytes),
                  io::ReadFile((fs::path(dir_) / e.thumbnail).string(), io::kMaxImageFileBytes)};
       const Timestamp after = keyframes_.empty() ? 0 : keyframes_.back().t_ns;
-      keyframes_.push_back(route::DecodeKeyframe(r.parts[0], r.parts[1], m, e.index, after,
-                                                 (fs::path(dir_) / e.data).replace_extension().string()));
+      keyframes_.push_back(
+          route::DecodeKeyframe(r.parts[0], r.parts[1], m, e.index, after,
+                                (fs::path(dir_) / e.data).replace_extension().string()));
       log_.push_back(std::move(r));
     }
     complete_ = m.complete;
@@ -238,8 +241,8 @@ void RouteCopy::Apply(const std::vector<Record>& records) {
 }
 
 void RouteCopy::ApplyOne(const Record& record) {
-  const std::string what = std::string(RecordTypeName(record.type)) + " record " +
-                           std::to_string(record.sequence);
+  const std::string what =
+      std::string(RecordTypeName(record.type)) + " record " + std::to_string(record.sequence);
   if (record.sequence != log_.size())
     throw InputError(what + ": expected sequence " + std::to_string(log_.size()));
   if (complete_) throw InputError(what + ": after the end of the route");
@@ -265,12 +268,11 @@ void RouteCopy::ApplyOne(const Record& record) {
   } else if (record.type == RecordType::kKeyframe) {
     MAPLESS_CHECK(header_->kind == RouteKind::kFunnel, what << ": in an eigenspace route");
     const int index = static_cast<int>(keyframes_.size());
-    MAPLESS_CHECK(index < io::kMaxKeyframes, what << ": more than " << io::kMaxKeyframes
-                                                  << " keyframes");
-    route::Keyframe kf = route::DecodeKeyframe(record.parts[0], record.parts[1],
-                                               FunnelManifest(*header_), index,
-                                               keyframes_.empty() ? 0 : keyframes_.back().t_ns,
-                                               what + " keyframe");
+    MAPLESS_CHECK(index < io::kMaxKeyframes,
+                  what << ": more than " << io::kMaxKeyframes << " keyframes");
+    route::Keyframe kf =
+        route::DecodeKeyframe(record.parts[0], record.parts[1], FunnelManifest(*header_), index,
+                              keyframes_.empty() ? 0 : keyframes_.back().t_ns, what + " keyframe");
     keyframe_writer_->AppendEncoded(index, kf.t_ns, record.parts[0], record.parts[1]);
     keyframes_.push_back(std::move(kf));
     funnel_cache_.reset();
@@ -282,8 +284,7 @@ void RouteCopy::ApplyOne(const Record& record) {
     image.low = io::DecodeImage(record.parts[1], what + " image", cv::IMREAD_GRAYSCALE);
     MAPLESS_CHECK(image.low.cols == header_->low_width && image.low.rows == header_->low_height,
                   what << ": image is " << image.low.cols << "x" << image.low.rows
-                       << ", the route's are " << header_->low_width << "x"
-                       << header_->low_height);
+                       << ", the route's are " << header_->low_width << "x" << header_->low_height);
     MAPLESS_CHECK(images_ == 0 || image.distance_m >= last_distance_m_,
                   what << ": distance_m goes backwards");
     image_writer_->AppendEncoded(image, record.parts[1]);

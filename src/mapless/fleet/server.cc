@@ -61,7 +61,8 @@ struct LeaderServer::Impl {
       ++held_back;
       return;
     }
-    Log(line + (held_back > 0 ? " (and " + std::to_string(held_back) + " more since the last)" : ""));
+    Log(line +
+        (held_back > 0 ? " (and " + std::to_string(held_back) + " more since the last)" : ""));
     held_back = 0;
     last_reject_log = now;
   }
@@ -91,16 +92,16 @@ struct LeaderServer::Impl {
       client_key = z85;
     }
     const auto& allowed = options.security.allowed_public;
-    const bool ok = request[5].to_string() == "CURVE" &&
-                    (allowed.empty() ||
-                     std::find(allowed.begin(), allowed.end(), client_key) != allowed.end());
+    const bool ok =
+        request[5].to_string() == "CURVE" &&
+        (allowed.empty() || std::find(allowed.begin(), allowed.end(), client_key) != allowed.end());
     if (!ok) {
       Count(&ServerStats::refused);
       Log("fleet: refused a follower from " + address + ": its key " + client_key +
           " is not admitted (--curve-allow)");
     }
-    std::vector<std::string> reply = {"1.0", request[1].to_string(), ok ? "200" : "400",
-                                      ok ? "OK" : "key not admitted", "", ""};
+    std::vector<std::string> reply = {
+        "1.0", request[1].to_string(), ok ? "200" : "400", ok ? "OK" : "key not admitted", "", ""};
     for (std::size_t i = 0; i < reply.size(); ++i) {
       zap.send(zmq::buffer(reply[i]),
                i + 1 < reply.size() ? zmq::send_flags::sndmore : zmq::send_flags::none);
@@ -182,7 +183,8 @@ struct LeaderServer::Impl {
       std::vector<std::string> out;
       std::uint64_t first = peer.next;
       if (peer.next < size) {
-        for (const Record& r : log.RecordsFrom(peer.next, options.batch)) out.push_back(EncodeRecord(r));
+        for (const Record& r : log.RecordsFrom(peer.next, options.batch))
+          out.push_back(EncodeRecord(r));
       } else if (now - peer.last_sent >= std::chrono::duration<double>(options.heartbeat_s)) {
         Record beat;
         beat.type = RecordType::kHeartbeat;

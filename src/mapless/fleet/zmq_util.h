@@ -13,8 +13,8 @@ inline bool RecvAll(zmq::socket_t& socket, std::vector<zmq::message_t>* parts, b
   parts->clear();
   while (true) {
     zmq::message_t part;
-    const auto got =
-        socket.recv(part, wait || !parts->empty() ? zmq::recv_flags::none : zmq::recv_flags::dontwait);
+    const auto got = socket.recv(
+        part, wait || !parts->empty() ? zmq::recv_flags::none : zmq::recv_flags::dontwait);
     if (!got) return false;
     const bool more = part.more();
     parts->push_back(std::move(part));
