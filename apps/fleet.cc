@@ -205,6 +205,8 @@ struct LeadArgs {
 };
 
 void Lead(const LeadArgs& a) {
+  if (a.method != "funnel" && a.method != "eigenspace")
+    throw InputError("--method " + a.method + ": must be funnel or eigenspace");
   const fleet::RouteKind kind = fleet::ParseRouteKind(a.method);
   if (a.source.empty() == a.robot.empty())
     throw InputError("lead: give one of --source sim:SCENARIO or --robot");

@@ -294,6 +294,18 @@ probe "follow a directory with no appearance route" 2 "no appearance route here"
 probe "follow a route whose manifest is wrong" 2 "appearance.json: image_width: missing" -- "$MAPLESS" follow --route "$FX/aroute_bad_manifest" --source sim:table1_almost_straight
 probe "follow a route with a cut image" 2 "000001.png" -- "$MAPLESS" follow --route "$FX/aroute_cut_image" --source sim:table1_almost_straight
 probe "follow a route with an image of the wrong size" 2 "000002.png: 320x240, the route's images are 64x64" -- "$MAPLESS" follow --route "$FX/aroute_wrong_size" --source sim:table1_almost_straight
+# The fleet (issue 19): leaders and followers refuse bad endpoints, keys and directories up front.
+printf 'public_key: "short"\nsecret_key: "short"\n' >"$FX/bad.key"
+"$MAPLESS" fleet keygen "$FX/fleet.key" >/dev/null 2>&1
+probe "lead with an endpoint that is not one" 2 "--bind nonsense" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/l1" --bind nonsense
+probe "lead with an unknown --method" 2 "--method dense: must be funnel or eigenspace" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/l2" --bind tcp://127.0.0.1:1 --method dense
+probe "lead with a key file that is not a key" 2 "bad.key: public_key: not a CURVE key" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/l3" --bind tcp://127.0.0.1:1 --curve-key "$FX/bad.key"
+probe "lead with a public key as its key" 2 "fleet.key.pub: secret_key: missing" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/l4" --bind tcp://127.0.0.1:1 --curve-key "$FX/fleet.key.pub"
+probe "lead into a directory that holds something else" 2 "holds something else than a route" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$FX/frames" --bind tcp://127.0.0.1:1
+probe "lead an eigenspace route into a funnel route" 2 "holds a funnel route; this leader teaches eigenspace" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$FX/route" --bind tcp://127.0.0.1:1 --method eigenspace
+probe "follow --connect to an endpoint that is not one" 2 "--connect nonsense" -- "$MAPLESS" follow --connect nonsense --source sim:table1_almost_straight --route "$NEW/c1"
+probe "follow --connect with a key but no leader key" 2 "--curve-key and --curve-leader go together" -- "$MAPLESS" follow --connect tcp://127.0.0.1:1 --source sim:table1_almost_straight --route "$NEW/c2" --curve-key "$FX/fleet.key"
+probe "fleet keygen over an existing file" 2 "fleet.key: exists" -- "$MAPLESS" fleet keygen "$FX/fleet.key"
 probe "navigate --robot without a calibration" 2 "needs --calibration" -- "$MAPLESS" navigate --robot "$FX/robot_ros3.yaml" --destination 1,1
 probe "sim serve --like an unknown run" 2 "--like dance" -- "$MAPLESS" sim serve --scenario table1_almost_straight --robot "$FX/robot_ok.yaml" --like dance
 probe "sim serve --size too small" 2 "--size 8x8" -- "$MAPLESS" sim serve --scenario table1_almost_straight --robot "$FX/robot_ok.yaml" --size 8x8
