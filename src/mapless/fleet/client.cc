@@ -2,6 +2,8 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
+#include <deque>
 #include <mutex>
 #include <thread>
 #include <zmq.hpp>
@@ -25,6 +27,9 @@ constexpr std::size_t kMaxLatencySamples = 100000;
 
 }  // namespace
 
+// Two threads: the network thread takes messages off the socket as they arrive (stamping the
+// receive time, so a record's latency does not include the previous record's disk flush) and
+// queues the records that continue the copy; the apply thread writes them to the copy in batches.
 struct FollowerClient::Impl {
   RouteCopy& copy;
   ClientOptions options;
@@ -34,13 +39,22 @@ struct FollowerClient::Impl {
   std::atomic<bool> stop{false};
   mutable std::mutex stats_mutex;
   ClientStats stats;
+  // Network thread only.
   Clock::time_point last_heard = Clock::now();
   Clock::time_point last_subscribe;
+  Clock::time_point hold_until;  // after a refused record: ask again no sooner than this
   std::int64_t first_subscribe_ns = 0;
-  std::uint64_t rejected_sequence = ~0ull;
-  bool unsent = false;  // the last subscription found no connection  // log a bad record once, not
-                        // at every resend
-  std::thread thread;
+  std::uint64_t expected = 0;  // the next sequence number to queue
+  bool unsent = false;         // the last subscription found no connection
+  // Between the two threads.
+  std::mutex queue_mutex;
+  std::condition_variable queue_ready;
+  std::deque<Record> queue;
+  std::atomic<bool> resync{false};  // a record was refused: drop the queue, ask from the copy
+  // Apply thread only.
+  std::uint64_t rejected_sequence = ~0ull;  // log a bad record once, not at every resend
+  std::thread network;
+  std::thread applier;
 
   Impl(RouteCopy& c, ClientOptions o, FleetLogger f)
       : copy(c), options(std::move(o)), log_line(std::move(f)) {}
@@ -52,7 +66,7 @@ struct FollowerClient::Impl {
   // With ZMQ_IMMEDIATE a message is not queued while there is no connection: nothing was sent,
   // and the next round tries again.
   void Subscribe() {
-    const std::string msg = EncodeSubscribe(copy.next_sequence());
+    const std::string msg = EncodeSubscribe(expected);
     if (!dealer.send(zmq::buffer(msg), zmq::send_flags::dontwait)) {
       unsent = true;
       return;
@@ -64,22 +78,14 @@ struct FollowerClient::Impl {
     ++stats.subscriptions;
   }
 
-  // Takes the waiting messages (up to a batch) and applies the run of records that continues the
-  // copy; true when a gap was seen (ask again).
-  bool Drain() {
-    std::vector<Record> batch;
+  // Takes the waiting messages and queues the records that continue the copy; true when a gap was
+  // seen (ask again).
+  bool Receive() {
     bool gap = false;
-    std::uint64_t next = copy.next_sequence();
-    while (batch.size() < options.max_batch) {
+    std::vector<Record> taken;
+    while (true) {
       zmq::message_t msg;
-      if (!dealer.recv(msg, zmq::recv_flags::dontwait)) {
-        // Catching up, more records are on their way: wait a moment for them, so that many are
-        // written with one flush (a live record, alone, is applied at once).
-        if (batch.empty()) break;
-        zmq::pollitem_t item{dealer.handle(), 0, ZMQ_POLLIN, 0};
-        if (zmq::poll(&item, 1, std::chrono::milliseconds(2)) == 0) break;
-        continue;
-      }
+      if (!dealer.recv(msg, zmq::recv_flags::dontwait)) break;
       const std::int64_t now_ns = WallNs();
       last_heard = Clock::now();
       Record r;
@@ -95,25 +101,77 @@ struct FollowerClient::Impl {
       if (r.type == RecordType::kHeartbeat) {
         stats.leader_records = r.sequence;
         stats.leader_complete = r.parts[0] == "1";
-        if (r.sequence > next) gap = true;  // the leader has more than this copy: ask
+        if (r.sequence > expected) gap = true;  // the leader has more than this follower: ask
         continue;
       }
       ++stats.received;
-      if (r.sequence < next) {
+      if (r.sequence < expected) {
         ++stats.duplicates_dropped;
         continue;
       }
-      if (r.sequence > next) {
+      if (r.sequence > expected) {
         ++stats.ahead_dropped;
         gap = true;
         continue;
       }
       if (r.written_ns >= first_subscribe_ns && stats.latency_ms.size() < kMaxLatencySamples)
         stats.latency_ms.push_back(static_cast<double>(now_ns - r.written_ns) * 1e-6);
-      batch.push_back(std::move(r));
-      ++next;
+      taken.push_back(std::move(r));
+      ++expected;
     }
-    if (!batch.empty()) {
+    if (!taken.empty()) {
+      std::lock_guard<std::mutex> lock(queue_mutex);
+      for (Record& r : taken) queue.push_back(std::move(r));
+      queue_ready.notify_one();
+    }
+    return gap;
+  }
+
+  void RunNetwork() {
+    expected = copy.next_sequence();
+    Subscribe();
+    while (!stop) {
+      zmq::pollitem_t item{dealer.handle(), 0, ZMQ_POLLIN, 0};
+      zmq::poll(&item, 1, std::chrono::milliseconds(unsent ? 20 : 100));
+      if (stop) break;
+      const auto now = Clock::now();
+      if (resync.exchange(false)) {
+        std::lock_guard<std::mutex> lock(queue_mutex);
+        queue.clear();
+        expected = copy.next_sequence();
+        hold_until = now + std::chrono::duration_cast<Clock::duration>(
+                               std::chrono::duration<double>(options.resubscribe_s));
+      }
+      bool gap = false;
+      if (item.revents & ZMQ_POLLIN) gap = Receive();
+      const double silent = std::chrono::duration<double>(now - last_heard).count();
+      const double since_ask = std::chrono::duration<double>(now - last_subscribe).count();
+      if (now >= hold_until &&
+          (unsent || (gap && since_ask > 0.2) ||
+           (silent > options.resubscribe_s && since_ask > options.resubscribe_s)))
+        Subscribe();
+      std::lock_guard<std::mutex> lock(stats_mutex);
+      stats.silent_s = silent;
+    }
+  }
+
+  void RunApplier() {
+    while (true) {
+      std::vector<Record> batch;
+      {
+        std::unique_lock<std::mutex> lock(queue_mutex);
+        queue_ready.wait(lock, [&] { return stop || !queue.empty(); });
+        if (stop) return;
+        // Catching up, more records are on their way: wait a moment for them, so that many are
+        // written with one flush (a live record, alone, is applied at once).
+        if (queue.size() < options.max_batch)
+          queue_ready.wait_for(lock, std::chrono::milliseconds(2),
+                               [&] { return stop || queue.size() >= options.max_batch; });
+        while (!queue.empty() && batch.size() < options.max_batch) {
+          batch.push_back(std::move(queue.front()));
+          queue.pop_front();
+        }
+      }
       const std::uint64_t before = copy.next_sequence();
       try {
         copy.Apply(batch);
@@ -122,31 +180,12 @@ struct FollowerClient::Impl {
         if (bad != rejected_sequence)
           Log(std::string("fleet: rejected a record from the leader: ") + e.what());
         rejected_sequence = bad;
+        resync = true;
         std::lock_guard<std::mutex> lock(stats_mutex);
         ++stats.rejected;
       }
       std::lock_guard<std::mutex> lock(stats_mutex);
       stats.applied += copy.next_sequence() - before;
-    }
-    return gap;
-  }
-
-  void Run() {
-    Subscribe();
-    while (!stop) {
-      zmq::pollitem_t item{dealer.handle(), 0, ZMQ_POLLIN, 0};
-      zmq::poll(&item, 1, std::chrono::milliseconds(unsent ? 20 : 100));
-      if (stop) break;
-      bool gap = false;
-      if (item.revents & ZMQ_POLLIN) gap = Drain();
-      const auto now = Clock::now();
-      const double silent = std::chrono::duration<double>(now - last_heard).count();
-      const double since_ask = std::chrono::duration<double>(now - last_subscribe).count();
-      if (unsent || (gap && since_ask > 0.2) ||
-          (silent > options.resubscribe_s && since_ask > options.resubscribe_s))
-        Subscribe();
-      std::lock_guard<std::mutex> lock(stats_mutex);
-      stats.silent_s = silent;
     }
   }
 };
@@ -171,18 +210,30 @@ FollowerClient::FollowerClient(RouteCopy& copy, ClientOptions options, FleetLogg
   } catch (const zmq::error_t& e) {
     throw InputError("--connect " + c.options.connect + ": " + e.what());
   }
-  c.thread = std::thread([&c] {
+  c.network = std::thread([&c] {
     try {
-      c.Run();
+      c.RunNetwork();
     } catch (const std::exception& e) {
       c.Log(std::string("fleet: the link to the leader stopped: ") + e.what());
+    }
+  });
+  c.applier = std::thread([&c] {
+    try {
+      c.RunApplier();
+    } catch (const std::exception& e) {
+      c.Log(std::string("fleet: the copy of the route stopped: ") + e.what());
     }
   });
 }
 
 FollowerClient::~FollowerClient() {
   impl_->stop = true;
-  if (impl_->thread.joinable()) impl_->thread.join();
+  {
+    std::lock_guard<std::mutex> lock(impl_->queue_mutex);
+    impl_->queue_ready.notify_all();
+  }
+  if (impl_->network.joinable()) impl_->network.join();
+  if (impl_->applier.joinable()) impl_->applier.join();
 }
 
 ClientStats FollowerClient::stats() const {

@@ -51,6 +51,18 @@ class CanonicalReader {
             s_[pos_] == '+' || s_[pos_] == '.' || s_[pos_] == 'e' || s_[pos_] == 'E'))
       ++pos_;
     if (pos_ == start || pos_ - start > 40) return false;
+    // Whole numbers (descriptor bytes, most of a keyframe file) without strtod: exact up to 15
+    // digits, as strtod would give them.
+    std::size_t i = start + (s_[start] == '-' ? 1 : 0);
+    if (i < pos_ && pos_ - i <= 15) {
+      double whole = 0.0;
+      while (i < pos_ && std::isdigit(static_cast<unsigned char>(s_[i])))
+        whole = whole * 10.0 + (s_[i++] - '0');
+      if (i == pos_) {
+        *v = s_[start] == '-' ? -whole : whole;
+        return true;
+      }
+    }
     const std::string token = s_.substr(start, pos_ - start);
     char* end = nullptr;
     *v = std::strtod(token.c_str(), &end);
