@@ -309,9 +309,13 @@ void FollowConnected(const FollowConnectArgs& a) {
                  copy.next_sequence());
   fleet::FollowerClient client(copy, options, FleetLog);
   StopCleanlyOnInterrupt();
-  // The robot stays still (nothing is sent) until the route's header says what to follow.
-  while (!copy.header()) {
+  // The robot stays still (nothing is sent) until the route's header says what to follow and,
+  // for a copy resumed from disk, until the leader has confirmed it is the same route.
+  if (copy.next_sequence() > 0)
+    spdlog::info("follow: waiting for the leader to confirm the copy in {}", a.route);
+  while (!copy.header() || !client.Verified()) {
     ThrowIfInterrupted();
+    if (!client.Refusal().empty()) throw InputError("follow: " + client.Refusal());
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   const fleet::RouteHeader header = *copy.header();

@@ -44,13 +44,20 @@ struct FollowerClient::Impl {
   Clock::time_point last_subscribe;
   Clock::time_point hold_until;  // after a refused record: ask again no sooner than this
   std::int64_t first_subscribe_ns = 0;
-  std::uint64_t expected = 0;  // the next sequence number to queue
-  bool unsent = false;         // the last subscription found no connection
+  std::uint64_t expected = 0;   // the next sequence number to queue
+  bool verify_pending = false;  // the copy's last record not yet compared with the leader's
+  bool verified = false;        // under stats_mutex: the copy is the leader's route (so far)
+  bool unsent = false;          // the last subscription found no connection
   // Between the two threads.
   std::mutex queue_mutex;
   std::condition_variable queue_ready;
   std::deque<Record> queue;
   std::atomic<bool> resync{false};  // a record was refused: drop the queue, ask from the copy
+  std::string refusal;              // under stats_mutex: why this follower takes nothing more
+  std::string refused() {
+    std::lock_guard<std::mutex> lock(stats_mutex);
+    return refusal;
+  }
   // Apply thread only.
   std::uint64_t rejected_sequence = ~0ull;  // log a bad record once, not at every resend
   std::thread network;
@@ -65,8 +72,10 @@ struct FollowerClient::Impl {
 
   // With ZMQ_IMMEDIATE a message is not queued while there is no connection: nothing was sent,
   // and the next round tries again.
+  // A copy resumed from disk asks for its own last record once more and compares it with what the
+  // leader sends: a copy of another route (a directory reused) is refused, not continued.
   void Subscribe() {
-    const std::string msg = EncodeSubscribe(expected);
+    const std::string msg = EncodeSubscribe(verify_pending ? expected - 1 : expected);
     if (!dealer.send(zmq::buffer(msg), zmq::send_flags::dontwait)) {
       unsent = true;
       return;
@@ -98,6 +107,7 @@ struct FollowerClient::Impl {
         continue;
       }
       std::lock_guard<std::mutex> lock(stats_mutex);
+      if (!refusal.empty()) continue;
       if (r.type == RecordType::kHeartbeat) {
         stats.leader_records = r.sequence;
         stats.leader_complete = r.parts[0] == "1";
@@ -105,6 +115,19 @@ struct FollowerClient::Impl {
         continue;
       }
       ++stats.received;
+      if (verify_pending && r.sequence + 1 == expected) {
+        verify_pending = false;
+        const std::vector<Record> mine = copy.RecordsFrom(r.sequence, 1);
+        if (mine.empty() || !(mine[0] == r)) {
+          refusal = "the copy in " + copy.dir() +
+                    " is of another route than the leader's (record " + std::to_string(r.sequence) +
+                    " differs); follow into a new directory";
+          Log("fleet: " + refusal);
+        } else {
+          verified = true;
+        }
+        continue;
+      }
       if (r.sequence < expected) {
         ++stats.duplicates_dropped;
         continue;
@@ -129,8 +152,17 @@ struct FollowerClient::Impl {
 
   void RunNetwork() {
     expected = copy.next_sequence();
+    verify_pending = expected > 0;
+    {
+      std::lock_guard<std::mutex> lock(stats_mutex);
+      verified = !verify_pending;
+    }
     Subscribe();
     while (!stop) {
+      if (!refused().empty()) {  // nothing more from a leader whose route this is not
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        continue;
+      }
       zmq::pollitem_t item{dealer.handle(), 0, ZMQ_POLLIN, 0};
       zmq::poll(&item, 1, std::chrono::milliseconds(unsent ? 20 : 100));
       if (stop) break;
@@ -234,6 +266,16 @@ FollowerClient::~FollowerClient() {
   }
   if (impl_->network.joinable()) impl_->network.join();
   if (impl_->applier.joinable()) impl_->applier.join();
+}
+
+bool FollowerClient::Verified() const {
+  std::lock_guard<std::mutex> lock(impl_->stats_mutex);
+  return impl_->verified;
+}
+
+std::string FollowerClient::Refusal() const {
+  std::lock_guard<std::mutex> lock(impl_->stats_mutex);
+  return impl_->refusal;
 }
 
 ClientStats FollowerClient::stats() const {

@@ -48,6 +48,12 @@ class FollowerClient {
   FollowerClient(RouteCopy& copy, ClientOptions options, FleetLogger log_line);
   ~FollowerClient();
   ClientStats stats() const;
+  // Not empty when this follower refuses the leader's route: its copy (resumed from disk) is of
+  // another route. It then takes nothing more.
+  std::string Refusal() const;
+  // True once the copy is known to be the leader's route: at once for a new copy; for one resumed
+  // from disk, when the leader's copy of its last record matched.
+  bool Verified() const;
 
  private:
   struct Impl;

@@ -224,6 +224,45 @@ TEST(FleetLink, AFollowerCatchesUpThenReceivesLiveRecordsOnLoopback) {
   EXPECT_GE(stats.latency_ms.size(), 1u);  // the live ones
 }
 
+TEST(FleetLink, ACopyOfAnotherRouteIsRefusedNotContinued) {
+  // The follower's directory holds the first records of one route; the leader serves another.
+  const std::string stale = FreshDir("stale_copy");
+  RouteCopy(stale).Apply(ImageRecords(4, false));
+  std::vector<Record> other = ImageRecords(8, true);
+  route::StoredAppearanceImage moved = MakeImage(3);
+  moved.odometry.y_m += 1.0;
+  other[4].parts[0] = route::AppearanceEntryJson(moved);  // record 4, the copy's last, differs
+  RouteCopy leader(FreshDir("other_leader"));
+  leader.Apply(other);
+  ServerOptions server_options;
+  server_options.bind = "tcp://127.0.0.1:*";
+  LeaderServer server(leader, server_options, nullptr);
+  const auto before = Files(stale);
+  {
+    RouteCopy copy(stale);
+    ClientOptions options;
+    options.connect = server.endpoint();
+    FollowerClient client(copy, options, nullptr);
+    ASSERT_TRUE(WaitFor([&] { return !client.Refusal().empty(); }, 10.0));
+    EXPECT_FALSE(client.Verified());
+    EXPECT_NE(client.Refusal().find("another route"), std::string::npos);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    EXPECT_EQ(copy.next_sequence(), 5u);  // the header and 4 images, nothing more
+  }
+  EXPECT_EQ(Files(stale), before);
+  // A copy of the same route is confirmed and continued.
+  const std::string same = FreshDir("same_copy");
+  RouteCopy(same).Apply({other.begin(), other.begin() + 4});
+  RouteCopy copy(same);
+  ClientOptions options;
+  options.connect = server.endpoint();
+  FollowerClient client(copy, options, nullptr);
+  ASSERT_TRUE(WaitFor([&] { return copy.complete(); }, 10.0));
+  EXPECT_TRUE(client.Verified());
+  EXPECT_TRUE(client.Refusal().empty());
+  EXPECT_EQ(Files(same), Files(leader.dir()));
+}
+
 TEST(FleetLink, WithCurveAFollowerWithoutTheRightKeyReceivesNothing) {
   if (!CurveAvailable()) GTEST_SKIP() << "libzmq without CURVE";
   const std::string keys = FreshDir("keys");
