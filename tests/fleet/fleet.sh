@@ -7,11 +7,17 @@
 # route taught: a follower with a wrong CURVE key receives nothing and the leader logs the refusal;
 # garbage sent to the leader's port is refused with a log line and the leader goes on serving.
 #
-#   fleet.sh MAPLESS funnel|eigenspace [--faults]
+#   fleet.sh MAPLESS funnel|eigenspace [--faults] [--no-curve]
+# The simulations run at 6x the wall clock (short routes, to keep the suite short); the outage is
+# 10 s of wall clock, as the issue asks. --no-curve skips the CURVE and garbage checks (CI runs
+# them once, with the plain funnel run).
 set -euo pipefail
 mapless=$1
 method=$2
 faults=${3:-}
+curve=yes
+for arg in "$@"; do [ "$arg" = --no-curve ] && curve=no; done
+[ "$faults" = --no-curve ] && faults=
 work=$(mktemp -d /tmp/mapless-fleet-test-XXXXXX)
 pids=()
 cleanup() {
@@ -23,12 +29,14 @@ cleanup() {
 trap cleanup EXIT
 fail() { echo "FAIL: $*"; for f in "$work"/run/*.log "$work"/*.log; do [ -f "$f" ] && { echo "== $f"; tail -20 "$f"; }; done; exit 1; }
 
-args=(eval fleet --followers 3 --method "$method" --json --keep "$work/run")
+args=(eval fleet --followers 3 --method "$method" --rate 6 --start-after 2 --json --keep "$work/run")
 if [ "$faults" = --faults ]; then
+  # Mid-route for each: the funnel route is taught in about 6 s of wall clock at 6x, the
+  # eigenspace route in about 13 s.
   if [ "$method" = funnel ]; then
-    args+=(--kill-leader-at 5 --kill-follower-at 8 --link-down-at 6 --link-down-for 10)
+    args+=(--kill-leader-at 3.5 --kill-follower-at 5.5 --link-down-at 4 --link-down-for 10)
   else
-    args+=(--kill-leader-at 8 --kill-follower-at 12 --link-down-at 9 --link-down-for 10)
+    args+=(--kill-leader-at 6 --kill-follower-at 9 --link-down-at 7 --link-down-for 10)
   fi
 fi
 timeout 600 "$mapless" "${args[@]}" > "$work/eval.json" 2> "$work/eval.log" || fail "eval fleet: exit $?"
@@ -47,6 +55,7 @@ if [ "$faults" = --faults ]; then
     fail "the restarted follower did not resume its copy"
 fi
 echo "eval fleet ($method ${faults:-plain}): 3/3 followers complete, copies identical"
+[ "$curve" = yes ] || exit 0
 
 # CURVE: the taught route served with keys; a follower with a key not admitted gets nothing.
 "$mapless" fleet keygen "$work/leader.key" > /dev/null 2>&1
