@@ -17,6 +17,7 @@
 #include "mapless/fleet/client.h"
 #include "mapless/fleet/route_log.h"
 #include "mapless/fleet/server.h"
+#include "mapless/robot/link_bench.h"
 
 namespace mapless::app {
 
@@ -78,10 +79,8 @@ bool WaitUntil(const std::function<bool()>& done, double seconds) {
   return done();
 }
 
-double Percentile(std::vector<double> v, double p) {
-  if (v.empty()) return -1.0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<std::size_t>(p * static_cast<double>(v.size())))];
+double Percentile(const std::vector<double>& v, double p) {  // -1: nothing measured
+  return v.empty() ? -1.0 : robot::Percentile(v, p);
 }
 
 }  // namespace

@@ -19,6 +19,7 @@
 #include "mapless/fleet/server.h"
 #include "mapless/io/atomic_file.h"
 #include "mapless/navigation/teach.h"
+#include "mapless/robot/link_bench.h"
 #include "mapless/robot/loop.h"
 #include "mapless/robot/methods.h"
 #include "mapless/robot/robot_file.h"
@@ -410,12 +411,9 @@ void FollowConnected(const FollowConnectArgs& a) {
   spdlog::info("follow: {} ({} frames); {:.2f} m from the route's end; {} records applied",
                result.reason, result.frames, final_error, stats.applied);
   if (!a.summary.empty()) {
-    std::vector<double> latency = stats.latency_ms;
-    std::sort(latency.begin(), latency.end());
-    const auto pct = [&](double p) {
-      if (latency.empty()) return -1.0;
-      return latency[std::min(latency.size() - 1,
-                              static_cast<std::size_t>(p * static_cast<double>(latency.size())))];
+    const std::vector<double>& latency = stats.latency_ms;
+    const auto pct = [&](double p) {  // -1: no live records (the route was finished)
+      return latency.empty() ? -1.0 : robot::Percentile(latency, p);
     };
     nlohmann::json j;
     j["completed"] = success;

@@ -17,12 +17,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::int64_t WallNs() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
 constexpr std::size_t kMaxLatencySamples = 100000;
 
 }  // namespace
@@ -82,7 +76,7 @@ struct FollowerClient::Impl {
     }
     unsent = false;
     last_subscribe = Clock::now();
-    if (first_subscribe_ns == 0) first_subscribe_ns = WallNs();
+    if (first_subscribe_ns == 0) first_subscribe_ns = WallClockNs();
     std::lock_guard<std::mutex> lock(stats_mutex);
     ++stats.subscriptions;
   }
@@ -95,7 +89,7 @@ struct FollowerClient::Impl {
     while (true) {
       zmq::message_t msg;
       if (!dealer.recv(msg, zmq::recv_flags::dontwait)) break;
-      const std::int64_t now_ns = WallNs();
+      const std::int64_t now_ns = WallClockNs();
       last_heard = Clock::now();
       Record r;
       try {

@@ -1,5 +1,6 @@
 #include "mapless/fleet/record.h"
 
+#include <chrono>
 #include <cstring>
 
 #include "mapless/core/check.h"
@@ -69,6 +70,12 @@ void CheckMagic(Reader* in, const char (&magic)[4], const char* what) {
 }
 
 }  // namespace
+
+std::int64_t WallClockNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
 
 const char* RecordTypeName(RecordType type) {
   switch (type) {

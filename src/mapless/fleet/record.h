@@ -52,6 +52,10 @@ struct Record {
   }
 };
 
+// The wall clock in nanoseconds since the epoch (written_ns; latency between processes on one
+// machine, or machines whose clocks are synchronised).
+std::int64_t WallClockNs();
+
 std::string EncodeRecord(const Record& record);
 // Throws InputError (one line: what is wrong, at which byte) on anything but a well-formed record.
 Record DecodeRecord(std::string_view bytes);

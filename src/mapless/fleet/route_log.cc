@@ -18,12 +18,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::int64_t WallNs() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
 int HeaderInt(const nlohmann::json& j, const char* key, int lo, int hi) {
   if (!j.contains(key) || !j[key].is_number_integer())
     throw InputError(std::string("fleet header: ") + key + ": missing or not a whole number");
@@ -186,7 +180,7 @@ void RouteCopy::Load() {
     complete_ = route.complete;
   }
   if (complete_) log_.push_back(EndRecord());
-  const std::int64_t now = WallNs();
+  const std::int64_t now = WallClockNs();
   for (std::size_t i = 0; i < log_.size(); ++i) {
     log_[i].sequence = i;
     log_[i].written_ns = now;
@@ -225,7 +219,7 @@ void RouteCopy::Apply(const std::vector<Record>& records) {
   const std::size_t first = log_.size();
   // A leader's own records are stamped once they are on disk (their latency counts from there).
   const auto stamp = [&] {
-    const std::int64_t now = WallNs();
+    const std::int64_t now = WallClockNs();
     for (std::size_t i = first; i < log_.size(); ++i)
       if (log_[i].written_ns == 0) log_[i].written_ns = now;
   };

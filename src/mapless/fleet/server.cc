@@ -180,39 +180,34 @@ struct LeaderServer::Impl {
         it = peers.erase(it);
         continue;
       }
-      std::vector<std::string> out;
-      std::uint64_t first = peer.next;
-      if (peer.next < size) {
-        for (const Record& r : log.RecordsFrom(peer.next, options.batch))
-          out.push_back(EncodeRecord(r));
-      } else if (now - peer.last_sent >= std::chrono::duration<double>(options.heartbeat_s)) {
-        Record beat;
-        beat.type = RecordType::kHeartbeat;
-        beat.sequence = size;
-        beat.parts = {log.complete() ? "1" : "0"};
-        out.push_back(EncodeRecord(beat));
-        first = size;  // a heartbeat does not advance peer.next
-      }
-      bool gone = false;
+      // Records are taken from the log one at a time while the follower's pipe takes them: a full
+      // pipe wastes one copy, not a batch (a follower catching up on large keyframes).
+      SendResult result = SendResult::kSent;
       std::size_t sent = 0;
-      for (const std::string& bytes : out) {
-        const SendResult result = SendTo(router, it->first, bytes);
-        if (result == SendResult::kFull) {
-          blocked = true;
-          break;
-        }
-        if (result == SendResult::kGone) {
-          gone = true;
-          break;
-        }
+      while (peer.next < size && sent < options.batch) {
+        const std::vector<Record> next = log.RecordsFrom(peer.next, 1);
+        if (next.empty()) break;
+        result = SendTo(router, it->first, EncodeRecord(next.front()));
+        if (result != SendResult::kSent) break;
+        ++peer.next;
         ++sent;
         peer.last_sent = now;
       }
-      if (peer.next < size) {
-        peer.next = first + sent;
+      if (sent > 0) {
         std::lock_guard<std::mutex> lock(stats_mutex);
         stats.records_sent += sent;
       }
+      if (result == SendResult::kSent && peer.next >= size &&
+          now - peer.last_sent >= std::chrono::duration<double>(options.heartbeat_s)) {
+        Record beat;  // does not advance peer.next
+        beat.type = RecordType::kHeartbeat;
+        beat.sequence = size;
+        beat.parts = {log.complete() ? "1" : "0"};
+        result = SendTo(router, it->first, EncodeRecord(beat));
+        if (result == SendResult::kSent) peer.last_sent = now;
+      }
+      blocked = blocked || result == SendResult::kFull;
+      const bool gone = result == SendResult::kGone;
       if (gone) {
         it = peers.erase(it);
         continue;
