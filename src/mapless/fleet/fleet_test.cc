@@ -189,6 +189,45 @@ TEST(FleetRouteCopy, ABadRecordChangesNothing) {
   EXPECT_EQ(copy.next_sequence(), 3u);
 }
 
+// A catching-up batch is decoded on two threads (RouteCopy::Apply): the copy, and the refusal of a
+// bad record in the middle of a batch, must be the same as when the records come one at a time.
+TEST(FleetRouteCopy, ABatchAppliesAsTheSameRecordsOneAtATime) {
+  std::vector<Record> records = FunnelRecords(16, true);
+  RouteCopy whole(FreshDir("batch_whole"));
+  whole.Apply(records);
+  RouteCopy single(FreshDir("batch_single"));
+  for (const Record& r : records) single.Apply({r});
+  EXPECT_EQ(Files(whole.dir()), Files(single.dir()));
+  ASSERT_NE(whole.FunnelRoute(), nullptr);
+  EXPECT_EQ(whole.FunnelRoute()->keyframes.size(), 16u);
+
+  // Record 9 (keyframe 8) goes back in time, record 12 is truncated: in a batch, and alone.
+  route::Keyframe back = MakeKeyframe(8);
+  back.t_ns = 1;  // before keyframe 7's
+  records[9].parts = KeyframeRecord(back).parts;
+  records[12].parts[0].resize(records[12].parts[0].size() / 2);
+  std::string batch_error, single_error;
+  RouteCopy batch(FreshDir("batch_bad"));
+  try {
+    batch.Apply(records);
+  } catch (const InputError& e) {
+    batch_error = e.what();
+  }
+  RouteCopy one(FreshDir("batch_bad_single"));
+  for (const Record& r : records) {
+    try {
+      one.Apply({r});
+    } catch (const InputError& e) {
+      single_error = e.what();
+      break;
+    }
+  }
+  EXPECT_NE(batch_error.find("time goes backwards"), std::string::npos) << batch_error;
+  EXPECT_EQ(batch_error, single_error);
+  EXPECT_EQ(batch.next_sequence(), 9u);
+  EXPECT_EQ(Files(batch.dir()), Files(one.dir()));
+}
+
 // Waits (bounded) until `done` holds.
 bool WaitFor(const std::function<bool()>& done, double seconds) {
   const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);

@@ -3,8 +3,11 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <optional>
+#include <thread>
 
 #include "mapless/core/check.h"
 #include "mapless/features/features.h"
@@ -34,6 +37,47 @@ route::Manifest FunnelManifest(const RouteHeader& h) {
   m.image_width = h.image_width;
   m.image_height = h.image_height;
   return m;
+}
+
+// Catching up, a batch holds many keyframes, and parsing their files is most of what applying
+// them costs: they are decoded on two threads first, each checked as it would be on its own (its
+// index is its place in the batch; its time is checked against the previous keyframe's in order,
+// by ApplyOne). A record whose decoding fails is left empty: ApplyOne decodes it again, in order,
+// and refuses it with the same error as without this step.
+std::vector<std::optional<route::Keyframe>> PreDecodeKeyframes(const std::vector<Record>& records,
+                                                               std::optional<RouteHeader> header,
+                                                               std::size_t keyframes) {
+  std::vector<std::optional<route::Keyframe>> out(records.size());
+  if (!records.empty() && records.front().type == RecordType::kHeader && !header) {
+    try {
+      header = ParseHeader(records.front());
+    } catch (const InputError&) {
+      return out;
+    }
+  }
+  if (!header || header->kind != RouteKind::kFunnel) return out;
+  std::vector<std::pair<std::size_t, int>> todo;  // (position in the batch, keyframe index)
+  for (std::size_t i = 0; i < records.size(); ++i)
+    if (records[i].type == RecordType::kKeyframe && records[i].parts.size() == 2)
+      todo.emplace_back(i, static_cast<int>(keyframes + todo.size()));
+  constexpr std::size_t kMinForThreads = 8;  // a live record or two is decoded where it is applied
+  if (todo.size() < kMinForThreads) return out;
+  const route::Manifest manifest = FunnelManifest(*header);
+  const auto decode = [&](std::size_t first) {
+    for (std::size_t k = first; k < todo.size(); k += 2) {
+      const Record& r = records[todo[k].first];
+      try {
+        out[todo[k].first] = route::DecodeKeyframe(r.parts[0], r.parts[1], manifest, todo[k].second,
+                                                   std::numeric_limits<Timestamp>::min(), "");
+      } catch (const InputError&) {
+        out[todo[k].first].reset();
+      }
+    }
+  };
+  std::thread other(decode, 1);
+  decode(0);
+  other.join();
+  return out;
 }
 
 }  // namespace
@@ -224,7 +268,9 @@ void RouteCopy::Apply(const std::vector<Record>& records) {
       if (log_[i].written_ns == 0) log_[i].written_ns = now;
   };
   try {
-    for (const Record& r : records) ApplyOne(r);
+    std::vector<std::optional<route::Keyframe>> decoded =
+        PreDecodeKeyframes(records, header_, keyframes_.size());
+    for (std::size_t i = 0; i < records.size(); ++i) ApplyOne(records[i], &decoded[i]);
   } catch (...) {
     flush();
     stamp();
@@ -234,7 +280,7 @@ void RouteCopy::Apply(const std::vector<Record>& records) {
   stamp();
 }
 
-void RouteCopy::ApplyOne(const Record& record) {
+void RouteCopy::ApplyOne(const Record& record, std::optional<route::Keyframe>* decoded) {
   const std::string what =
       std::string(RecordTypeName(record.type)) + " record " + std::to_string(record.sequence);
   if (record.sequence != log_.size())
@@ -264,9 +310,13 @@ void RouteCopy::ApplyOne(const Record& record) {
     const int index = static_cast<int>(keyframes_.size());
     MAPLESS_CHECK(index < io::kMaxKeyframes,
                   what << ": more than " << io::kMaxKeyframes << " keyframes");
-    route::Keyframe kf =
-        route::DecodeKeyframe(record.parts[0], record.parts[1], FunnelManifest(*header_), index,
-                              keyframes_.empty() ? 0 : keyframes_.back().t_ns, what + " keyframe");
+    const Timestamp after_t_ns = keyframes_.empty() ? 0 : keyframes_.back().t_ns;
+    const bool predecoded = decoded && *decoded && (*decoded)->index == index &&
+                            (index == 0 || (*decoded)->t_ns > after_t_ns);
+    route::Keyframe kf = predecoded ? std::move(**decoded)
+                                    : route::DecodeKeyframe(record.parts[0], record.parts[1],
+                                                            FunnelManifest(*header_), index,
+                                                            after_t_ns, what + " keyframe");
     keyframe_writer_->AppendEncoded(index, kf.t_ns, record.parts[0], record.parts[1]);
     keyframes_.push_back(std::move(kf));
     funnel_cache_.reset();

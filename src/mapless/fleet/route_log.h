@@ -78,7 +78,8 @@ class RouteCopy {
   const std::string& dir() const { return dir_; }
 
  private:
-  void ApplyOne(const Record& record);
+  // `decoded`: the keyframe of a keyframe record, when it was decoded ahead (or empty).
+  void ApplyOne(const Record& record, std::optional<route::Keyframe>* decoded);
   void Load();
 
   std::string dir_;

@@ -1,6 +1,7 @@
 // Keyframe data files (route/keyframes/NNNNNN.yml): written by OpenCV's FileStorage, read by a
 // fast reader for exactly that layout or, for anything else, by yaml-cpp (route_store.h).
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -51,19 +52,30 @@ class CanonicalReader {
             s_[pos_] == '+' || s_[pos_] == '.' || s_[pos_] == 'e' || s_[pos_] == 'E'))
       ++pos_;
     if (pos_ == start || pos_ - start > 40) return false;
-    // Whole numbers (descriptor bytes, most of a keyframe file) without strtod: exact up to 15
-    // digits, as strtod would give them.
+    // Whole numbers (descriptor bytes, most of a keyframe file, and floats such as "151.") without
+    // strtod: exact up to 15 digits, as strtod would give them.
     std::size_t i = start + (s_[start] == '-' ? 1 : 0);
     if (i < pos_ && pos_ - i <= 15) {
       double whole = 0.0;
       while (i < pos_ && std::isdigit(static_cast<unsigned char>(s_[i])))
         whole = whole * 10.0 + (s_[i++] - '0');
+      if (i + 1 == pos_ && i > start && s_[i] == '.' &&
+          std::isdigit(static_cast<unsigned char>(s_[i - 1])))
+        ++i;  // "151.": OpenCV writes a whole float so
       if (i == pos_) {
         *v = s_[start] == '-' ? -whole : whole;
         return true;
       }
     }
-    const std::string token = s_.substr(start, pos_ - start);
+    // std::from_chars: correctly rounded like strtod, without the locale or a copy of the token.
+    // It refuses a leading '+' and results that underflow, which strtod takes: those go to strtod.
+    const char* first = s_.data() + start;
+    const char* last = s_.data() + pos_;
+    if (s_[start] != '+') {
+      const std::from_chars_result r = std::from_chars(first, last, *v);
+      if (r.ec == std::errc() && r.ptr == last) return std::isfinite(*v);
+    }
+    const std::string token(first, last);
     char* end = nullptr;
     *v = std::strtod(token.c_str(), &end);
     return end == token.c_str() + token.size() && std::isfinite(*v);
