@@ -28,6 +28,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev  # unit and integration tests
   libbenchmark-dev       # micro benchmarks
   libzmq3-dev cppzmq-dev # fleet messaging (leader/follower)
+  libzstd-dev liblz4-dev zlib1g-dev   # MCAP recordings: zstd and lz4 chunks, CRC-32
 )
 if [ "$WITH_ROS" = "1" ]; then
   PACKAGES+=(

@@ -1,0 +1,121 @@
+#include "mapless/recording/mcap_reader.h"
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include "mapless/core/check.h"
+#include "mapless/recording/compression.h"
+
+namespace mapless::recording {
+
+McapReader::McapReader(const std::string& path) : path_(path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
+  if (fd < 0) throw InputError(path + ": cannot open file: " + std::strerror(errno));
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    throw InputError(path + ": not a regular file (a directory, a device or a pipe)");
+  }
+  map_size_ = static_cast<std::size_t>(st.st_size);
+  if (map_size_ > 0) {
+    map_ = ::mmap(nullptr, map_size_, PROT_READ, MAP_PRIVATE, fd, 0);
+    if (map_ == MAP_FAILED) {
+      map_ = nullptr;
+      const std::string why = std::strerror(errno);
+      ::close(fd);
+      throw InputError(path + ": cannot map file: " + why);
+    }
+    bytes_ = std::string_view(static_cast<const char*>(map_), map_size_);
+  }
+  ::close(fd);
+  if (bytes_.size() < kMcapMagic.size() || bytes_.substr(0, kMcapMagic.size()) != kMcapMagic) {
+    if (map_) ::munmap(map_, map_size_);
+    throw InputError(path + ": not an MCAP file (it does not start with the MCAP magic)");
+  }
+}
+
+McapReader::~McapReader() {
+  if (map_) ::munmap(map_, map_size_);
+}
+
+void McapReader::Walk(const RecordFn& fn, std::uint64_t skip_chunks_before_ns) {
+  cut_ = false;
+  const std::string_view rest = bytes_.substr(kMcapMagic.size());
+  McapRecordCursor cursor(rest, kMcapMagic.size(), /*tolerate_cut=*/true);
+  std::uint8_t op = 0;
+  std::string_view body;
+  bool footer = false;
+  try {
+    while (true) {
+      const std::uint64_t offset = cursor.offset();
+      if (!cursor.Next(&op, &body)) break;
+      if (op == static_cast<std::uint8_t>(McapOp::kChunk)) {
+        const McapChunk chunk = ParseMcapChunk(body);
+        if (chunk.message_end_time < skip_chunks_before_ns) continue;
+        const std::string what = "chunk at byte " + std::to_string(offset);
+        const std::string records =
+            Decompress(chunk.compression, chunk.records, chunk.uncompressed_size, what);
+        if (chunk.uncompressed_crc != 0)
+          MAPLESS_CHECK(McapCrc32(records) == chunk.uncompressed_crc,
+                        what << ": its records do not match their CRC");
+        McapRecordCursor inner(records, 0);
+        std::uint8_t inner_op = 0;
+        std::string_view inner_body;
+        while (inner.Next(&inner_op, &inner_body)) fn(inner_op, inner_body, offset);
+        continue;
+      }
+      fn(op, body, offset);
+      if (op == static_cast<std::uint8_t>(McapOp::kFooter)) {
+        footer = true;
+        break;
+      }
+    }
+  } catch (const InputError& e) {
+    throw InputError(path_ + ": " + e.what());
+  }
+  if (!footer) {
+    cut_ = true;  // killed before it closed: every whole record up to the cut was read
+    return;
+  }
+  const std::string_view tail = rest.substr(cursor.offset() - kMcapMagic.size());
+  MAPLESS_CHECK(tail == kMcapMagic, path_ << ": " << tail.size()
+                                          << " bytes after the footer are not the closing magic");
+}
+
+void McapReader::ForEachRecord(const RecordFn& fn) { Walk(fn, 0); }
+
+void McapReader::ForEachMessage(const MessageFn& fn, std::uint64_t start_ns) {
+  std::map<std::uint16_t, McapSchema> schemas;
+  std::map<std::uint16_t, McapChannel> channels;
+  Walk(
+      [&](std::uint8_t op, std::string_view body, std::uint64_t offset) {
+        if (op == static_cast<std::uint8_t>(McapOp::kSchema)) {
+          McapSchema s = ParseMcapSchema(body);
+          MAPLESS_CHECK(s.id != 0, "Schema record at byte " << offset << ": id 0 is reserved");
+          schemas[s.id] = std::move(s);
+        } else if (op == static_cast<std::uint8_t>(McapOp::kChannel)) {
+          McapChannel c = ParseMcapChannel(body);
+          MAPLESS_CHECK(c.schema_id == 0 || schemas.count(c.schema_id),
+                        "Channel " << c.id << " at byte " << offset << ": schema " << c.schema_id
+                                   << " was not defined before it");
+          channels[c.id] = std::move(c);
+        } else if (op == static_cast<std::uint8_t>(McapOp::kMessage)) {
+          const McapMessage m = ParseMcapMessage(body);
+          if (m.log_time < start_ns) return;
+          const auto c = channels.find(m.channel_id);
+          MAPLESS_CHECK(c != channels.end(), "Message at byte " << offset << ": channel "
+                                                                << m.channel_id
+                                                                << " was not defined before it");
+          const auto s = schemas.find(c->second.schema_id);
+          fn(c->second, s == schemas.end() ? nullptr : &s->second, m);
+        }
+      },
+      start_ns);
+}
+
+}  // namespace mapless::recording

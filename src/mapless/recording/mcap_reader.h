@@ -1,0 +1,53 @@
+// Reading MCAP files (mcap_format.h): every record in file order, with chunks opened (the
+// conformance "streamed" order), or the messages with their channels and schemas. A file cut short
+// (a recording killed before it closed) is read up to its last whole record, and cut() says so.
+// The file is mapped read-only; nothing in it is trusted (bounded sizes, checked CRCs).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "mapless/recording/mcap_format.h"
+
+namespace mapless::recording {
+
+class McapReader {
+ public:
+  // Throws InputError naming `path` when it cannot be read or does not start with the magic.
+  explicit McapReader(const std::string& path);
+  ~McapReader();
+  McapReader(const McapReader&) = delete;
+  McapReader& operator=(const McapReader&) = delete;
+
+  // Every record from the header to the footer, in file order; a chunk's records in its place
+  // (the chunk itself is not passed). `offset`: the record's byte offset in the file (for records
+  // inside a chunk, the chunk's). Throws InputError on a malformed record, a bad CRC or data after
+  // the footer that is not the closing magic.
+  using RecordFn =
+      std::function<void(std::uint8_t op, std::string_view body, std::uint64_t offset)>;
+  void ForEachRecord(const RecordFn& fn);
+
+  // The messages in file order, from log time `start_ns` on (chunks that end before it are
+  // skipped without opening them), each with its channel and schema (nullptr for schema id 0).
+  using MessageFn = std::function<void(const McapChannel&, const McapSchema*, const McapMessage&)>;
+  void ForEachMessage(const MessageFn& fn, std::uint64_t start_ns = 0);
+
+  bool cut() const { return cut_; }  // the file ended before its footer (after a read)
+  const std::string& path() const { return path_; }
+  std::string_view bytes() const { return bytes_; }
+
+ private:
+  void Walk(const RecordFn& fn, std::uint64_t skip_chunks_before_ns);
+
+  std::string path_;
+  std::string_view bytes_;
+  void* map_ = nullptr;
+  std::size_t map_size_ = 0;
+  bool cut_ = false;
+};
+
+}  // namespace mapless::recording
