@@ -11,10 +11,11 @@
 #include "mapless/fleet/record.h"
 #include "mapless/fleet/route_log.h"
 #include "mapless/io/flo.h"
-#include "mapless/io/image_file.h"
 #include "mapless/io/frame_source.h"
+#include "mapless/io/image_file.h"
 #include "mapless/io/tum.h"
 #include "mapless/navigation/potential.h"
+#include "mapless/recording/mcap_reader.h"
 #include "mapless/robot/camera_image.h"
 #include "mapless/robot/robot_file.h"
 #include "mapless/route/appearance_store.h"
@@ -210,6 +211,67 @@ void FleetRecord(const std::string& input) {
   });
 }
 
+void McapFile(const std::string& input) {
+  AcceptInputError([&] {
+    const std::unique_ptr<recording::McapReader> reader =
+        recording::McapReader::FromBytes(input, "fuzz.mcap");
+    using recording::McapOp;
+    reader->ForEachRecord([](std::uint8_t op, std::string_view body, std::uint64_t) {
+      switch (static_cast<McapOp>(op)) {
+        case McapOp::kHeader:
+          recording::ParseMcapHeader(body);
+          break;
+        case McapOp::kFooter:
+          recording::ParseMcapFooter(body);
+          break;
+        case McapOp::kSchema:
+          recording::ParseMcapSchema(body);
+          break;
+        case McapOp::kChannel:
+          recording::ParseMcapChannel(body);
+          break;
+        case McapOp::kMessage:
+          recording::ParseMcapMessage(body);
+          break;
+        case McapOp::kMessageIndex:
+          recording::ParseMcapMessageIndex(body);
+          break;
+        case McapOp::kChunkIndex:
+          recording::ParseMcapChunkIndex(body);
+          break;
+        case McapOp::kAttachment:
+          recording::ParseMcapAttachment(body);
+          break;
+        case McapOp::kAttachmentIndex:
+          recording::ParseMcapAttachmentIndex(body);
+          break;
+        case McapOp::kStatistics:
+          recording::ParseMcapStatistics(body);
+          break;
+        case McapOp::kMetadata:
+          recording::ParseMcapMetadata(body);
+          break;
+        case McapOp::kMetadataIndex:
+          recording::ParseMcapMetadataIndex(body);
+          break;
+        case McapOp::kSummaryOffset:
+          recording::ParseMcapSummaryOffset(body);
+          break;
+        case McapOp::kDataEnd:
+          recording::ParseMcapDataEnd(body);
+          break;
+        default:
+          break;
+      }
+    });
+  });
+  AcceptInputError([&] {
+    recording::McapReader::FromBytes(input, "fuzz.mcap")
+        ->ForEachMessage([](const recording::McapChannel&, const recording::McapSchema*,
+                            const recording::McapMessage&) {});
+  });
+}
+
 const std::vector<NamedHarness>& Harnesses() {
   static const std::vector<NamedHarness> harnesses = {{"route_manifest", RouteManifest},
                                                       {"route_keyframe", RouteKeyframe},
@@ -224,7 +286,8 @@ const std::vector<NamedHarness>& Harnesses() {
                                                       {"robot_file", RobotFile},
                                                       {"appearance_manifest", AppearanceManifest},
                                                       {"camera_message", CameraMessage},
-                                                      {"fleet_record", FleetRecord}};
+                                                      {"fleet_record", FleetRecord},
+                                                      {"mcap", McapFile}};
   return harnesses;
 }
 

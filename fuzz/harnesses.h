@@ -51,6 +51,10 @@ void CameraMessage(const std::string& input);
 // eigenspace route image and its entry, a keyframe's YAML and PNG against a 320x240 ORB route).
 void FleetRecord(const std::string& input);
 
+// An MCAP file (recording/mcap_reader.h): every record, chunks opened and every record type
+// parsed, then the messages with their channels and schemas.
+void McapFile(const std::string& input);
+
 const std::vector<NamedHarness>& Harnesses();
 
 }  // namespace mapless::fuzz

@@ -33,10 +33,26 @@ McapReader::McapReader(const std::string& path) : path_(path) {
     bytes_ = std::string_view(static_cast<const char*>(map_), map_size_);
   }
   ::close(fd);
-  if (bytes_.size() < kMcapMagic.size() || bytes_.substr(0, kMcapMagic.size()) != kMcapMagic) {
+  try {
+    CheckMagic();
+  } catch (...) {
     if (map_) ::munmap(map_, map_size_);
-    throw InputError(path + ": not an MCAP file (it does not start with the MCAP magic)");
+    throw;
   }
+}
+
+std::unique_ptr<McapReader> McapReader::FromBytes(std::string bytes, const std::string& name) {
+  std::unique_ptr<McapReader> r(new McapReader());
+  r->path_ = name;
+  r->owned_ = std::move(bytes);
+  r->bytes_ = r->owned_;
+  r->CheckMagic();
+  return r;
+}
+
+void McapReader::CheckMagic() {
+  if (bytes_.size() < kMcapMagic.size() || bytes_.substr(0, kMcapMagic.size()) != kMcapMagic)
+    throw InputError(path_ + ": not an MCAP file (it does not start with the MCAP magic)");
 }
 
 McapReader::~McapReader() {

@@ -19,6 +19,8 @@ class McapReader {
  public:
   // Throws InputError naming `path` when it cannot be read or does not start with the magic.
   explicit McapReader(const std::string& path);
+  // Bytes held in memory (tests, fuzzing); `name` stands for the path in errors.
+  static std::unique_ptr<McapReader> FromBytes(std::string bytes, const std::string& name);
   ~McapReader();
   McapReader(const McapReader&) = delete;
   McapReader& operator=(const McapReader&) = delete;
@@ -41,10 +43,13 @@ class McapReader {
   std::string_view bytes() const { return bytes_; }
 
  private:
+  McapReader() = default;
+  void CheckMagic();
   void Walk(const RecordFn& fn, std::uint64_t skip_chunks_before_ns);
 
   std::string path_;
   std::string_view bytes_;
+  std::string owned_;  // FromBytes
   void* map_ = nullptr;
   std::size_t map_size_ = 0;
   bool cut_ = false;
