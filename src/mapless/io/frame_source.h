@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 
 #include "mapless/core/pose.h"
@@ -14,6 +15,7 @@ struct Frame {
   cv::Mat image;       // CV_8UC1
   Timestamp t_ns = 0;  // from the video's frame times, or index / fps for folders
   std::string name;    // file name (folders) or frame number
+  std::optional<Pose2> odometry;  // the wheel odometry at the frame (recordings that have it)
 };
 
 class FrameSource {

@@ -39,6 +39,7 @@ class McapReader {
   void ForEachMessage(const MessageFn& fn, std::uint64_t start_ns = 0);
 
   bool cut() const { return cut_; }  // the file ended before its footer (after a read)
+  void set_cut(bool cut) { cut_ = cut; }
   const std::string& path() const { return path_; }
   std::string_view bytes() const { return bytes_; }
 
@@ -53,6 +54,38 @@ class McapReader {
   void* map_ = nullptr;
   std::size_t map_size_ = 0;
   bool cut_ = false;
+};
+
+// The messages of a reader one at a time, in file order, with their channels and schemas (what
+// ForEachMessage does, pulled: a recording played as a camera). A chunk is opened when its first
+// message is asked for. Throws InputError as ForEachRecord does; a cut file ends at its cut.
+class McapMessageStream {
+ public:
+  // `reader` must outlive the stream. Messages before log time `start_ns` are skipped (whole
+  // chunks that end before it are not opened).
+  explicit McapMessageStream(McapReader& reader, std::uint64_t start_ns = 0);
+
+  struct Item {
+    const McapChannel* channel = nullptr;
+    const McapSchema* schema = nullptr;  // nullptr for schema id 0
+    McapMessage message;
+  };
+  // The next message; false at the end of the file or at its cut.
+  bool Next(Item* item);
+
+ private:
+  // A record outside a chunk or inside one; true when it was a message to return.
+  bool Handle(std::uint8_t op, std::string_view body, std::uint64_t offset, Item* item);
+
+  McapReader& reader_;
+  std::uint64_t start_ns_;
+  McapRecordCursor outer_;
+  std::string chunk_records_;
+  std::unique_ptr<McapRecordCursor> inner_;
+  std::uint64_t chunk_offset_ = 0;
+  bool done_ = false;
+  std::map<std::uint16_t, McapSchema> schemas_;
+  std::map<std::uint16_t, McapChannel> channels_;
 };
 
 }  // namespace mapless::recording

@@ -8,6 +8,7 @@
 // default; a link sends a non-zero command only when the loop asks for it.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "mapless/core/pose.h"
@@ -44,6 +45,8 @@ class RobotLink {
   virtual std::string Halted() { return {}; }
   // The link's clock: simulated time for the simulator and under ROS `use_sim_time`.
   virtual Timestamp now_ns() const = 0;
+  // The robot's true pose now, where it is known (the simulator); recordings keep it.
+  virtual std::optional<Pose2> GroundTruth() const { return std::nullopt; }
 };
 
 }  // namespace mapless::robot

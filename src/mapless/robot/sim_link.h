@@ -33,6 +33,7 @@ class SimLink : public RobotLink {
   void Stop(const std::string& reason) override;
   std::string Halted() override;
   Timestamp now_ns() const override { return sim_.now_ns(); }
+  std::optional<Pose2> GroundTruth() const override { return truth(); }
 
   const Pose2& truth() const { return sim_.robot(robot_).pose(); }  // ground truth now
   sim::Simulation& simulation() { return sim_; }

@@ -1,0 +1,39 @@
+// Recordings as camera sources, played like `ros2 bag play`: an MCAP file (ROS 2 messages), a
+// ROS 1 bag (when mapless is built with ROS 1), a video file, an image folder, or a camera. Frames
+// carry the recording's wheel odometry when it has any (nav_msgs/Odometry), so every method can
+// run on a recording as on a robot.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "mapless/io/frame_source.h"
+
+namespace mapless::recording {
+
+struct PlaybackOptions {
+  // The image topic (sensor_msgs/Image or CompressedImage); "": the recording's only one.
+  std::string topic;
+  // The odometry topic (nav_msgs/Odometry); "": the only one when there is one; "none": none.
+  std::string odom_topic;
+  // Wall-clock pacing at this multiple of the recorded speed (ros2 bag play --rate); 0: every frame
+  // as soon as the previous one was used (the default: nothing is dropped, results do not depend
+  // on the machine's speed).
+  double rate = 0.0;
+  double start_s = 0.0;  // begin this far into the recording (ros2 bag play --start-offset)
+  bool loop = false;     // play again from the start; times go on from the end
+  double fps = 10.0;     // image folders: their frame rate
+  void Validate() const;
+};
+
+// True for the recordings OpenSource reads itself (.mcap, .bag), not through io::OpenFrameSource.
+bool IsRecording(const std::string& spec);
+
+// Opens `spec` with the options; throws InputError naming the file, topic or option.
+std::unique_ptr<io::FrameSource> OpenSource(const std::string& spec,
+                                            const PlaybackOptions& options);
+
+// Whether ROS 1 bags can be read (mapless built with librosbag-storage-dev).
+bool CanReadBags();
+
+}  // namespace mapless::recording

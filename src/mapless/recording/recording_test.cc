@@ -1,0 +1,186 @@
+// Recording runs and playing recordings (run_recorder.h, recording_link.h, playback.h).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgproc.hpp>
+
+#include "mapless/core/check.h"
+#include "mapless/core/testing.h"
+#include "mapless/recording/mcap_reader.h"
+#include "mapless/recording/mcap_source.h"
+#include "mapless/recording/playback.h"
+#include "mapless/recording/run_recorder.h"
+#include "mapless/rosmsg/messages.h"
+
+namespace mapless::recording {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string FreshPath(const std::string& name) {
+  const std::string path = ::testing::TempDir() + "mapless_recording_" + name + ".mcap";
+  fs::remove(path);
+  return path;
+}
+
+cv::Mat Pattern(int i) {
+  cv::Mat img(48, 64, CV_8UC1);
+  for (int y = 0; y < img.rows; ++y)
+    for (int x = 0; x < img.cols; ++x)
+      img.at<std::uint8_t>(y, x) = static_cast<std::uint8_t>((x * 3 + y * 5 + i * 7) & 255);
+  return img;
+}
+
+Timestamp FrameTime(int i) { return 100'000'000LL * i; }
+
+// `n` frames at 10 Hz, each with odometry written after its image (as RecordingLink does), a
+// command and a decision.
+void RecordFrames(const std::string& path, int n, const std::string& images = "raw") {
+  RunRecorderOptions options;
+  options.images = images;
+  options.mcap.chunk_ns = 300'000'000;  // several chunks
+  RunRecorder rec(path, options);
+  for (int i = 0; i < n; ++i) {
+    rec.Image(FrameTime(i), Pattern(i));
+    rec.Odometry(FrameTime(i), Pose2{0.1 * i, 0.0, 0.01 * i});
+    rec.GroundTruth(FrameTime(i), Pose2{0.1 * i, 0.001, 0.0});
+    rec.Command(FrameTime(i), Twist2{0.2, 0.0});
+    rec.Decision(FrameTime(i), {{"frame", i}});
+  }
+  rec.Close();
+}
+
+TEST(Recording, FramesPlayBackWithTheirTimesAndOdometry) {
+  const std::string path = FreshPath("frames");
+  RecordFrames(path, 25);
+  std::unique_ptr<io::FrameSource> source = OpenSource(path, {});
+  io::Frame f;
+  for (int i = 0; i < 25; ++i) {
+    ASSERT_TRUE(source->Next(&f)) << i;
+    EXPECT_EQ(f.t_ns, FrameTime(i));
+    EXPECT_EQ(cv::norm(f.image, Pattern(i), cv::NORM_INF), 0.0) << i;
+    ASSERT_TRUE(f.odometry.has_value()) << i;
+    EXPECT_DOUBLE_EQ(f.odometry->x_m, 0.1 * i);  // its own odometry, written after it
+  }
+  EXPECT_FALSE(source->Next(&f));
+}
+
+TEST(Recording, CompressedFramesPlayBack) {
+  for (const std::string images : {"png", "jpeg"}) {
+    const std::string path = FreshPath("compressed_" + images);
+    RecordFrames(path, 5, images);
+    std::unique_ptr<io::FrameSource> source = OpenSource(path, {});
+    io::Frame f;
+    for (int i = 0; i < 5; ++i) {
+      ASSERT_TRUE(source->Next(&f)) << images << " " << i;
+      const double err = cv::norm(f.image, Pattern(i), cv::NORM_L1) / f.image.total();
+      if (images == "png") EXPECT_EQ(err, 0.0);
+      else EXPECT_LT(err, 6.0);  // jpeg at quality 90
+    }
+  }
+}
+
+TEST(Recording, StartAndLoopLikeRos2BagPlay) {
+  const std::string path = FreshPath("loop");
+  RecordFrames(path, 10);
+  PlaybackOptions options;
+  options.start_s = 0.45;  // frames 5..9
+  options.loop = true;
+  std::unique_ptr<io::FrameSource> source = OpenSource(path, options);
+  io::Frame f;
+  std::vector<Timestamp> times;
+  for (int i = 0; i < 12; ++i) {
+    ASSERT_TRUE(source->Next(&f));
+    times.push_back(f.t_ns);
+    EXPECT_EQ(cv::norm(f.image, Pattern(5 + i % 5), cv::NORM_INF), 0.0) << i;
+  }
+  for (std::size_t i = 1; i < times.size(); ++i)
+    EXPECT_EQ(times[i] - times[i - 1], 100'000'000) << "time goes on across a loop, " << i;
+}
+
+TEST(Recording, TopicsAreChosenOrRefusedByName) {
+  const std::string path = FreshPath("topics");
+  RecordFrames(path, 3);
+  McapReader reader(path);
+  std::vector<std::string> names;
+  for (const RecordedTopic& t : McapTopics(reader)) names.push_back(t.topic + " " + t.type);
+  EXPECT_EQ(names, (std::vector<std::string>{
+                       "/camera/image_raw sensor_msgs/msg/Image", "/cmd_vel geometry_msgs/msg/Twist",
+                       "/ground_truth geometry_msgs/msg/PoseStamped",
+                       "/mapless/decision mapless/Decision", "/odom nav_msgs/msg/Odometry"}));
+  PlaybackOptions options;
+  options.topic = "/cmd_vel";
+  EXPECT_NE(testing::InputErrorOf([&] { OpenSource(path, options); })
+                .find("topic /cmd_vel is geometry_msgs/msg/Twist, not camera image"),
+            std::string::npos);
+  options.topic = "/front/image";
+  EXPECT_NE(testing::InputErrorOf([&] { OpenSource(path, options); }).find("no topic /front/image"),
+            std::string::npos);
+  options.topic = "/camera/image_raw";
+  options.odom_topic = "none";
+  io::Frame f;
+  ASSERT_TRUE(OpenSource(path, options)->Next(&f));
+  EXPECT_FALSE(f.odometry.has_value());
+}
+
+TEST(Recording, ACutRecordingPlaysEveryWholeFrameBeforeTheCut) {
+  const std::string path = FreshPath("cut");
+  RecordFrames(path, 30);
+  const auto size = fs::file_size(path);
+  fs::resize_file(path, size * 2 / 3);
+  std::unique_ptr<io::FrameSource> source = OpenSource(path, {});
+  io::Frame f;
+  int n = 0;
+  while (source->Next(&f)) {
+    EXPECT_EQ(cv::norm(f.image, Pattern(n), cv::NORM_INF), 0.0) << n;
+    ++n;
+  }
+  EXPECT_GT(n, 6);  // the chunks before the cut (3 frames a chunk)
+  EXPECT_LT(n, 30);
+}
+
+TEST(Recording, RecorderRefusesToOverwrite) {
+  const std::string path = FreshPath("exists");
+  RecordFrames(path, 1);
+  EXPECT_THROW(RecordFrames(path, 1), InputError);
+  EXPECT_THROW(RecordFrames(FreshPath("bad_images"), 1, "bmp"), InputError);
+}
+
+// The fixtures of foxglove/rosbag (tests/data/rosbag1/README.md): the same recording stored
+// uncompressed, with lz4 and with bz2 chunks.
+TEST(RosBag, TheThreeCompressionsGiveTheSameMessages) {
+  if (!CanReadBags()) GTEST_SKIP() << "mapless was built without ROS 1 bags (setup.sh --ros)";
+  const std::string dir = std::string(MAPLESS_SOURCE_DIR) + "/tests/data/rosbag1/";
+  std::vector<std::vector<std::string>> all;
+  for (const char* name : {"example.bag", "example-lz4.bag", "example-bz2.bag"}) {
+    std::unique_ptr<MessageStream> bag = OpenBagMessages(dir + name);
+    std::vector<std::string> seen;
+    RecordedMessage m;
+    int twists = 0;
+    while (bag->Next(&m)) {
+      std::string line = m.topic->topic + " " + std::to_string(m.log_ns);
+      if (m.topic->type == "geometry_msgs/msg/Twist") {
+        const Twist2 t = rosmsg::DecodeTwist(m.data, rosmsg::Wire::kRos1);
+        line += " " + std::to_string(t.v_mps) + " " + std::to_string(t.omega_radps);
+        ++twists;
+      }
+      seen.push_back(line);
+    }
+    EXPECT_EQ(seen.size(), 8647u) << name;
+    EXPECT_GT(twists, 0) << name;
+    all.push_back(seen);
+  }
+  EXPECT_EQ(all[0], all[1]);
+  EXPECT_EQ(all[0], all[2]);
+  RecordedMessage m;
+  EXPECT_FALSE(OpenBagMessages(dir + "no-messages.bag")->Next(&m));
+  // No camera in these bags: a clear error naming the file and the topics it has.
+  const std::string error =
+      testing::InputErrorOf([&] { OpenSource(dir + "example.bag", {}); });
+  EXPECT_NE(error.find("example.bag: no camera image topic (topics: /rosout"), std::string::npos)
+      << error;
+}
+
+}  // namespace
+}  // namespace mapless::recording
