@@ -7,12 +7,15 @@
 #include "interrupt.h"
 #include "mapless/core/check.h"
 #include "mapless/eval/eigenspace.h"
+#include "mapless/recording/playback.h"
+#include "mapless/recording/recording_link.h"
 #include "mapless/robot/loop.h"
 #include "mapless/robot/methods.h"
 #include "mapless/robot/sim_link.h"
 #include "mapless/robot/status.h"
 #include "mapless/route/appearance_store.h"
 #include "mapless/sim/driver.h"
+#include "recording_args.h"
 #include "robot_run.h"
 #include "teach.h"
 
@@ -48,6 +51,26 @@ std::shared_ptr<const route::AppearanceRoute> RebuildRoute(const std::string& di
 
 }  // namespace
 
+void ReplayOnRecording(robot::Method& method, const std::string& source,
+                       const recording::PlaybackOptions& playback, const std::string& log_path) {
+  recording::PlaybackLink link(recording::OpenSource(source, playback));
+  JsonLines log(log_path);
+  StopCleanlyOnInterrupt();
+  int frame = 0;
+  const robot::LoopResult result = robot::RunLoop(
+      method, link, robot::LoopOptions{},
+      [&](const robot::Observation& obs, const robot::Decision& decision) {
+        log.Write(robot::StatusJson(method.name(), frame++, obs, decision));
+        return true;
+      },
+      [] { return InterruptSignal() != 0; });
+  ThrowIfInterrupted();
+  spdlog::info("{} (open loop on {}): {} frames, {}", method.name(), source, result.frames,
+               result.reason);
+  if (!result.finished && result.reason != recording::kEndOfRecording)
+    throw RunFailed(std::string(method.name()) + " stopped: " + result.reason);
+}
+
 void AddFollowCommand(CLI::App* app) {
   struct Args {
     std::string route;
@@ -57,6 +80,8 @@ void AddFollowCommand(CLI::App* app) {
     std::uint64_t seed = 1;
     double motion_noise = 0.1;
     FollowConnectArgs fleet;
+    RecordArgs record;
+    recording::PlaybackOptions playback;
   };
   auto a = std::make_shared<Args>();
   CLI::App* cmd = app->add_subcommand(
@@ -77,7 +102,10 @@ void AddFollowCommand(CLI::App* app) {
   cmd->add_option("--summary", a->fleet.summary, "With --connect on the simulator: a JSON summary");
   cmd->add_option("--curve-key", a->fleet.curve_key, "CURVE: this follower's key file");
   cmd->add_option("--curve-leader", a->fleet.curve_leader, "CURVE: the leader's public key file");
-  CLI::Option* source = cmd->add_option("--source", a->source, "sim:SCENARIO");
+  CLI::Option* source = cmd->add_option(
+      "--source", a->source, "sim:SCENARIO, or a recording (.mcap, .bag, video, image folder)");
+  AddPlaybackOptions(cmd, &a->playback, /*with_rate=*/false);
+  AddRecordOptions(cmd, &a->record);
   cmd->add_option("--robot", a->robot, "Drive a robot: its robot file (YAML)")->excludes(source);
   cmd->add_option("--log", a->log, "Per-frame decisions as JSON lines (- for stdout)");
   cmd->add_option("--seed", a->seed, "Simulator: seed of the motion noise")
@@ -102,16 +130,24 @@ void AddFollowCommand(CLI::App* app) {
     if (a->source.empty() == a->robot.empty())
       throw InputError("follow: give one of --source sim:SCENARIO or --robot");
     RefuseOutputOverInputs(a->log, "--log", {a->route, SourceInput(a->source), a->robot});
+    RefuseOutputOverInputs(a->record.path, "--record",
+                           {a->route, SourceInput(a->source), a->robot});
     cv::Size size;
     const std::shared_ptr<const route::AppearanceRoute> route = RebuildRoute(a->route, &size);
     const navigation::AppearanceFollowerOptions follower;
     robot::FollowMethod method([route] { return route; }, follower, size);
     if (!a->robot.empty()) {
-      RunOnRobot(method, a->robot, a->log);
+      const auto recorder = OpenRecorder(a->record);
+      RunOnRobot(method, a->robot, a->log, recorder.get());
       return;
     }
-    if (!IsSim(a->source))
-      throw InputError("--source " + a->source + ": follow runs on sim:SCENARIO or --robot");
+    if (!IsSim(a->source)) {
+      if (!a->record.path.empty())
+        throw InputError("--record: records runs on the simulator or a robot; " + a->source +
+                         " is played open loop (its decisions are in --log)");
+      ReplayOnRecording(method, a->source, a->playback, a->log);
+      return;
+    }
     const sim::Scenario scenario = sim::LoadScenario(a->source.substr(4));
     if (scenario.camera.model.width != size.width || scenario.camera.model.height != size.height)
       throw InputError(
@@ -128,11 +164,14 @@ void AddFollowCommand(CLI::App* app) {
     link_options.period_s = 1.0 / scenario.camera.rate_hz;
     link_options.timeout_s = eval::FollowTimeoutS(scenario, options);
     robot::SimLink link(sim, r, link_options);
+    const auto recorder = OpenRecorder(a->record, recording::CameraInfoOf(scenario.camera.model));
+    const robot::LinkWrapper wrap = RecordingWrapper(recorder.get(), method.name());
+    const std::unique_ptr<robot::RobotLink> wrapped = wrap ? wrap(link) : nullptr;
     JsonLines log(a->log);
     StopCleanlyOnInterrupt();
     int frame = 0;
     const robot::LoopResult result = robot::RunLoop(
-        method, link, robot::LoopOptions{},
+        method, wrapped ? *wrapped : static_cast<robot::RobotLink&>(link), robot::LoopOptions{},
         [&](const robot::Observation& obs, const robot::Decision& decision) {
           ThrowIfInterrupted();
           nlohmann::json j = robot::StatusJson(method.name(), frame++, obs, decision);

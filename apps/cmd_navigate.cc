@@ -11,6 +11,8 @@
 #include "mapless/io/atomic_file.h"
 #include "mapless/io/limits.h"
 #include "mapless/robot/methods.h"
+#include "mapless/recording/recording_link.h"
+#include "recording_args.h"
 #include "robot_run.h"
 
 namespace mapless::app {
@@ -35,6 +37,7 @@ struct NavigateArgs {
   double motion_noise = 0.1;
   double image_noise = 2.0;
   std::string robot;
+  RecordArgs record;
 };
 
 // `navigate --robot`: the visual potential on a robot through its robot link.
@@ -68,7 +71,9 @@ void NavigateOnRobot(const NavigateArgs& a, bool by_index) {
   navigation::PotentialNavOptions nav;
   nav.homing = a.homing;
   robot::PotentialMethod method(calibration, nav, destination);
-  RunOnRobot(method, a.robot, a.log);
+  RefuseOutputOverInputs(a.record.path, "--record", {a.robot, a.calibration});
+  const auto recorder = OpenRecorder(a.record);
+  RunOnRobot(method, a.robot, a.log, recorder.get());
 }
 
 }  // namespace
@@ -98,6 +103,7 @@ void AddNavigateCommand(CLI::App* app) {
   cmd->add_option("--save-calibration", a->save_calibration,
                   "Write the calibration used to this file (YAML)");
   cmd->add_option("--log", a->log, "Per-frame decisions as JSON lines (- for stdout)");
+  AddRecordOptions(cmd, &a->record);
   cmd->add_option("--seed", a->seed, "Noise seed")->capture_default_str()->check(SeedCheck());
   cmd->add_option("--motion-noise", a->motion_noise, "Fraction of T and R")
       ->capture_default_str()
@@ -171,6 +177,9 @@ void AddNavigateCommand(CLI::App* app) {
     if (!a->save_calibration.empty())
       io::WriteFileAtomic(a->save_calibration, navigation::CalibrationToYaml(calibration));
 
+    RefuseOutputOverInputs(a->record.path, "--record", {a->calibration, a->scenario});
+    const auto recorder = OpenRecorder(a->record, recording::CameraInfoOf(scenario.camera.model));
+    o.wrap_link = RecordingWrapper(recorder.get(), "navigate");
     JsonLines log(a->log.empty() ? std::string() : a->log);
     StopCleanlyOnInterrupt();
     const bool logging = !a->log.empty();

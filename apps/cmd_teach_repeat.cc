@@ -17,6 +17,8 @@
 #include "mapless/io/output_dir.h"
 #include "mapless/robot/methods.h"
 #include "mapless/route/route_store.h"
+#include "mapless/recording/recording_link.h"
+#include "recording_args.h"
 #include "robot_run.h"
 #include "teach.h"
 
@@ -72,6 +74,8 @@ void AddTeachRepeatCommands(CLI::App* app) {
   teach->add_option("--fps", t->fps, "Frame rate of image folders (timestamps)")
       ->capture_default_str()
       ->check(FiniteIn(io::kMinFolderFps, io::kMaxFolderFps));
+  AddPlaybackOptions(teach, &t->playback);
+  AddRecordOptions(teach, &t->record);
   teach->callback([t] { Teach(*t); });
 
   struct RepeatArgs {
@@ -87,6 +91,8 @@ void AddTeachRepeatCommands(CLI::App* app) {
     double fps = 10.0;
     std::string robot;
     double speed = 0.2;
+    RecordArgs record;
+    recording::PlaybackOptions playback;
   };
   auto r = std::make_shared<RepeatArgs>();
   CLI::App* repeat = app->add_subcommand(
@@ -130,10 +136,16 @@ void AddTeachRepeatCommands(CLI::App* app) {
   repeat->add_option("--fps", r->fps, "Frame rate of image folders (timestamps)")
       ->capture_default_str()
       ->check(FiniteIn(io::kMinFolderFps, io::kMaxFolderFps));
+  AddPlaybackOptions(repeat, &r->playback);
+  AddRecordOptions(repeat, &r->record);
   repeat->callback([r] {
     if (r->source.empty() && r->robot.empty())
       throw InputError("repeat: give --source (simulator, recording, camera) or --robot");
     RefuseOutputOverInputs(r->log, "--log", {r->route, SourceInput(r->source), r->robot});
+    RefuseOutputOverInputs(r->record.path, "--record", {r->route, SourceInput(r->source), r->robot});
+    if (!r->record.path.empty() && !r->source.empty() && !IsSim(r->source))
+      throw InputError("--record: records runs on the simulator or a robot; " + r->source +
+                       " is played open loop (its decisions are in --log)");
     auto route = std::make_shared<route::Route>(route::LoadRoute(r->route));
     if (!route->complete)
       spdlog::warn("repeat: {} is an interrupted teach; repeating its {} keyframes", r->route,
@@ -147,7 +159,8 @@ void AddTeachRepeatCommands(CLI::App* app) {
       options.sloped.max_speed_mps = r->speed;
       options.standard.forward_speed_mps = r->speed;
       robot::RepeatMethod method(route, options);
-      RunOnRobot(method, r->robot, r->log);
+      const auto recorder = OpenRecorder(r->record);
+      RunOnRobot(method, r->robot, r->log, recorder.get());
       return;
     }
     std::unique_ptr<io::FrameSource> source;
@@ -155,8 +168,11 @@ void AddTeachRepeatCommands(CLI::App* app) {
     if (IsSim(r->source)) {
       scenario = sim::LoadScenario(r->source.substr(4));
     } else {
-      source = io::OpenFrameSource(r->source, r->fps);
+      r->playback.fps = r->fps;
+      source = recording::OpenSource(r->source, r->playback);
     }
+    const auto recorder =
+        scenario ? OpenRecorder(r->record, recording::CameraInfoOf(scenario->camera.model)) : nullptr;
     JsonLines log(r->log);
     StopCleanlyOnInterrupt();
     int frame_index = 0;
@@ -181,6 +197,7 @@ void AddTeachRepeatCommands(CLI::App* app) {
       run_options.seed = r->seed;
       run_options.motion_noise_frac = r->motion_noise;
       run_options.image_noise_sigma = r->image_noise;
+      run_options.wrap_link = RecordingWrapper(recorder.get(), "repeat");
       const double speed = eval::RepeatSpeedFor(*scenario, run_options.max_repeat_speed_mps);
       run_options.repeat.sloped.max_speed_mps = speed;
       run_options.repeat.standard.forward_speed_mps = speed;

@@ -7,6 +7,7 @@
 #include "cli_common.h"
 #include "interrupt.h"
 #include "mapless/core/check.h"
+#include "mapless/recording/recording_link.h"
 #include "mapless/robot/loop.h"
 #include "mapless/robot/status.h"
 #ifdef MAPLESS_HAVE_ROS1
@@ -49,18 +50,21 @@ std::unique_ptr<robot::RobotLink> OpenRobotLink(const robot::RobotFile& robot, c
                    " is not available in this build");
 }
 
-void RunOnRobot(robot::Method& method, const std::string& robot_path, const std::string& log_path) {
+void RunOnRobot(robot::Method& method, const std::string& robot_path, const std::string& log_path,
+                recording::RunRecorder* recorder) {
   const robot::RobotFile file = robot::LoadRobotFile(robot_path);
   std::unique_ptr<JsonLines> log;
   if (!log_path.empty()) log = std::make_unique<JsonLines>(log_path);
   StopCleanlyOnInterrupt();
   std::unique_ptr<robot::RobotLink> link = OpenRobotLink(file, method.image_size(), method.name());
+  std::unique_ptr<robot::RobotLink> recording;
+  if (recorder) recording = std::make_unique<recording::RecordingLink>(*link, *recorder, method.name());
   spdlog::info("{}: on {} ({}), commands to {}", method.name(), file.name,
                robot::MiddlewareName(file.middleware), file.Resolve(file.topics.cmd_vel));
   int frame = 0;
   std::string last_state;
   const robot::LoopResult result = robot::RunLoop(
-      method, *link, file.Loop(),
+      method, recording ? *recording : *link, file.Loop(),
       [&](const robot::Observation& obs, const robot::Decision& decision) {
         if (log) log->Write(robot::StatusJson(method.name(), frame, obs, decision));
         ++frame;
@@ -72,6 +76,7 @@ void RunOnRobot(robot::Method& method, const std::string& robot_path, const std:
         return true;
       },
       [] { return InterruptSignal() != 0; });
+  recording.reset();
   link.reset();  // zero velocity published, then off the graph
   spdlog::info("{}: {} after {} frames: {}", method.name(),
                result.finished ? "finished" : "stopped", result.frames, result.reason);

@@ -7,6 +7,8 @@
 #include <memory>
 #include <string>
 
+#include "mapless/recording/playback.h"
+#include "mapless/recording/run_recorder.h"
 #include "mapless/robot/link.h"
 #include "mapless/robot/method.h"
 #include "mapless/robot/robot_file.h"
@@ -21,7 +23,15 @@ std::unique_ptr<robot::RobotLink> OpenRobotLink(const robot::RobotFile& robot, c
 // Runs `method` on the robot. Decisions go to `log_path` as JSON lines ("" : none, "-": stdout).
 // Throws RunFailed when the method failed or gave up, Interrupted on SIGINT/SIGTERM (after the
 // robot was stopped).
-void RunOnRobot(robot::Method& method, const std::string& robot_path, const std::string& log_path);
+// With a recorder, the run is recorded (recording/recording_link.h).
+void RunOnRobot(robot::Method& method, const std::string& robot_path, const std::string& log_path,
+                recording::RunRecorder* recorder = nullptr);
+
+// Runs `method` open loop on a recording (recording/playback.h) through the same loop as on a
+// robot; decisions to `log_path` as JSON lines (robot/status.h). The end of the recording is a
+// normal end; throws RunFailed when the method failed, Interrupted on SIGINT/SIGTERM.
+void ReplayOnRecording(robot::Method& method, const std::string& source,
+                       const recording::PlaybackOptions& playback, const std::string& log_path);
 
 // `mapless sim serve`.
 void AddSimServeCommand(CLI::App* sim);

@@ -13,6 +13,7 @@
 #include "mapless/io/output_dir.h"
 #include "mapless/navigation/appearance.h"
 #include "mapless/navigation/teach.h"
+#include "mapless/recording/recording_link.h"
 #include "mapless/robot/link.h"
 #include "mapless/robot/robot_file.h"
 #include "mapless/route/appearance_store.h"
@@ -142,6 +143,10 @@ void Teach(const TeachArgs& t) {
   if (!eigenspace) features::ParseDetectorType(t.detector);
   const char* marker = eigenspace ? "appearance.json" : "manifest.json";
   RefuseOutputOverInputs(t.out, "--out", {SourceInput(t.source), t.robot});
+  RefuseOutputOverInputs(t.record.path, "--record", {SourceInput(t.source), t.robot, t.out});
+  if (!t.record.path.empty() && !t.source.empty() && !IsSim(t.source))
+    throw InputError("--record: records teaches on the simulator or a robot; " + t.source +
+                     " is already a recording or a camera");
   const std::filesystem::path out_path(t.out);
   if (!t.overwrite && (std::filesystem::exists(out_path / "manifest.json") ||
                        std::filesystem::exists(out_path / "appearance.json"))) {
@@ -163,8 +168,12 @@ void Teach(const TeachArgs& t) {
   } else if (IsSim(t.source)) {
     scenario = sim::LoadScenario(t.source.substr(4));
   } else {
-    source = io::OpenFrameSource(t.source, t.fps);
+    recording::PlaybackOptions playback = t.playback;
+    playback.fps = t.fps;
+    source = recording::OpenSource(t.source, playback);
   }
+  const auto recorder = OpenRecorder(
+      t.record, scenario ? std::optional(recording::CameraInfoOf(scenario->camera.model)) : std::nullopt);
   io::OutputDirectory out(t.out, t.overwrite, "route", marker);
   StopCleanlyOnInterrupt();
   std::unique_ptr<Teacher> teacher;
@@ -175,8 +184,14 @@ void Teach(const TeachArgs& t) {
   }
   int frames = 0;
   const auto frame_in = [&](const cv::Mat& image, Timestamp t_ns,
-                            const std::optional<Pose2>& odometry) {
+                            const std::optional<Pose2>& odometry,
+                            const std::optional<Pose2>& truth = std::nullopt) {
     ThrowIfInterrupted();
+    if (recorder) {
+      if (!image.empty()) recorder->Image(t_ns, image);
+      if (odometry) recorder->Odometry(t_ns, *odometry);
+      if (truth) recorder->GroundTruth(t_ns, *truth);
+    }
     teacher->Frame(image, t_ns, odometry);
     ++frames;
   };
@@ -185,7 +200,7 @@ void Teach(const TeachArgs& t) {
     if (scenario) {
       const sim::DriveSummary summary = sim::DriveTaughtPath(
           *scenario, sim::DriveOptions{},
-          [&](const sim::DriveFrame& f) { frame_in(f.image, f.t_ns, f.odometry); });
+          [&](const sim::DriveFrame& f) { frame_in(f.image, f.t_ns, f.odometry, f.truth); });
       if (!summary.completed) {
         throw RunFailed("teach: the drive of '" + scenario->name +
                         "' did not complete: " + summary.status);
@@ -206,7 +221,7 @@ void Teach(const TeachArgs& t) {
       }
     } else {
       io::Frame frame;
-      while (source->Next(&frame)) frame_in(frame.image, frame.t_ns, std::nullopt);
+      while (source->Next(&frame)) frame_in(frame.image, frame.t_ns, frame.odometry);
     }
   } catch (const Interrupted&) {
     if (frames == 0 || !(IsLive(t.source) || robot_file)) throw;

@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include "recording_args.h"
+
 namespace mapless::app {
 
 struct TeachArgs {
@@ -14,6 +16,8 @@ struct TeachArgs {
   bool overwrite = false;
   std::string detector = "orb";
   double fps = 10.0;
+  recording::PlaybackOptions playback;  // a recording as the source
+  RecordArgs record;                    // --record (simulator and robot teaches)
 };
 
 bool IsSim(const std::string& source);

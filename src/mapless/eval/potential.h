@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "mapless/robot/link.h"
+
 #include "mapless/eval/suite.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/navigation/potential.h"
@@ -39,6 +41,7 @@ struct PotentialRunOptions {
   double success_radius_m = 0.3;  // final distance to the goal (the issue: 0.3 m)
   std::vector<sim::CameraFaultWindow> camera_faults;  // hardening tests (sim/camera_faults.h)
   std::uint64_t seed = 1;
+  robot::LinkWrapper wrap_link;  // between the loop and the simulator (a recording)
   void Validate() const;
 };
 

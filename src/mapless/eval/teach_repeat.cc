@@ -102,9 +102,10 @@ RepeatRun RepeatOnSimulator(const sim::Scenario& scenario, const TaughtRoute& ta
   link_options.camera_faults = options.camera_faults;
   link_options.fault_seed = options.seed;
   robot::SimLink link(sim, r, link_options);
+  const std::unique_ptr<robot::RobotLink> wrapped = options.wrap_link ? options.wrap_link(link) : nullptr;
   RepeatRun run;
   const robot::LoopResult result =
-      robot::RunLoop(method, link, robot::LoopOptions{},
+      robot::RunLoop(method, wrapped ? *wrapped : static_cast<robot::RobotLink&>(link), robot::LoopOptions{},
                      [&](const robot::Observation& obs, const robot::Decision& decision) {
                        const auto& step = std::get<navigation::RepeatStep>(decision.detail);
                        run.path.push_back(link.truth());

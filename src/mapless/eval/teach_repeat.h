@@ -37,6 +37,7 @@ struct RepeatRunOptions {
   double success_radius_m = 0.5;      // final pose within this of the taught end
   std::vector<sim::CameraFaultWindow> camera_faults;  // hardening tests (sim/camera_faults.h)
   std::uint64_t seed = 1;
+  robot::LinkWrapper wrap_link;  // between the loop and the simulator (a recording)
   void Validate() const;
 };
 

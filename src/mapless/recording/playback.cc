@@ -90,6 +90,22 @@ void PlaybackOptions::Validate() const {
     throw InputError("--fps " + std::to_string(fps) + ": out of range");
 }
 
+robot::LinkEvent PlaybackLink::Next() {
+  robot::LinkEvent event;
+  io::Frame frame;
+  if (!source_->Next(&frame)) {
+    event.type = robot::LinkEventType::kClosed;
+    event.reason = kEndOfRecording;
+    return event;
+  }
+  now_ns_ = frame.t_ns;
+  event.type = robot::LinkEventType::kFrame;
+  event.observation.image = frame.image;
+  event.observation.t_ns = frame.t_ns;
+  event.observation.odometry = frame.odometry;
+  return event;
+}
+
 bool CanReadBags() { return CanReadBagsImpl(); }
 
 bool IsRecording(const std::string& spec) {

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "mapless/io/frame_source.h"
+#include "mapless/robot/link.h"
 
 namespace mapless::recording {
 
@@ -32,6 +33,23 @@ bool IsRecording(const std::string& spec);
 // Opens `spec` with the options; throws InputError naming the file, topic or option.
 std::unique_ptr<io::FrameSource> OpenSource(const std::string& spec,
                                             const PlaybackOptions& options);
+
+// A recording as a robot link: its frames (with their odometry) go to the loop, the commands go
+// nowhere. The link's clock is the frame's time, so no frame is stale. The end of the recording
+// closes the link ("end of the recording").
+class PlaybackLink : public robot::RobotLink {
+ public:
+  explicit PlaybackLink(std::unique_ptr<io::FrameSource> source) : source_(std::move(source)) {}
+  robot::LinkEvent Next() override;
+  void Send(const Twist2&, const robot::Observation&, const robot::Decision&) override {}
+  void Stop(const std::string&) override {}
+  Timestamp now_ns() const override { return now_ns_; }
+
+ private:
+  std::unique_ptr<io::FrameSource> source_;
+  Timestamp now_ns_ = 0;
+};
+inline constexpr const char* kEndOfRecording = "end of the recording";
 
 // Whether ROS 1 bags can be read (mapless built with librosbag-storage-dev).
 bool CanReadBags();

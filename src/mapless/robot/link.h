@@ -8,6 +8,8 @@
 // default; a link sends a non-zero command only when the loop asks for it.
 #pragma once
 
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -48,5 +50,8 @@ class RobotLink {
   // The robot's true pose now, where it is known (the simulator); recordings keep it.
   virtual std::optional<Pose2> GroundTruth() const { return std::nullopt; }
 };
+
+// A link put around another one for a run (a recording link, say); empty: none.
+using LinkWrapper = std::function<std::unique_ptr<RobotLink>(RobotLink& inner)>;
 
 }  // namespace mapless::robot

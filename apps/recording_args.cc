@@ -1,0 +1,63 @@
+#include "recording_args.h"
+
+#include <spdlog/spdlog.h>
+
+#include "cli_common.h"
+#include "mapless/core/check.h"
+#include "mapless/recording/recording_link.h"
+
+namespace mapless::app {
+
+void AddRecordOptions(CLI::App* cmd, RecordArgs* args) {
+  cmd->add_option("--record", args->path,
+                  "Record the run to this MCAP file (ROS 2 messages: camera, camera_info, "
+                  "cmd_vel, odom, ground truth, decisions); Foxglove and ros2 bag open it, "
+                  "mapless replays it as a --source");
+  cmd->add_option("--record-images", args->images,
+                  "raw (sensor_msgs/Image), png or jpeg (CompressedImage)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"raw", "png", "jpeg"}));
+  cmd->add_option("--record-compression", args->compression, "MCAP chunks: zstd, lz4 or none")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"zstd", "lz4", "none"}));
+}
+
+void AddPlaybackOptions(CLI::App* cmd, recording::PlaybackOptions* options, bool with_rate) {
+  cmd->add_option("--topic", options->topic,
+                  "Recordings (.mcap, .bag): the camera topic (default: the only one)");
+  cmd->add_option("--odom-topic", options->odom_topic,
+                  "Recordings: the nav_msgs/Odometry topic (default: the only one, if any; none: "
+                  "no odometry)");
+  if (with_rate) {
+    cmd->add_option("--rate", options->rate,
+                    "Play the source at this multiple of its recorded speed (0: each frame as "
+                    "soon as the previous one is used)")
+        ->capture_default_str()
+        ->check(FiniteIn(0.0, 1000.0));
+  }
+  cmd->add_option("--start", options->start_s, "Begin this many seconds into the source")
+      ->capture_default_str()
+      ->check(FiniteIn(0.0, 1e9));
+  cmd->add_flag("--loop", options->loop, "Play the source again from the start when it ends");
+}
+
+std::unique_ptr<recording::RunRecorder> OpenRecorder(
+    const RecordArgs& args, std::optional<rosmsg::CameraInfoFields> camera_info) {
+  if (args.path.empty()) return nullptr;
+  recording::RunRecorderOptions options;
+  options.images = args.images;
+  options.mcap.compression = args.compression == "none" ? "" : args.compression;
+  options.camera_info = std::move(camera_info);
+  auto recorder = std::make_unique<recording::RunRecorder>(args.path, options);
+  spdlog::info("recording to {}", args.path);
+  return recorder;
+}
+
+robot::LinkWrapper RecordingWrapper(recording::RunRecorder* recorder, const char* method) {
+  if (!recorder) return {};
+  return [recorder, method](robot::RobotLink& inner) -> std::unique_ptr<robot::RobotLink> {
+    return std::make_unique<recording::RecordingLink>(inner, *recorder, method);
+  };
+}
+
+}  // namespace mapless::app

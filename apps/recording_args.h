@@ -1,0 +1,37 @@
+// The command-line options of recordings: `--record FILE` on any run (recording/run_recorder.h)
+// and the `ros2 bag play`-like options of recordings used as sources (recording/playback.h).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "mapless/recording/playback.h"
+#include "mapless/recording/run_recorder.h"
+#include "mapless/robot/link.h"
+
+namespace mapless::app {
+
+struct RecordArgs {
+  std::string path;
+  std::string images = "raw";
+  std::string compression = "zstd";
+};
+
+// --record FILE, --record-images raw|png|jpeg, --record-compression zstd|lz4|none.
+void AddRecordOptions(CLI::App* cmd, RecordArgs* args);
+
+// --topic, --odom-topic, --start, --loop, and --rate unless `with_rate` is false (a command whose
+// --rate means something else).
+void AddPlaybackOptions(CLI::App* cmd, recording::PlaybackOptions* options, bool with_rate = true);
+
+// The recorder --record asks for (nullptr without it). Created before the run starts, so a bad
+// path fails before anything moves.
+std::unique_ptr<recording::RunRecorder> OpenRecorder(
+    const RecordArgs& args, std::optional<rosmsg::CameraInfoFields> camera_info = std::nullopt);
+
+// A link wrapper that records through `recorder` (empty when it is nullptr).
+robot::LinkWrapper RecordingWrapper(recording::RunRecorder* recorder, const char* method);
+
+}  // namespace mapless::app
