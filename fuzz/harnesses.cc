@@ -16,6 +16,8 @@
 #include "mapless/io/tum.h"
 #include "mapless/navigation/potential.h"
 #include "mapless/recording/mcap_reader.h"
+#include "mapless/recording/mcap_source.h"
+#include "mapless/rosmsg/messages.h"
 #include "mapless/robot/camera_image.h"
 #include "mapless/robot/robot_file.h"
 #include "mapless/route/appearance_store.h"
@@ -211,6 +213,36 @@ void FleetRecord(const std::string& input) {
   });
 }
 
+// Every message of a recording through the reader of its type (ROS 1 or ROS 2 wire).
+void DecodeEveryMessage(std::unique_ptr<recording::MessageStream> messages) {
+  recording::RecordedMessage m;
+  for (int n = 0; n < 100'000 && messages->Next(&m); ++n) {
+    const std::string& type = m.topic->type;
+    AcceptInputError([&] {
+      if (type == "sensor_msgs/msg/Image") {
+        const rosmsg::ImageFields im = rosmsg::DecodeImage(m.data, m.wire);
+        robot::GreyFromRaw(im.encoding, im.width, im.height, im.step, im.big_endian, im.data);
+      } else if (type == "sensor_msgs/msg/CompressedImage") {
+        rosmsg::DecodeCompressedImage(m.data, m.wire);
+      } else if (type == "sensor_msgs/msg/CameraInfo") {
+        rosmsg::DecodeCameraInfo(m.data, m.wire);
+      } else if (type == "geometry_msgs/msg/Twist") {
+        rosmsg::DecodeTwist(m.data, m.wire);
+      } else if (type == "nav_msgs/msg/Odometry") {
+        rosmsg::DecodeOdometry(m.data, m.wire);
+      } else if (type == "geometry_msgs/msg/PoseStamped") {
+        rosmsg::DecodePoseStamped(m.data, m.wire);
+      }
+    });
+  }
+}
+
+void PlayFrames(std::unique_ptr<io::FrameSource> source) {
+  io::Frame frame;
+  for (int n = 0; n < 1000 && source->Next(&frame); ++n) {
+  }
+}
+
 void McapFile(const std::string& input) {
   AcceptInputError([&] {
     const std::unique_ptr<recording::McapReader> reader =
@@ -270,6 +302,19 @@ void McapFile(const std::string& input) {
         ->ForEachMessage([](const recording::McapChannel&, const recording::McapSchema*,
                             const recording::McapMessage&) {});
   });
+  // As a recording played back: its topics, every message decoded by its type, its frames.
+  const std::filesystem::path path = Scratch("mcap") / "fuzz.mcap";
+  WriteBytes(path, input);
+  AcceptInputError([&] { DecodeEveryMessage(recording::OpenMcapMessages(path.string())); });
+  AcceptInputError([&] { PlayFrames(recording::OpenMcapSource(path.string(), "", "")); });
+}
+
+void RosBag(const std::string& input) {
+  if (!recording::CanReadBagsImpl()) return;
+  const std::filesystem::path path = Scratch("bag") / "fuzz.bag";
+  WriteBytes(path, input);
+  AcceptInputError([&] { DecodeEveryMessage(recording::OpenBagMessages(path.string())); });
+  AcceptInputError([&] { PlayFrames(recording::OpenBagSource(path.string(), "", "")); });
 }
 
 const std::vector<NamedHarness>& Harnesses() {
@@ -287,7 +332,8 @@ const std::vector<NamedHarness>& Harnesses() {
                                                       {"appearance_manifest", AppearanceManifest},
                                                       {"camera_message", CameraMessage},
                                                       {"fleet_record", FleetRecord},
-                                                      {"mcap", McapFile}};
+                                                      {"mcap", McapFile},
+                                                      {"rosbag", RosBag}};
   return harnesses;
 }
 

@@ -54,6 +54,9 @@ void FleetRecord(const std::string& input);
 // An MCAP file (recording/mcap_reader.h): every record, chunks opened and every record type
 // parsed, then the messages with their channels and schemas.
 void McapFile(const std::string& input);
+// A ROS 1 bag (rosbag_storage) read to the end, every message decoded by its type, and played as
+// a camera source (nothing when mapless was built without ROS 1 bags).
+void RosBag(const std::string& input);
 
 const std::vector<NamedHarness>& Harnesses();
 
