@@ -11,6 +11,7 @@
 #include "mapless/core/check.h"
 #include "mapless/io/frame_source.h"
 #include "mapless/localization/sequence.h"
+#include "mapless/recording/playback.h"
 
 namespace mapless::app {
 namespace {
@@ -23,11 +24,15 @@ struct Folder {
   std::vector<std::string> names;
 };
 
-Folder ReadFolder(const std::string& dir, const std::string& option) {
-  MAPLESS_CHECK(std::filesystem::is_directory(dir),
-                option << " " << dir << ": not a directory of images");
+// The images of a folder, a recording (.mcap, .bag) or a video, in order.
+Folder ReadFolder(const std::string& dir, const std::string& option,
+                  const recording::PlaybackOptions& playback) {
+  MAPLESS_CHECK(std::filesystem::is_directory(dir) || std::filesystem::is_regular_file(dir),
+                option << " " << dir << ": not a folder of images, a recording or a video");
   Folder folder;
-  const std::unique_ptr<io::FrameSource> source = io::OpenFrameSource(dir);
+  recording::PlaybackOptions once = playback;
+  once.loop = false;  // every image is kept
+  const std::unique_ptr<io::FrameSource> source = recording::OpenSource(dir, once);
   io::Frame frame;
   double pixels = 0.0;
   while (source->Next(&frame)) {
@@ -57,15 +62,22 @@ void AddLocalizeCommand(CLI::App* app) {
     int dimensions = 16;
     double advance = 1.0;
     double advance_sigma = 0.2;
+    recording::PlaybackOptions playback;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app->add_subcommand(
       "localize", "Localize query images on the route formed by database images (incremental PCA)");
   cmd->add_option("--database", args->database,
-                  "Folder of route images, in route (file-name) order")
+                  "Route images: a folder (file-name order), a recording (.mcap, .bag) or a video")
       ->required();
-  cmd->add_option("--query", args->query, "Folder of query images (a traversal of the same route)")
+  cmd->add_option("--query", args->query,
+                  "Query images (a traversal of the same route): a folder, a recording or a video")
       ->required();
+  cmd->add_option("--topic", args->playback.topic,
+                  "Recordings: the camera topic (default: the only one)");
+  cmd->add_option("--start", args->playback.start_s, "Begin this many seconds into each source")
+      ->capture_default_str()
+      ->check(FiniteIn(0.0, 1e9));
   cmd->add_option("--method", args->method, "nn (nearest projection) or markov")
       ->capture_default_str();
   cmd->add_option("--pca", args->pca, "incremental or batch")->capture_default_str();
@@ -99,8 +111,8 @@ void AddLocalizeCommand(CLI::App* app) {
     options.advance_per_query = args->advance;
     options.advance_sigma = args->advance_sigma;
     options.Validate();
-    const Folder database = ReadFolder(args->database, "--database");
-    const Folder query = ReadFolder(args->query, "--query");
+    const Folder database = ReadFolder(args->database, "--database", args->playback);
+    const Folder query = ReadFolder(args->query, "--query", args->playback);
     const appearance::Eigenspace route =
         localization::BuildRouteEigenspace(database.images, options);
     spdlog::info("localize: {} route images, eigenspace of {} dimensions ({} PCA); {} queries ({})",

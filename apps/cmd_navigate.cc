@@ -10,8 +10,8 @@
 #include "mapless/eval/potential.h"
 #include "mapless/io/atomic_file.h"
 #include "mapless/io/limits.h"
-#include "mapless/robot/methods.h"
 #include "mapless/recording/recording_link.h"
+#include "mapless/robot/methods.h"
 #include "recording_args.h"
 #include "robot_run.h"
 

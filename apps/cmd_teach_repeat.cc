@@ -15,9 +15,9 @@
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/io/frame_source.h"
 #include "mapless/io/output_dir.h"
+#include "mapless/recording/recording_link.h"
 #include "mapless/robot/methods.h"
 #include "mapless/route/route_store.h"
-#include "mapless/recording/recording_link.h"
 #include "recording_args.h"
 #include "robot_run.h"
 #include "teach.h"
@@ -142,7 +142,8 @@ void AddTeachRepeatCommands(CLI::App* app) {
     if (r->source.empty() && r->robot.empty())
       throw InputError("repeat: give --source (simulator, recording, camera) or --robot");
     RefuseOutputOverInputs(r->log, "--log", {r->route, SourceInput(r->source), r->robot});
-    RefuseOutputOverInputs(r->record.path, "--record", {r->route, SourceInput(r->source), r->robot});
+    RefuseOutputOverInputs(r->record.path, "--record",
+                           {r->route, SourceInput(r->source), r->robot});
     if (!r->record.path.empty() && !r->source.empty() && !IsSim(r->source))
       throw InputError("--record: records runs on the simulator or a robot; " + r->source +
                        " is played open loop (its decisions are in --log)");
@@ -172,7 +173,8 @@ void AddTeachRepeatCommands(CLI::App* app) {
       source = recording::OpenSource(r->source, r->playback);
     }
     const auto recorder =
-        scenario ? OpenRecorder(r->record, recording::CameraInfoOf(scenario->camera.model)) : nullptr;
+        scenario ? OpenRecorder(r->record, recording::CameraInfoOf(scenario->camera.model))
+                 : nullptr;
     JsonLines log(r->log);
     StopCleanlyOnInterrupt();
     int frame_index = 0;

@@ -58,7 +58,8 @@ void RunOnRobot(robot::Method& method, const std::string& robot_path, const std:
   StopCleanlyOnInterrupt();
   std::unique_ptr<robot::RobotLink> link = OpenRobotLink(file, method.image_size(), method.name());
   std::unique_ptr<robot::RobotLink> recording;
-  if (recorder) recording = std::make_unique<recording::RecordingLink>(*link, *recorder, method.name());
+  if (recorder)
+    recording = std::make_unique<recording::RecordingLink>(*link, *recorder, method.name());
   spdlog::info("{}: on {} ({}), commands to {}", method.name(), file.name,
                robot::MiddlewareName(file.middleware), file.Resolve(file.topics.cmd_vel));
   int frame = 0;

@@ -173,7 +173,8 @@ void Teach(const TeachArgs& t) {
     source = recording::OpenSource(t.source, playback);
   }
   const auto recorder = OpenRecorder(
-      t.record, scenario ? std::optional(recording::CameraInfoOf(scenario->camera.model)) : std::nullopt);
+      t.record,
+      scenario ? std::optional(recording::CameraInfoOf(scenario->camera.model)) : std::nullopt);
   io::OutputDirectory out(t.out, t.overwrite, "route", marker);
   StopCleanlyOnInterrupt();
   std::unique_ptr<Teacher> teacher;

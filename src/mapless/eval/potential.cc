@@ -123,11 +123,13 @@ PotentialRun RunPotential(const sim::Scenario& scenario,
   link_options.camera_faults = options.camera_faults;
   link_options.fault_seed = options.seed;
   robot::SimLink link(sim, r, link_options);
-  const std::unique_ptr<robot::RobotLink> wrapped = options.wrap_link ? options.wrap_link(link) : nullptr;
+  const std::unique_ptr<robot::RobotLink> wrapped =
+      options.wrap_link ? options.wrap_link(link) : nullptr;
 
   PotentialRun run;
   bool passed_end = false;
-  const robot::LoopResult result = robot::RunLoop(method, wrapped ? *wrapped : static_cast<robot::RobotLink&>(link), robot::LoopOptions{},
+  const robot::LoopResult result = robot::RunLoop(
+      method, wrapped ? *wrapped : static_cast<robot::RobotLink&>(link), robot::LoopOptions{},
       [&](const robot::Observation& obs, const robot::Decision& decision) {
         const auto& step = std::get<navigation::PotentialStep>(decision.detail);
         const Pose2 pose = link.truth();

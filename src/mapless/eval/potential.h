@@ -9,11 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "mapless/robot/link.h"
-
 #include "mapless/eval/suite.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/navigation/potential.h"
+#include "mapless/robot/link.h"
 #include "mapless/sim/camera_faults.h"
 #include "mapless/sim/scenario.h"
 

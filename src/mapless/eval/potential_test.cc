@@ -47,8 +47,9 @@ TEST(PlanarFlowCalibration, YamlRoundTripAndErrorsNameTheSource) {
       testing::InputErrorOf([&] { navigation::CalibrationFromYaml(text, "cal.yaml"); });
   EXPECT_NE(err.find("cal.yaml"), std::string::npos) << err;
   EXPECT_NE(err.find("speed_mps"), std::string::npos) << err;
-  EXPECT_NE(testing::InputErrorOf([] { navigation::CalibrationFromYaml("format: x\n", "c.yaml"); })
-                .find("c.yaml"),
+  EXPECT_NE(testing::InputErrorOf([] {
+              navigation::CalibrationFromYaml("format: x\n", "c.yaml");
+            }).find("c.yaml"),
             std::string::npos);
 }
 

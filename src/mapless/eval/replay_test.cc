@@ -41,11 +41,11 @@ TEST(Replay, ARecordedRepeatReplaysToTheSameDecisions) {
     options.wrap_link = [&](robot::RobotLink& inner) -> std::unique_ptr<robot::RobotLink> {
       return std::make_unique<recording::RecordingLink>(inner, recorder, "repeat");
     };
-    const RepeatRun run = RepeatOnSimulator(
-        scenario, taught, options,
-        [&](const Pose2&, const cv::Mat&, const navigation::RepeatStep& step) {
-          live.push_back(step);
-        });
+    const RepeatRun run =
+        RepeatOnSimulator(scenario, taught, options,
+                          [&](const Pose2&, const cv::Mat&, const navigation::RepeatStep& step) {
+                            live.push_back(step);
+                          });
     ASSERT_TRUE(run.success) << run.status;
   }  // the recorder closes the file
 
@@ -53,13 +53,13 @@ TEST(Replay, ARecordedRepeatReplaysToTheSameDecisions) {
   recording::PlaybackLink link(recording::OpenSource(path, {}));
   std::vector<navigation::RepeatStep> replayed;
   int odometry_frames = 0;
-  const robot::LoopResult result = robot::RunLoop(
-      method, link, robot::LoopOptions{},
-      [&](const robot::Observation& obs, const robot::Decision& decision) {
-        replayed.push_back(std::get<navigation::RepeatStep>(decision.detail));
-        odometry_frames += obs.odometry.has_value() ? 1 : 0;
-        return true;
-      });
+  const robot::LoopResult result =
+      robot::RunLoop(method, link, robot::LoopOptions{},
+                     [&](const robot::Observation& obs, const robot::Decision& decision) {
+                       replayed.push_back(std::get<navigation::RepeatStep>(decision.detail));
+                       odometry_frames += obs.odometry.has_value() ? 1 : 0;
+                       return true;
+                     });
   ASSERT_EQ(replayed.size(), live.size());
   int differing = 0;
   for (std::size_t i = 0; i < live.size(); ++i) {

@@ -102,17 +102,18 @@ RepeatRun RepeatOnSimulator(const sim::Scenario& scenario, const TaughtRoute& ta
   link_options.camera_faults = options.camera_faults;
   link_options.fault_seed = options.seed;
   robot::SimLink link(sim, r, link_options);
-  const std::unique_ptr<robot::RobotLink> wrapped = options.wrap_link ? options.wrap_link(link) : nullptr;
+  const std::unique_ptr<robot::RobotLink> wrapped =
+      options.wrap_link ? options.wrap_link(link) : nullptr;
   RepeatRun run;
-  const robot::LoopResult result =
-      robot::RunLoop(method, wrapped ? *wrapped : static_cast<robot::RobotLink&>(link), robot::LoopOptions{},
-                     [&](const robot::Observation& obs, const robot::Decision& decision) {
-                       const auto& step = std::get<navigation::RepeatStep>(decision.detail);
-                       run.path.push_back(link.truth());
-                       if (observer) observer(link.truth(), obs.image, step);
-                       run.steps.push_back(step);
-                       return true;
-                     });
+  const robot::LoopResult result = robot::RunLoop(
+      method, wrapped ? *wrapped : static_cast<robot::RobotLink&>(link), robot::LoopOptions{},
+      [&](const robot::Observation& obs, const robot::Decision& decision) {
+        const auto& step = std::get<navigation::RepeatStep>(decision.detail);
+        run.path.push_back(link.truth());
+        if (observer) observer(link.truth(), obs.image, step);
+        run.steps.push_back(step);
+        return true;
+      });
   run.completed = result.finished;
   run.collided = sim.collided(r);
   run.status = result.reason;

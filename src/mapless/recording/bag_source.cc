@@ -101,8 +101,9 @@ bool CanReadBagsImpl() { return false; }
 
 std::unique_ptr<io::FrameSource> OpenBagSource(const std::string& path, const std::string&,
                                                const std::string&) {
-  throw InputError(path + ": ROS 1 bags need mapless built with librosbag-storage-dev "
-                          "(scripts/setup.sh --ros, then build again)");
+  throw InputError(path +
+                   ": ROS 1 bags need mapless built with librosbag-storage-dev "
+                   "(scripts/setup.sh --ros, then build again)");
 }
 
 std::unique_ptr<MessageStream> OpenBagMessages(const std::string& path) {

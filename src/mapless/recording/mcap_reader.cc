@@ -134,14 +134,16 @@ bool McapMessageStream::Next(Item* item) {
       const std::uint64_t offset = outer_.offset();
       if (!outer_.Next(&op, &body)) {
         done_ = true;
-        reader_.set_cut(true);  // killed before it closed: every whole record up to the cut was read
+        reader_.set_cut(
+            true);  // killed before it closed: every whole record up to the cut was read
         return false;
       }
       if (op == static_cast<std::uint8_t>(McapOp::kChunk)) {
         const McapChunk chunk = ParseMcapChunk(body);
         if (chunk.message_end_time < start_ns_) continue;
         const std::string what = "chunk at byte " + std::to_string(offset);
-        chunk_records_ = Decompress(chunk.compression, chunk.records, chunk.uncompressed_size, what);
+        chunk_records_ =
+            Decompress(chunk.compression, chunk.records, chunk.uncompressed_size, what);
         if (chunk.uncompressed_crc != 0)
           MAPLESS_CHECK(McapCrc32(chunk_records_) == chunk.uncompressed_crc,
                         what << ": its records do not match their CRC");
@@ -182,9 +184,8 @@ bool McapMessageStream::Handle(std::uint8_t op, std::string_view body, std::uint
     McapMessage m = ParseMcapMessage(body);
     if (m.log_time < start_ns_) return false;
     const auto c = channels_.find(m.channel_id);
-    MAPLESS_CHECK(c != channels_.end(), "Message at byte " << offset << ": channel "
-                                                          << m.channel_id
-                                                          << " was not defined before it");
+    MAPLESS_CHECK(c != channels_.end(), "Message at byte " << offset << ": channel " << m.channel_id
+                                                           << " was not defined before it");
     const auto sc = schemas_.find(c->second.schema_id);
     item->channel = &c->second;
     item->schema = sc == schemas_.end() ? nullptr : &sc->second;

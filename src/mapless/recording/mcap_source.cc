@@ -112,14 +112,12 @@ class TopicFrames : public io::FrameSource {
     }
   }
 
-
   // The next message of the image topic; odometry on the way is kept for the frames.
   bool NextImage(RecordedMessage* m) {
     while (messages_->Next(m)) {
       if (!odom_.empty() && m->topic->topic == odom_) {
-        const rosmsg::OdometryFields o = Decode(*m, [](std::string_view b, rosmsg::Wire w) {
-          return rosmsg::DecodeOdometry(b, w);
-        });
+        const rosmsg::OdometryFields o = Decode(
+            *m, [](std::string_view b, rosmsg::Wire w) { return rosmsg::DecodeOdometry(b, w); });
         pending_odometry_[Stamp(o.header.stamp_ns, m->log_ns)] = o.pose;
         continue;
       }
@@ -182,7 +180,8 @@ class McapMessages : public MessageStream {
       if (it == by_topic_.end()) continue;  // a channel the summary did not list
       if (item_.channel->message_encoding != "cdr") continue;
       m->topic = &topics_[it->second];
-      m->log_ns = static_cast<Timestamp>(std::min<std::uint64_t>(item_.message.log_time, INT64_MAX));
+      m->log_ns =
+          static_cast<Timestamp>(std::min<std::uint64_t>(item_.message.log_time, INT64_MAX));
       m->data = item_.message.data;
       m->wire = rosmsg::Wire::kCdr;
       return true;
@@ -233,8 +232,9 @@ std::vector<RecordedTopic> McapTopics(McapReader& reader) {
       if (cursor.Next(&op, &body) && op == static_cast<std::uint8_t>(McapOp::kFooter)) {
         const McapFooter footer = ParseMcapFooter(body);
         if (footer.summary_start >= kMcapMagic.size() && footer.summary_start < footer_at) {
-          McapRecordCursor summary(bytes.substr(footer.summary_start, footer_at - footer.summary_start),
-                                   footer.summary_start);
+          McapRecordCursor summary(
+              bytes.substr(footer.summary_start, footer_at - footer.summary_start),
+              footer.summary_start);
           while (summary.Next(&op, &body)) take(op, body);
           from_summary = true;
         }
@@ -244,7 +244,8 @@ std::vector<RecordedTopic> McapTopics(McapReader& reader) {
     }
   }
   if (!from_summary)
-    reader.ForEachRecord([&](std::uint8_t op, std::string_view body, std::uint64_t) { take(op, body); });
+    reader.ForEachRecord(
+        [&](std::uint8_t op, std::string_view body, std::uint64_t) { take(op, body); });
   std::vector<RecordedTopic> out;
   for (const auto& [topic, type] : topics) out.push_back({topic, type});
   return out;

@@ -13,7 +13,8 @@ namespace mapless::recording {
 namespace {
 
 bool EndsWith(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 // --start, --loop and --rate over any source that can be opened again.
@@ -60,15 +61,16 @@ class PlaybackSource : public io::FrameSource {
       wall_start_ = now;
       return;
     }
-    const auto due = wall_start_ + std::chrono::nanoseconds(static_cast<std::int64_t>(
-                                       static_cast<double>(t_ns - first_played_ns_) / options_.rate));
+    const auto due =
+        wall_start_ + std::chrono::nanoseconds(static_cast<std::int64_t>(
+                          static_cast<double>(t_ns - first_played_ns_) / options_.rate));
     if (due > now) std::this_thread::sleep_until(due);
   }
 
   Factory factory_;
   PlaybackOptions options_;
   std::unique_ptr<io::FrameSource> source_;
-  Timestamp offset_ns_ = 0;          // added to the source's times in this pass
+  Timestamp offset_ns_ = 0;           // added to the source's times in this pass
   Timestamp pass_first_ns_ = kUnset;  // the source's time of the pass's first frame
   Timestamp last_out_ns_ = 0;
   Timestamp last_gap_ns_ = 0;

@@ -13,7 +13,8 @@ robot::LinkEvent RecordingLink::Next() {
   const robot::Observation& obs = event.observation;
   if (!obs.image.empty() && obs.image.type() == CV_8UC1) recorder_.Image(obs.t_ns, obs.image);
   if (obs.odometry) recorder_.Odometry(obs.t_ns, *obs.odometry);
-  if (const std::optional<Pose2> truth = inner_.GroundTruth()) recorder_.GroundTruth(obs.t_ns, *truth);
+  if (const std::optional<Pose2> truth = inner_.GroundTruth())
+    recorder_.GroundTruth(obs.t_ns, *truth);
   return event;
 }
 

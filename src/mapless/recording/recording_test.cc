@@ -75,8 +75,10 @@ TEST(Recording, CompressedFramesPlayBack) {
     for (int i = 0; i < 5; ++i) {
       ASSERT_TRUE(source->Next(&f)) << images << " " << i;
       const double err = cv::norm(f.image, Pattern(i), cv::NORM_L1) / f.image.total();
-      if (images == "png") EXPECT_EQ(err, 0.0);
-      else EXPECT_LT(err, 6.0);  // jpeg at quality 90
+      if (images == "png")
+        EXPECT_EQ(err, 0.0);
+      else
+        EXPECT_LT(err, 6.0);  // jpeg at quality 90
     }
   }
 }
@@ -105,14 +107,16 @@ TEST(Recording, TopicsAreChosenOrRefusedByName) {
   McapReader reader(path);
   std::vector<std::string> names;
   for (const RecordedTopic& t : McapTopics(reader)) names.push_back(t.topic + " " + t.type);
-  EXPECT_EQ(names, (std::vector<std::string>{
-                       "/camera/image_raw sensor_msgs/msg/Image", "/cmd_vel geometry_msgs/msg/Twist",
-                       "/ground_truth geometry_msgs/msg/PoseStamped",
-                       "/mapless/decision mapless/Decision", "/odom nav_msgs/msg/Odometry"}));
+  EXPECT_EQ(names,
+            (std::vector<std::string>{
+                "/camera/image_raw sensor_msgs/msg/Image", "/cmd_vel geometry_msgs/msg/Twist",
+                "/ground_truth geometry_msgs/msg/PoseStamped", "/mapless/decision mapless/Decision",
+                "/odom nav_msgs/msg/Odometry"}));
   PlaybackOptions options;
   options.topic = "/cmd_vel";
-  EXPECT_NE(testing::InputErrorOf([&] { OpenSource(path, options); })
-                .find("topic /cmd_vel is geometry_msgs/msg/Twist, not camera image"),
+  EXPECT_NE(testing::InputErrorOf([&] {
+              OpenSource(path, options);
+            }).find("topic /cmd_vel is geometry_msgs/msg/Twist, not camera image"),
             std::string::npos);
   options.topic = "/front/image";
   EXPECT_NE(testing::InputErrorOf([&] { OpenSource(path, options); }).find("no topic /front/image"),
@@ -176,8 +180,7 @@ TEST(RosBag, TheThreeCompressionsGiveTheSameMessages) {
   RecordedMessage m;
   EXPECT_FALSE(OpenBagMessages(dir + "no-messages.bag")->Next(&m));
   // No camera in these bags: a clear error naming the file and the topics it has.
-  const std::string error =
-      testing::InputErrorOf([&] { OpenSource(dir + "example.bag", {}); });
+  const std::string error = testing::InputErrorOf([&] { OpenSource(dir + "example.bag", {}); });
   EXPECT_NE(error.find("example.bag: no camera image topic (topics: /rosout"), std::string::npos)
       << error;
 }

@@ -24,7 +24,9 @@ std::string_view View(const std::vector<std::uint8_t>& b) {
   return {reinterpret_cast<const char*>(b.data()), b.size()};
 }
 
-std::uint64_t LogTime(Timestamp t_ns) { return static_cast<std::uint64_t>(std::max<Timestamp>(t_ns, 0)); }
+std::uint64_t LogTime(Timestamp t_ns) {
+  return static_cast<std::uint64_t>(std::max<Timestamp>(t_ns, 0));
+}
 
 }  // namespace
 
@@ -77,8 +79,9 @@ void RunRecorder::Image(Timestamp t_ns, const cv::Mat& grey) {
   } else {
     std::vector<std::uint8_t> encoded;
     const std::vector<int> params =
-        options_.images == "jpeg" ? std::vector<int>{cv::IMWRITE_JPEG_QUALITY, options_.jpeg_quality}
-                                  : std::vector<int>{};
+        options_.images == "jpeg"
+            ? std::vector<int>{cv::IMWRITE_JPEG_QUALITY, options_.jpeg_quality}
+            : std::vector<int>{};
     cv::imencode(options_.images == "jpeg" ? ".jpg" : ".png", grey, encoded, params);
     rosmsg::CompressedImageFields m;
     m.header = header;

@@ -78,10 +78,9 @@ struct FieldType {
 // an unbounded sequence.
 FieldType ParseFieldType(const std::string& text) {
   static const std::map<std::string, int> kPrimitive = {
-      {"int8", 2},     {"uint8", 3},    {"int16", 4},    {"uint16", 5},
-      {"int32", 6},    {"uint32", 7},   {"int64", 8},    {"uint64", 9},
-      {"float32", 10}, {"float64", 11}, {"char", 13},    {"bool", 15},
-      {"byte", 16},    {"string", 17},  {"wstring", 18},
+      {"int8", 2},   {"uint8", 3}, {"int16", 4},  {"uint16", 5},   {"int32", 6},
+      {"uint32", 7}, {"int64", 8}, {"uint64", 9}, {"float32", 10}, {"float64", 11},
+      {"char", 13},  {"bool", 15}, {"byte", 16},  {"string", 17},  {"wstring", 18},
   };
   FieldType t;
   std::string base = text;
@@ -118,8 +117,9 @@ std::string DescriptionJson(const MsgDefinition& d) {
   for (std::size_t i = 0; i < d.fields.size(); ++i) {
     const FieldType t = ParseFieldType(d.fields[i].type);
     if (i > 0) s += ", ";
-    s += "{\"name\": \"" + d.fields[i].name + "\", \"type\": {\"type_id\": " +
-         std::to_string(t.type_id) + ", \"capacity\": " + std::to_string(t.capacity) +
+    s += "{\"name\": \"" + d.fields[i].name +
+         "\", \"type\": {\"type_id\": " + std::to_string(t.type_id) +
+         ", \"capacity\": " + std::to_string(t.capacity) +
          ", \"string_capacity\": 0, \"nested_type_name\": \"" + t.nested + "\"}}";
   }
   return s + "]}";

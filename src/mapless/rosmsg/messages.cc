@@ -107,8 +107,8 @@ std::vector<std::uint8_t> EncodeCameraInfo(const CameraInfoFields& m) {
   for (double v : m.k) w.F64(v);
   for (double v : m.r) w.F64(v);
   for (double v : m.p) w.F64(v);
-  w.U32(0);  // binning_x
-  w.U32(0);  // binning_y
+  w.U32(0);                              // binning_x
+  w.U32(0);                              // binning_y
   for (int i = 0; i < 4; ++i) w.U32(0);  // roi: the full image
   w.Bool(false);
   return w.Take();

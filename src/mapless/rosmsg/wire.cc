@@ -6,7 +6,8 @@
 
 namespace mapless::rosmsg {
 
-static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "CdrWriter writes the host order as little-endian");
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
+              "CdrWriter writes the host order as little-endian");
 
 namespace {
 
@@ -84,7 +85,8 @@ std::string_view WireReader::Bytes(const char* field) {
 
 std::vector<double> WireReader::F64Sequence(const char* field, std::uint32_t max_count) {
   const std::uint32_t n = U32(field);
-  if (n > max_count) Fail(field, std::to_string(n) + " values, at most " + std::to_string(max_count));
+  if (n > max_count)
+    Fail(field, std::to_string(n) + " values, at most " + std::to_string(max_count));
   std::vector<double> v(n);
   for (double& x : v) x = F64(field);
   return v;
@@ -94,8 +96,8 @@ Timestamp WireReader::Time(const char* field) {
   const std::uint32_t sec = U32(field);
   const std::uint32_t nsec = U32(field);
   if (nsec >= kNsPerSecond) Fail(field, "nanoseconds " + std::to_string(nsec) + " >= 1e9");
-  const std::int64_t s = wire_ == Wire::kCdr ? static_cast<std::int32_t>(sec)
-                                             : static_cast<std::int64_t>(sec);
+  const std::int64_t s =
+      wire_ == Wire::kCdr ? static_cast<std::int32_t>(sec) : static_cast<std::int64_t>(sec);
   return s * kNsPerSecond + nsec;
 }
 
