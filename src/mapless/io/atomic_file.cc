@@ -124,7 +124,7 @@ void WriteImageAtomic(const std::string& path, const cv::Mat& image) {
   WriteFileAtomic(path, EncodeImage(image, ext, path));
 }
 
-std::string ReadFile(const std::string& path, std::size_t max_bytes) {
+int OpenRegularFile(const std::string& path, std::uint64_t* size) {
   // O_NONBLOCK: opening a FIFO must not wait for a writer; regular files ignore it.
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
   if (fd < 0) throw InputError(path + ": cannot open file: " + std::strerror(errno));
@@ -133,15 +133,22 @@ std::string ReadFile(const std::string& path, std::size_t max_bytes) {
     ::close(fd);
     throw InputError(path + ": not a regular file (a directory, a device or a pipe)");
   }
-  if (static_cast<std::uint64_t>(st.st_size) > max_bytes) {
+  *size = static_cast<std::uint64_t>(st.st_size);
+  return fd;
+}
+
+std::string ReadFile(const std::string& path, std::size_t max_bytes) {
+  std::uint64_t size = 0;
+  const int fd = OpenRegularFile(path, &size);
+  if (size > max_bytes) {
     ::close(fd);
-    throw InputError(path + ": " + std::to_string(st.st_size) +
+    throw InputError(path + ": " + std::to_string(size) +
                      " bytes; the limit for this kind "
                      "of file is " +
                      std::to_string(max_bytes) + " bytes");
   }
   // Read at most max_bytes + 1: a file that grows while it is read is still caught.
-  std::string bytes(static_cast<std::size_t>(st.st_size), '\0');
+  std::string bytes(static_cast<std::size_t>(size), '\0');
   std::size_t done = 0;
   while (true) {
     if (done == bytes.size()) {

@@ -37,6 +37,10 @@ std::string EncodeImage(const cv::Mat& image, const std::string& ext, const std:
 // Encodes an image by the extension of `path` (.png, .jpg, ...) and writes it atomically.
 void WriteImageAtomic(const std::string& path, const cv::Mat& image);
 
+// Opens `path` for reading (O_CLOEXEC, never waiting on a FIFO) and checks it is a regular file;
+// returns the descriptor (the caller closes it) and its size. Throws InputError naming the path.
+int OpenRegularFile(const std::string& path, std::uint64_t* size);
+
 // Reads a whole regular file of at most `max_bytes`; throws InputError naming the path when it
 // cannot be read, is not a regular file (a directory, a device such as /dev/zero, a FIFO) or is
 // larger than `max_bytes` (io/limits.h has the limit of each kind of file).

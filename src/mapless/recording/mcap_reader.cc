@@ -2,26 +2,21 @@
 
 #include <fcntl.h>
 #include <sys/mman.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
 
 #include "mapless/core/check.h"
+#include "mapless/io/atomic_file.h"
 #include "mapless/recording/compression.h"
 
 namespace mapless::recording {
 
 McapReader::McapReader(const std::string& path) : path_(path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
-  if (fd < 0) throw InputError(path + ": cannot open file: " + std::strerror(errno));
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    ::close(fd);
-    throw InputError(path + ": not a regular file (a directory, a device or a pipe)");
-  }
-  map_size_ = static_cast<std::size_t>(st.st_size);
+  std::uint64_t size = 0;
+  const int fd = io::OpenRegularFile(path, &size);
+  map_size_ = static_cast<std::size_t>(size);
   if (map_size_ > 0) {
     map_ = ::mmap(nullptr, map_size_, PROT_READ, MAP_PRIVATE, fd, 0);
     if (map_ == MAP_FAILED) {
