@@ -123,7 +123,8 @@ void AddTeachRepeatCommands(CLI::App* app) {
                    "robust to a lateral offset) or switching (like every other keyframe)")
       ->capture_default_str();
   repeat->add_option("--log", r->log,
-                     "Per-frame decisions as JSON lines to this file (default: stdout)");
+                     "Per-frame decisions as JSON lines to this file (default: stdout; on a robot: "
+                     "none, - for stdout)");
   repeat->add_option("--seed", r->seed, "Simulator: seed of the noise")
       ->capture_default_str()
       ->check(SeedCheck());

@@ -4,7 +4,7 @@
 # person with the joystick — and Ctrl-C ends the teach with a complete route that loads. Both route
 # kinds at once: keyframes (funnel lanes) and appearance route images (eigenspace). Exit 77
 # (skipped) without the middleware.
-#   tests/robot_link/teach.sh MAPLESS ros1|ros2 [SECONDS]
+#   tests/robot_link/teach.sh MAPLESS ros1|ros2 [SECONDS of driving]
 set -uo pipefail
 BIN=$1; MW=$2; SECONDS_TO_TEACH=${3:-15}
 # shellcheck source=env.sh
@@ -24,9 +24,21 @@ T1=$!; PIDS+=("$T1")
   >"$OUT/t2.log" 2>&1 &
 T2=$!; PIDS+=("$T2")
 sleep 1
-timeout 120 "$BIN" repeat --route "$OUT/driver_route" --robot "$OUT/robot.yaml" >"$OUT/driver.log" 2>&1 &
+timeout 120 "$BIN" repeat --route "$OUT/driver_route" --robot "$OUT/robot.yaml" \
+  --log "$OUT/driver.jsonl" >"$OUT/driver.log" 2>&1 &
 DRIVER=$!; PIDS+=("$DRIVER")
-sleep "$SECONDS_TO_TEACH"
+# The teach lasts SECONDS of driving (10 frames a second with a forward command), not of wall time:
+# on a loaded machine the driver starts later and may stop on stale frames. At most 90 s.
+WANT=$((SECONDS_TO_TEACH * 10)); DRIVEN=0
+for _ in $(seq 1 900); do
+  # The log is written to driver.jsonl.partial until the run ends (io::JournalFile).
+  DRIVEN=$(cat "$OUT/driver.jsonl.partial" "$OUT/driver.jsonl" 2>/dev/null |
+    grep -vc '"v_mps":0.0[,}]') || true
+  [ "${DRIVEN:-0}" -ge "$WANT" ] && break
+  kill -0 "$DRIVER" 2>/dev/null || break
+  sleep 0.1
+done
+echo "driver: ${DRIVEN:-0} frames with a forward command (wanted $WANT)"
 kill -INT "$T1" "$T2"
 wait "$T1"; R1=$?
 wait "$T2"; R2=$?

@@ -65,13 +65,15 @@ void CheckFaultHandling(const std::vector<Frame>& frames, double period_s) {
     int flagged = 0;
     for (int k = first; k <= last; ++k) {
       const Frame& f = frames[static_cast<std::size_t>(k)];
-      // A frozen image is only recognisable once the robot was told to move; from then on the
-      // fault holds until the image changes (camera_check.h).
+      // A frozen image is only recognisable once the robot was told to move on the two frames
+      // before; from then on the fault holds until the image changes (camera_check.h).
+      const auto told_to_move = [&](int j) {
+        const Twist2& c = frames[static_cast<std::size_t>(j)].command;
+        return std::abs(c.v_mps) > camera.moving_speed_mps ||
+               std::abs(c.omega_radps) > camera.moving_rate_radps;
+      };
       const bool must_flag = w.kind != CameraFaultKind::kFrozen || flagged > 0 ||
-                             std::abs(frames[static_cast<std::size_t>(k - 1)].command.v_mps) >
-                                 camera.moving_speed_mps ||
-                             std::abs(frames[static_cast<std::size_t>(k - 1)].command.omega_radps) >
-                                 camera.moving_rate_radps;
+                             (told_to_move(k - 1) && told_to_move(k - 2));
       if (!must_flag) continue;
       EXPECT_FALSE(Moving(f.command)) << name << " fault, frame " << k << ": " << f.reason;
       EXPECT_NE(f.reason.find(ExpectedReason(w.kind)), std::string::npos)

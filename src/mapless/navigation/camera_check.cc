@@ -69,8 +69,10 @@ CameraCheck CameraMonitor::Check(const cv::Mat& image, const Twist2& last_comman
                  "expected 8-bit images, got OpenCV depth " + std::to_string(grey.depth()));
   }
 
-  const bool moving = std::abs(last_command.v_mps) > options_.moving_speed_mps ||
-                      std::abs(last_command.omega_radps) > options_.moving_rate_radps;
+  const bool told_to_move = std::abs(last_command.v_mps) > options_.moving_speed_mps ||
+                            std::abs(last_command.omega_radps) > options_.moving_rate_radps;
+  const bool moving = told_to_move && was_moving_;
+  was_moving_ = told_to_move;
   const bool same = !previous_.empty() && previous_.size() == grey.size() &&
                     cv::norm(previous_, grey, cv::NORM_INF) == 0.0;
   if (!same) frozen_ = false;

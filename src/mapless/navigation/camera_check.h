@@ -8,7 +8,9 @@
 // changes them), so a frame identical to the previous one while the robot was commanded to move is
 // a frozen source. The fault then holds until the image changes. A stopped robot may legitimately
 // see the same image (the simulator has no sensor noise by default), so identical frames while
-// stopped are not a fault.
+// stopped are not a fault. Nor are they on the first frame after the robot is told to move: it
+// may not have started yet (the command arrived after the frame was taken, latency, a loaded
+// computer); the command of the frame before must also have been a move.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -45,8 +47,9 @@ class CameraMonitor {
 
  private:
   CameraCheckOptions options_;
-  cv::Mat previous_;     // the last frame that was checked (for the frozen test)
-  bool frozen_ = false;  // latched until the image changes
+  cv::Mat previous_;         // the last frame that was checked (for the frozen test)
+  bool frozen_ = false;      // latched until the image changes
+  bool was_moving_ = false;  // the command before `last_command` was a move
 };
 
 }  // namespace mapless::navigation
