@@ -37,7 +37,7 @@ if [ "$WITH_ROS" = "1" ]; then
     ros-core-dev           # roscore / rosmaster, for `mapless sim serve` and the tests
     cyclonedds-dev cyclonedds-tools   # ROS 2 over DDS (Cyclone 0.10, as in Humble and Jazzy)
     libsodium-dev          # SHA-256 of the ROS 2 type descriptions (the RIHS01 type hash)
-    librosbag-storage-dev  # reading ROS 1 bags (recordings as sources)
+    librosbag-storage-dev libbz2-dev  # reading ROS 1 bags (recordings as sources; bz2 chunks checked)
   )
 fi
 

@@ -1,6 +1,7 @@
 // ROS 1 bags through Debian's rosbag_storage (librosbag-storage-dev): the container (chunks
 // uncompressed, bz2 or lz4, the index) is the library's; the message bodies are read by
-// rosmsg/messages.h from the ROS 1 serialization, with every length checked.
+// rosmsg/messages.h from the ROS 1 serialization, with every length checked. The library trusts
+// the lengths in the file, so bag_check.h walks its structure first.
 #include "mapless/core/check.h"
 #include "mapless/recording/mcap_source.h"
 
@@ -10,6 +11,8 @@
 
 #include <map>
 #include <optional>
+
+#include "mapless/recording/bag_check.h"
 #endif
 
 namespace mapless::recording {
@@ -30,6 +33,7 @@ constexpr std::uint32_t kMaxBagMessageBytes = 256u << 20;
 class BagMessages : public MessageStream {
  public:
   explicit BagMessages(const std::string& path) : path_(path) {
+    CheckBagStructure(path);  // the library trusts the file's lengths
     try {
       bag_.open(path, rosbag::bagmode::Read);
       view_.emplace(bag_);

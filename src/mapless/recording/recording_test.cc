@@ -7,6 +7,7 @@
 
 #include "mapless/core/check.h"
 #include "mapless/core/testing.h"
+#include "mapless/io/atomic_file.h"
 #include "mapless/recording/mcap_reader.h"
 #include "mapless/recording/mcap_source.h"
 #include "mapless/recording/playback.h"
@@ -183,6 +184,58 @@ TEST(RosBag, TheThreeCompressionsGiveTheSameMessages) {
   const std::string error = testing::InputErrorOf([&] { OpenSource(dir + "example.bag", {}); });
   EXPECT_NE(error.find("example.bag: no camera image topic (topics: /rosout"), std::string::npos)
       << error;
+}
+
+// rosbag_storage trusts the lengths in a bag; bag_check.h must refuse a bad one before the
+// library reads it (under ASan, an over-read or a huge allocation here fails the test).
+TEST(RosBag, BadLengthsAreRefusedBeforeTheLibraryReadsThem) {
+  if (!CanReadBags()) GTEST_SKIP() << "mapless was built without ROS 1 bags (setup.sh --ros)";
+  const std::string good = io::ReadFile(
+      std::string(MAPLESS_SOURCE_DIR) + "/tests/data/rosbag1/example-lz4.bag", 1u << 20);
+  ASSERT_GT(good.size(), 100000u);
+  const std::string path = ::testing::TempDir() + "mapless_recording_bad.bag";
+  const auto read_all = [&](const std::string& bytes) {
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+    return testing::InputErrorOf([&] {
+      std::unique_ptr<MessageStream> bag = OpenBagMessages(path);
+      RecordedMessage m;
+      while (bag->Next(&m)) {
+      }
+    });
+  };
+  EXPECT_EQ(read_all(good), "");
+  std::string bad = good;
+  bad.replace(13, 4, std::string("\xff\xff\xff\x7f", 4));  // the bag header's header length
+  std::string error = read_all(bad);
+  EXPECT_NE(error.find("mapless_recording_bad.bag: not a readable ROS 1 bag: at byte 13: a record "
+                       "header of 2147483647 bytes"),
+            std::string::npos)
+      << error;
+  // The first chunk says it decompresses to 4 GB.
+  const std::size_t size_field = good.find("size=");  // the first chunk's header
+  ASSERT_NE(size_field, std::string::npos);
+  ASSERT_LT(good.find("compression=lz4") - size_field, 40u);
+  bad = good;
+  bad.replace(size_field + 5, 4, std::string("\xff\xff\xff\xff", 4));
+  error = read_all(bad);
+  EXPECT_NE(error.find("a chunk of 4294967295 bytes (at most"), std::string::npos) << error;
+  // Cut short (the index at the end is gone): refused, with the reason.
+  error = read_all(good.substr(0, good.size() / 2));
+  EXPECT_NE(error.find("runs past the end"), std::string::npos) << error;
+  // Four bytes of 0xff at 40 places spread over the file: each bag is read to its end or refused
+  // with one error naming the file.
+  int refused = 0;
+  for (int k = 0; k < 40; ++k) {
+    bad = good;
+    bad.replace(13 + (good.size() - 20) * static_cast<std::size_t>(k) / 40 + k % 7, 4,
+                std::string("\xff\xff\xff\xff", 4));
+    error = read_all(bad);
+    if (error.empty()) continue;
+    ++refused;
+    EXPECT_EQ(error.rfind(path, 0), 0u) << error;
+  }
+  EXPECT_GT(refused, 0);
+  fs::remove(path);
 }
 
 }  // namespace
