@@ -6,7 +6,8 @@
 #                                    DDS for ROS 2: the robot links over ROS 1 and ROS 2 are built
 #                                    when they are present. About 180
 #                                    Debian packages, so the demo (README command 1) does without;
-#                                    the test command (command 2) and robot users take them.
+#                                    the test command (command 2) and robot users take them
+#                                    (with Chromium, which the report's test opens the report in).
 set -euo pipefail
 WITH_ROS=0
 for arg in "$@"; do
@@ -38,6 +39,7 @@ if [ "$WITH_ROS" = "1" ]; then
     cyclonedds-dev cyclonedds-tools   # ROS 2 over DDS (Cyclone 0.10, as in Humble and Jazzy)
     libsodium-dev          # SHA-256 of the ROS 2 type descriptions (the RIHS01 type hash)
     librosbag-storage-dev libbz2-dev  # reading ROS 1 bags (recordings as sources; bz2 chunks checked)
+    chromium               # tests: the HTML report opened headless (no console error, a screenshot)
   )
 fi
 

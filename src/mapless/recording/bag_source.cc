@@ -3,6 +3,7 @@
 // rosmsg/messages.h from the ROS 1 serialization, with every length checked. The library trusts
 // the lengths in the file, so bag_check.h walks its structure first.
 #include "mapless/core/check.h"
+#include "mapless/recording/bag_check.h"
 #include "mapless/recording/mcap_source.h"
 
 #ifdef MAPLESS_HAVE_ROSBAG
@@ -102,6 +103,10 @@ std::unique_ptr<MessageStream> OpenBagMessages(const std::string& path) {
 #else
 
 bool CanReadBagsImpl() { return false; }
+
+void CheckBagStructure(const std::string& path) {
+  throw InputError(path + ": ROS 1 bags need mapless built with librosbag-storage-dev");
+}
 
 std::unique_ptr<io::FrameSource> OpenBagSource(const std::string& path, const std::string&,
                                                const std::string&) {
