@@ -1,6 +1,8 @@
 // `mapless demo`: the main job. On the built-in simulator: teach a route by driving it (camera
-// frames, poses, the route store), then repeat it with the sloped funnel lane from a perturbed
-// start with motion and image noise, and draw both paths from above.
+// frames, poses, the route store) and repeat it with the sloped funnel lane from a perturbed start
+// with motion and image noise; follow a route with the eigenspace follower while the leader is
+// still teaching it; drive the visual potential to a destination and home. Then the report:
+// OUT/report/index.html with PNG plots beside it.
 #include <spdlog/spdlog.h>
 
 #include <filesystem>
@@ -8,12 +10,13 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
+#include "demo_runs.h"
 #include "interrupt.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/io/atomic_file.h"
 #include "mapless/io/output_dir.h"
 #include "mapless/route/route_store.h"
-#include "mapless/viz/topdown.h"
+#include "progress.h"
 
 namespace mapless::app {
 
@@ -23,11 +26,15 @@ void AddDemoCommand(CLI::App* app) {
     std::string out = "demo_out";
     std::string config;
     std::uint64_t seed = 1;
+    std::string eigenspace_scenario = "office_aliasing";
+    std::string potential_scenario = "obstacle_field";
   };
   auto args = std::make_shared<Args>();
   CLI::App* demo = app->add_subcommand("demo",
-                                       "Teach a route on the built-in simulator and repeat it; "
-                                       "write frames, the route and a top-down picture");
+                                       "The three methods on the built-in simulator: teach a route "
+                                       "and repeat it (sloped funnel lane), follow a route the "
+                                       "leader is still teaching (eigenspace), drive to a "
+                                       "destination and home (visual potential); write a report");
   demo->add_option("--scenario", args->scenario, "Built-in scenario name or YAML file")
       ->capture_default_str();
   demo->add_option("--out", args->out, "Output directory")->capture_default_str();
@@ -35,6 +42,12 @@ void AddDemoCommand(CLI::App* app) {
       ->capture_default_str()
       ->check(SeedCheck());
   demo->add_option("--config", args->config, "Run configuration YAML (see config/default.yaml)");
+  demo->add_option("--eigenspace-scenario", args->eigenspace_scenario,
+                   "Scenario of the eigenspace follower (leader still teaching)")
+      ->capture_default_str();
+  demo->add_option("--potential-scenario", args->potential_scenario,
+                   "Scenario of the visual potential (its first destination, then home)")
+      ->capture_default_str();
   demo->callback([args] {
     RefuseOutputOverInputs(args->out, "--out", {args->scenario, args->config});
     const sim::Scenario scenario = sim::LoadScenario(args->scenario);
@@ -44,6 +57,8 @@ void AddDemoCommand(CLI::App* app) {
     // replaced when this demo is done; any other directory with content is refused.
     io::OutputDirectory out_dir(args->out, /*replace=*/true, "demo's output", "teach/frames.csv");
     StopCleanlyOnInterrupt();
+    Progress progress("demo", 4);
+    progress.Stage(1, "teaching the route");
     const std::filesystem::path out(out_dir.path());
     spdlog::info("demo: teaching route '{}' ({:.1f} m) on the simulator", scenario.name,
                  scenario.PathLength());
@@ -65,53 +80,52 @@ void AddDemoCommand(CLI::App* app) {
     writer.Finish();
     spdlog::info("demo: route of {} keyframes in {}", taught.route->keyframes.size(), route_dir);
 
-    // Repeat with the sloped funnel lane, decisions logged as JSON lines.
-    eval::RepeatRunOptions run_options;
-    run_options.seed = args->seed;
-    const double speed = eval::RepeatSpeedFor(scenario, run_options.max_repeat_speed_mps);
-    run_options.repeat.sloped.max_speed_mps = speed;
-    JsonLines log((out / "repeat.jsonl").string(), /*in_place=*/true);
-    int frame = 0;
-    const eval::RepeatRun run = eval::RepeatOnSimulator(
-        scenario, taught, run_options,
-        [&](const Pose2& pose, const cv::Mat&, const navigation::RepeatStep& s) {
-          ThrowIfInterrupted();
-          nlohmann::json j{{"frame", frame++},
-                           {"x_m", pose.x_m},
-                           {"y_m", pose.y_m},
-                           {"destination", s.destination},
-                           {"matches", s.matches},
-                           {"std_ratio", s.switching.std_ratio},
-                           {"slope_x", s.sloped.slope_x},
-                           {"slope_y", s.sloped.slope_y},
-                           {"v_mps", s.command.v_mps},
-                           {"omega_radps", s.command.omega_radps},
-                           {"status", navigation::RepeatStatusName(s.status)}};
-          if (s.local_scale.ok) j["local_scale"] = s.local_scale.ratio;
-          log.Write(j);
-        });
-    const cv::Mat top =
-        viz::DrawTopDown(sim::ApplyVariant(scenario.world, scenario.repeat_variant),
-                         {{taught.path, cv::Scalar(30, 30, 220), "taught"},
-                          {run.path, cv::Scalar(40, 160, 40), "repeated (sloped funnel lane)"}},
-                         scenario.destinations);
-    io::WriteImageAtomic((out / "topdown.png").string(), top);
-    nlohmann::json j{{"scenario", scenario.name},
-                     {"keyframes", taught.route->keyframes.size()},
-                     {"success", run.success},
-                     {"status", run.status},
-                     {"final_error_m", run.final_error_m},
-                     {"lateral_rms_m", run.lateral_rms_m},
-                     {"repeat_duration_s", run.duration_s}};
+    // 1. Repeat with the sloped funnel lane, decisions logged as JSON lines.
+    progress.Stage(2, "repeating with the sloped funnel lane");
+    std::vector<DemoResult> results;
+    results.push_back(DemoRepeat(scenario, taught, args->seed, (out / "repeat.jsonl").string()));
+    spdlog::info("demo: repeat: {}", results.back().status);
+    // 2. The eigenspace follower while its leader is still teaching.
+    progress.Stage(3, "eigenspace follower while the leader teaches");
+    results.push_back(DemoEigenspace(args->eigenspace_scenario, args->seed));
+    spdlog::info("demo: eigenspace follower: {}", results.back().status);
+    // 3. The visual potential to a destination and home.
+    progress.Stage(4, "visual potential to a destination and home");
+    results.push_back(DemoPotential(args->potential_scenario, args->seed));
+    spdlog::info("demo: visual potential: {}", results.back().status);
+
+    report::HtmlReport html("mapless demo");
+    html.Paragraph("The three methods of mapless on the built-in simulator, seed " +
+                   std::to_string(args->seed) +
+                   ". Every picture and plot is in this file; nothing is loaded from elsewhere.");
+    html.Heading("Results");
+    std::vector<std::vector<std::string>> rows;
+    for (const DemoResult& r : results) rows.push_back(r.row);
+    html.Table({"method", "scenario", "success", "final error (m)", "detail"}, rows);
+    std::vector<RunSection> sections;
+    for (const DemoResult& r : results) {
+      AddRunSection(&html, r.section);
+      sections.push_back(r.section);
+    }
+    const std::string index = WriteReport((out / "report").string(), html, sections);
+    nlohmann::json j{{"scenario", scenario.name}, {"keyframes", taught.route->keyframes.size()}};
+    j["runs"] = nlohmann::json::array();
+    for (const DemoResult& r : results)
+      j["runs"].push_back({{"method", r.row[0]},
+                           {"scenario", r.row[1]},
+                           {"success", r.success},
+                           {"status", r.status},
+                           {"final_error_m", std::stod(r.row[3])}});
     io::WriteFileAtomic((out / "summary.json").string(), j.dump(2) + "\n");
     out_dir.Commit();
-    spdlog::info("demo: repeat: {}; ended {:.2f} m from the taught end, lateral RMS {:.2f} m",
-                 run.status, run.final_error_m, run.lateral_rms_m);
     spdlog::info(
-        "demo: wrote {0}/topdown.png, {0}/teach/ (frames, poses), {0}/route/, {0}/repeat.jsonl, "
-        "{0}/summary.json",
+        "demo: wrote {0}/teach/ (frames, poses), {0}/route/, {0}/repeat.jsonl, "
+        "{0}/summary.json and the report: {0}/report/index.html (PNG plots beside it)",
         args->out);
-    if (!run.success) throw RunFailed("demo: the repeat did not succeed: " + run.status);
+    int failed = 0;
+    for (const DemoResult& r : results) failed += !r.success;
+    if (failed > 0)
+      throw RunFailed("demo: " + std::to_string(failed) + " of the three runs did not succeed");
   });
 }
 

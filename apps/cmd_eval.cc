@@ -16,6 +16,8 @@
 #include "mapless/eval/eigenspace.h"
 #include "mapless/eval/potential.h"
 #include "mapless/eval/suite.h"
+#include "progress.h"
+#include "run_report.h"
 
 namespace mapless::app {
 
@@ -23,12 +25,18 @@ namespace {
 
 // Calls fn(0) ... fn(n - 1), `jobs` at a time (each entry is independent and seeded, so the
 // results do not depend on `jobs`).
+// Progress (runs done, time left) shows on a terminal.
 void RunInBatches(std::size_t n, int jobs, const std::function<void(std::size_t)>& fn) {
+  Progress progress("eval", static_cast<int>(n));
+  const auto run = [&](std::size_t k) {
+    fn(k);
+    progress.Done();
+  };
   std::size_t next = 0;
   while (next < n) {
     std::vector<std::future<void>> batch;
     for (int j = 0; j < jobs && next < n; ++j, ++next)
-      batch.push_back(std::async(std::launch::async, fn, next));
+      batch.push_back(std::async(std::launch::async, run, next));
     for (auto& f : batch) f.get();
   }
 }
@@ -56,7 +64,7 @@ nlohmann::json EntryJson(const eval::EntryResult& r) {
 
 // `mapless eval potential`: Ohnishi & Imiya, Section 5 (see eval/potential.h).
 void RunPotentialSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
-                       const std::string& only) {
+                       const std::string& only, const std::string& report_dir) {
   std::vector<eval::PotentialEntry> entries;
   for (const auto& e : eval::PotentialSuiteEntries())
     if (only.empty() || e.scenario == only) entries.push_back(e);
@@ -105,11 +113,18 @@ void RunPotentialSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
                  in.inclusion[2]);
   }
   if (json_out) std::cout << j.dump() << "\n";
+  if (!report_dir.empty()) {
+    std::vector<const eval::EntryResult*> entries_out;
+    std::vector<std::string> experiments;
+    for (const auto& r : results) entries_out.push_back(&r), experiments.push_back(r.experiment);
+    WriteSuiteReport(report_dir, "potential", runs, seed, entries_out, experiments);
+    spdlog::info("eval: report in {}/index.html", report_dir);
+  }
 }
 
 // `mapless eval eigenspace`: Payá et al., Section 5 (see eval/eigenspace.h).
 void RunEigenspaceSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
-                        const std::string& only) {
+                        const std::string& only, const std::string& report_dir) {
   std::vector<eval::EigenspaceEntry> entries;
   for (const auto& e : eval::EigenspaceSuiteEntries())
     if (only.empty() || e.scenario == only) entries.push_back(e);
@@ -139,6 +154,13 @@ void RunEigenspaceSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
                  r.localization_within_one, r.nearest_within_one);
   }
   if (json_out) std::cout << j.dump() << "\n";
+  if (!report_dir.empty()) {
+    std::vector<const eval::EntryResult*> entries_out;
+    std::vector<std::string> experiments;
+    for (const auto& r : results) entries_out.push_back(&r), experiments.push_back(r.experiment);
+    WriteSuiteReport(report_dir, "eigenspace", runs, seed, entries_out, experiments);
+    spdlog::info("eval: report in {}/index.html", report_dir);
+  }
 }
 
 }  // namespace
@@ -153,6 +175,7 @@ void AddEvalCommand(CLI::App* app) {
     std::string only;
     std::string switching = "stdratio";
     std::string end = "scale";
+    std::string report;
   };
   auto args = std::make_shared<Args>();
   auto fleet = std::make_shared<FleetEvalArgs>();
@@ -183,8 +206,16 @@ void AddEvalCommand(CLI::App* app) {
                   "table1, funnel-scenarios: the last keyframe by scale, or by the switching rule "
                   "(switching)")
       ->capture_default_str();
+  cmd->add_option("--report", args->report,
+                  "Write an HTML report (index.html: the results, each scenario from above with "
+                  "every run, the error along the path) and PNG plots into this directory");
   cmd->callback([args, fleet] {
+    if (!args->report.empty()) RefuseOutputOverInputs(args->report, "--report", {});
     if (args->suite == "fleet") {
+      if (!args->report.empty())
+        throw InputError(
+            "--report: not for the fleet suite (its runs are processes; --keep "
+            "keeps their routes and logs)");
       FleetEvalArgs f = *fleet;
       f.seed = args->seed;
       RunFleetEval(f, args->json);
@@ -198,11 +229,11 @@ void AddEvalCommand(CLI::App* app) {
     base.repeat.switching = navigation::ParseSwitching(args->switching);
     base.repeat.end_by_local_scale = ParseEndByLocalScale(args->end);
     if (args->suite == "potential") {
-      RunPotentialSuite(args->runs, args->seed, args->json, args->jobs, args->only);
+      RunPotentialSuite(args->runs, args->seed, args->json, args->jobs, args->only, args->report);
       return;
     }
     if (args->suite == "eigenspace") {
-      RunEigenspaceSuite(args->runs, args->seed, args->json, args->jobs, args->only);
+      RunEigenspaceSuite(args->runs, args->seed, args->json, args->jobs, args->only, args->report);
       return;
     }
     std::vector<eval::SuiteEntry> entries = eval::SuiteEntries(args->suite);
@@ -246,6 +277,13 @@ void AddEvalCommand(CLI::App* app) {
                    r.final_error_m_std, r.lateral_rms_m, r.collisions);
     }
     if (args->json) std::cout << j.dump() << "\n";
+    if (!args->report.empty()) {
+      std::vector<const eval::EntryResult*> entries_out;
+      for (const auto& r : results) entries_out.push_back(&r);
+      WriteSuiteReport(args->report, args->suite, args->runs, args->seed, entries_out,
+                       std::vector<std::string>(results.size()));
+      spdlog::info("eval: report in {}/index.html", args->report);
+    }
   });
 }
 

@@ -294,6 +294,8 @@ EigenspaceEntryResult RunEigenspaceEntry(const EigenspaceEntry& entry, int runs,
   for (int r = 0; r < runs; ++r) {
     const EigenspaceRun run = RunEigenspaceFollow(
         scenario, EigenspaceEntryOptions(entry, seed + static_cast<std::uint64_t>(r)));
+    if (result.reference_path.empty()) result.reference_path = run.leader_path;
+    result.paths.push_back(run.follower_path);
     result.successes += run.success;
     result.collisions += run.collided;
     if (!run.success) {

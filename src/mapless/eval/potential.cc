@@ -265,6 +265,7 @@ PotentialEntryResult RunPotentialEntry(const PotentialEntry& entry, int runs, st
     MAPLESS_CHECK(ref.success,
                   "the clean corridor run of " << entry.scenario << " failed: " << ref.status);
     clean = ref.path;
+    r.reference_path = ref.path;
     // The paper's perturbations (Section 5.2): 20% of the dominant-plane map's pixels inverted
     // (on top of sensor noise), or 20% errors on T and R.
     if (entry.experiment == "image-noise") {
@@ -291,6 +292,7 @@ PotentialEntryResult RunPotentialEntry(const PotentialEntry& entry, int runs, st
     o.seed = seed + static_cast<std::uint64_t>(i);
     o.nav.noise_seed = o.seed;
     const PotentialRun run = RunPotential(scenario, calibration, o);
+    r.paths.push_back(run.path);
     finals.push_back(run.final_error_m);
     if (corridor) {
       deviations.push_back(TrajectoryDeviationStd(clean, run.path));

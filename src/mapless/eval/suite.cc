@@ -42,6 +42,7 @@ EntryResult RunEntry(const sim::Scenario& scenario, const TaughtRoute& taught,
   r.scenario = scenario.name;
   r.controller = navigation::ControllerName(controller);
   r.runs = runs;
+  r.reference_path = taught.path;
   std::vector<double> finals;
   double lateral_sum_sq = 0.0;
   std::size_t lateral_count = 0;
@@ -53,6 +54,7 @@ EntryResult RunEntry(const sim::Scenario& scenario, const TaughtRoute& taught,
     o.repeat.sloped.max_speed_mps = speed;
     o.repeat.standard.forward_speed_mps = speed;
     const RepeatRun run = RepeatOnSimulator(scenario, taught, o);
+    r.paths.push_back(run.path);
     finals.push_back(run.final_error_m);
     for (const Pose2& p : run.path) {
       const double d = DistanceToPath(taught.path, p.x_m, p.y_m);

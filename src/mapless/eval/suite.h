@@ -30,6 +30,9 @@ struct EntryResult {
   double lateral_rms_m = 0.0;      // RMS over all repeated poses of the distance to the taught path
   int collisions = 0;
   std::vector<std::string> failures;  // one status line per failed run
+  // Ground truth for reports: the reference path (taught, or the leader's) and each run's path.
+  std::vector<Pose2> reference_path;
+  std::vector<std::vector<Pose2>> paths;
 };
 
 // Runs one entry: the route is taught once (clean), then repeated `runs` times with seeds

@@ -350,6 +350,10 @@ FollowerStep AppearanceFollower::Decide(const cv::Mat& image, const Pose2& odome
     step.index =
         std::clamp(loc.index + static_cast<int>(std::lround(pending_advance_images_)), 0, n - 1);
     step.probability = loc.probability;
+    const Eigen::VectorXd& belief = markov_.belief();
+    step.belief.resize(static_cast<std::size_t>(belief.size()));
+    for (Eigen::Index i = 0; i < belief.size(); ++i)
+      step.belief[static_cast<std::size_t>(i)] = static_cast<float>(belief[i]);
     if (loc.status == localization::LocalizationStatus::kLost) {
       StartInitialization(odometry, loc.index);
       step.state = FollowerState::kStopped;

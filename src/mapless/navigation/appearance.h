@@ -145,6 +145,7 @@ struct FollowerStep {
   int target = -1;           // route image steered towards
   std::string reason;        // why the robot is stopped (kStopped, kWaitingForLeader)
   control::SubWindowSteering steering;
+  std::vector<float> belief;  // Markov: the belief over the route images after this frame
 };
 
 class AppearanceFollower {

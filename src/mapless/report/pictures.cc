@@ -31,7 +31,8 @@ void Caption(cv::Mat* img, const std::string& text) {
 // "#rrggbb" -> BGR; anything else is grey.
 cv::Scalar Colour(const std::string& css) {
   unsigned r = 0, g = 0, b = 0;
-  if (css.size() == 7 && css[0] == '#' && std::sscanf(css.c_str() + 1, "%2x%2x%2x", &r, &g, &b) == 3)
+  if (css.size() == 7 && css[0] == '#' &&
+      std::sscanf(css.c_str() + 1, "%2x%2x%2x", &r, &g, &b) == 3)
     return cv::Scalar(b, g, r);
   return cv::Scalar(128, 128, 128);
 }
@@ -70,8 +71,8 @@ cv::Mat PlanePicture(const cv::Mat& image, const cv::Mat& plane_mask, double the
   if (!plane_mask.empty()) {
     cv::Mat mask;
     cv::resize(plane_mask, mask, out.size(), 0, 0, cv::INTER_NEAREST);
-    cv::Mat tint(out.size(), CV_8UC3, cv::Scalar(0, 0, 220));       // obstacle: red
-    tint.setTo(cv::Scalar(0, 200, 0), mask > 0);                     // dominant plane: green
+    cv::Mat tint(out.size(), CV_8UC3, cv::Scalar(0, 0, 220));  // obstacle: red
+    tint.setTo(cv::Scalar(0, 200, 0), mask > 0);               // dominant plane: green
     cv::addWeighted(out, 0.6, tint, 0.4, 0.0, out);
   }
   const cv::Point base(out.cols / 2, out.rows - 8);
@@ -137,7 +138,8 @@ cv::Mat LinePlotPicture(const PlotSpec& spec) {
   const auto P = [&](double x, double y) {
     return cv::Point2d(left + (x - x0) / (x1 - x0) * pw, top + (y1 - y) / (y1 - y0) * ph);
   };
-  cv::rectangle(img, cv::Point(left, top), cv::Point(left + static_cast<int>(pw), top + static_cast<int>(ph)),
+  cv::rectangle(img, cv::Point(left, top),
+                cv::Point(left + static_cast<int>(pw), top + static_cast<int>(ph)),
                 cv::Scalar(136, 136, 136));
   char buf[64];
   for (int k = 0; k <= 4; ++k) {

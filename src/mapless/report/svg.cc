@@ -51,8 +51,7 @@ struct Range {
 std::string Text(double x, double y, const std::string& s, const char* anchor = "start",
                  int size = 11, const char* extra = "") {
   return "<text x=\"" + Num(x) + "\" y=\"" + Num(y) + "\" font-size=\"" + std::to_string(size) +
-         "\" text-anchor=\"" + anchor + "\" fill=\"#333\"" + extra + ">" + Escape(s) +
-         "</text>\n";
+         "\" text-anchor=\"" + anchor + "\" fill=\"#333\"" + extra + ">" + Escape(s) + "</text>\n";
 }
 
 }  // namespace
@@ -62,12 +61,23 @@ std::string Escape(const std::string& text) {
   out.reserve(text.size());
   for (char c : text) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&#39;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -204,16 +214,15 @@ std::string TopDownSvg(const sim::World& world, const std::vector<PathSpec>& pat
         break;
       }
       case sim::ObjectKind::kCylinder:
-        o << "<circle cx=\"" << X(obj.center.x()) << "\" cy=\"" << Y(obj.center.y())
-          << "\" r=\"" << Num(std::max(2.0, obj.radius_m * ppm))
-          << "\" fill=\"#aac8b4\" stroke=\"#5a5a5a\"/>\n";
+        o << "<circle cx=\"" << X(obj.center.x()) << "\" cy=\"" << Y(obj.center.y()) << "\" r=\""
+          << Num(std::max(2.0, obj.radius_m * ppm)) << "\" fill=\"#aac8b4\" stroke=\"#5a5a5a\"/>\n";
         break;
       case sim::ObjectKind::kPoster: {
         const double c = std::cos(obj.yaw_rad + kPi / 2), s = std::sin(obj.yaw_rad + kPi / 2);
         const double hw = 0.5 * obj.size_m.x();
-        o << "<line x1=\"" << X(obj.center.x() - c * hw) << "\" y1=\""
-          << Y(obj.center.y() - s * hw) << "\" x2=\"" << X(obj.center.x() + c * hw) << "\" y2=\""
-          << Y(obj.center.y() + s * hw) << "\" stroke=\"#c850c8\" stroke-width=\"2\"/>\n";
+        o << "<line x1=\"" << X(obj.center.x() - c * hw) << "\" y1=\"" << Y(obj.center.y() - s * hw)
+          << "\" x2=\"" << X(obj.center.x() + c * hw) << "\" y2=\"" << Y(obj.center.y() + s * hw)
+          << "\" stroke=\"#c850c8\" stroke-width=\"2\"/>\n";
         break;
       }
     }
@@ -231,8 +240,8 @@ std::string TopDownSvg(const sim::World& world, const std::vector<PathSpec>& pat
     o << "\"/>\n";
     const Pose2& s = it->poses.front();
     const Pose2& e = it->poses.back();
-    o << "<circle cx=\"" << X(s.x_m) << "\" cy=\"" << Y(s.y_m) << "\" r=\"4\" fill=\"none\" stroke=\""
-      << Escape(it->color) << "\" stroke-width=\"2\"/>\n";
+    o << "<circle cx=\"" << X(s.x_m) << "\" cy=\"" << Y(s.y_m)
+      << "\" r=\"4\" fill=\"none\" stroke=\"" << Escape(it->color) << "\" stroke-width=\"2\"/>\n";
     o << "<line x1=\"" << X(e.x_m) << "\" y1=\"" << Y(e.y_m) << "\" x2=\""
       << X(e.x_m + 0.35 * std::cos(e.theta_rad)) << "\" y2=\""
       << Y(e.y_m + 0.35 * std::sin(e.theta_rad)) << "\" stroke=\"" << Escape(it->color)

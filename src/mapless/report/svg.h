@@ -14,7 +14,7 @@ namespace mapless::report {
 
 struct Series {
   std::vector<double> x;
-  std::vector<double> y;       // same length as x; non-finite values break the line
+  std::vector<double> y;          // same length as x; non-finite values break the line
   std::string color = "#1f77b4";  // any CSS colour
   std::string label;
   bool dashed = false;

@@ -1,0 +1,137 @@
+#include "run_report.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "mapless/eval/potential.h"
+#include "mapless/io/atomic_file.h"
+#include "mapless/report/pictures.h"
+#include "mapless/sim/scenario.h"
+#include "mapless/viz/topdown.h"
+
+namespace mapless::app {
+namespace {
+
+// "#rrggbb" -> BGR for the PNG twins.
+cv::Scalar Bgr(const std::string& css) {
+  unsigned r = 128, g = 128, b = 128;
+  if (css.size() == 7 && css[0] == '#') std::sscanf(css.c_str() + 1, "%2x%2x%2x", &r, &g, &b);
+  return cv::Scalar(b, g, r);
+}
+
+std::string Fixed(double v, int digits) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.*f", digits, v);
+  return buf;
+}
+
+// Colours of the runs of a suite entry: one hue, light to dark.
+std::string RunColour(std::size_t i, std::size_t n) {
+  const int shade = n <= 1 ? 120 : 60 + static_cast<int>(140 * i / (n - 1));
+  char buf[8];
+  std::snprintf(buf, sizeof(buf), "#%02x%02x%02x", 30, std::min(255, shade + 40), 30 + shade / 3);
+  return buf;
+}
+
+}  // namespace
+
+report::Series ErrorAlongPath(const std::vector<Pose2>& reference, const std::vector<Pose2>& path,
+                              const std::string& color, const std::string& label) {
+  report::Series s;
+  s.color = color;
+  s.label = label;
+  double driven = 0.0;
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    if (i > 0) driven += std::hypot(path[i].x_m - path[i - 1].x_m, path[i].y_m - path[i - 1].y_m);
+    s.x.push_back(driven);
+    s.y.push_back(reference.size() >= 2
+                      ? eval::SignedDistanceToPath(reference, path[i].x_m, path[i].y_m)
+                      : std::nan(""));
+  }
+  return s;
+}
+
+void AddRunSection(report::HtmlReport* html, const RunSection& section) {
+  html->Heading(section.title, 2, section.slug);
+  if (!section.summary.empty()) html->Paragraph(section.summary);
+  html->Figure(report::TopDownSvg(section.world, section.paths, section.markers),
+               "From above: the world, the reference path and the driven path(s); circles mark "
+               "the starts, bars the final headings, stars the destinations.");
+  for (const report::PlotSpec& plot : section.plots) html->Figure(report::LinePlotSvg(plot), "");
+  if (!section.pictures.empty()) html->Images(section.pictures, section.pictures_caption);
+}
+
+std::string WriteReport(const std::string& dir, const report::HtmlReport& html,
+                        const std::vector<RunSection>& sections) {
+  io::MakeDirectories(dir);
+  const std::filesystem::path out(dir);
+  for (const RunSection& s : sections) {
+    std::vector<viz::TopDownPath> paths;
+    for (const report::PathSpec& p : s.paths) paths.push_back({p.poses, Bgr(p.color), p.label});
+    io::WriteImageAtomic((out / (s.slug + "_topdown.png")).string(),
+                         viz::DrawTopDown(s.world, paths, s.markers));
+    for (std::size_t k = 0; k < s.plots.size(); ++k)
+      io::WriteImageAtomic((out / (s.slug + "_plot" + std::to_string(k + 1) + ".png")).string(),
+                           report::LinePlotPicture(s.plots[k]));
+  }
+  const std::string index = (out / "index.html").string();
+  io::WriteFileAtomic(index, html.Html());
+  return index;
+}
+
+void WriteSuiteReport(const std::string& dir, const std::string& suite, int runs,
+                      std::uint64_t seed, const std::vector<const eval::EntryResult*>& entries,
+                      const std::vector<std::string>& experiments) {
+  report::HtmlReport html("mapless eval " + suite);
+  html.Paragraph("Runs per line: " + std::to_string(runs) +
+                 "; first seed: " + std::to_string(seed) +
+                 ". Each run has its own seed (motion and image noise, start perturbation).");
+  html.Heading("Results");
+  std::vector<std::vector<std::string>> rows;
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    const eval::EntryResult& r = *entries[k];
+    rows.push_back({r.scenario, experiments[k].empty() ? r.controller : experiments[k],
+                    std::to_string(r.successes) + "/" + std::to_string(r.runs),
+                    std::to_string(r.collisions), Fixed(r.final_error_m_rms, 3),
+                    Fixed(r.final_error_m_std, 3), Fixed(r.lateral_rms_m, 3)});
+  }
+  html.Table({"scenario", "controller / experiment", "successes", "collisions",
+              "final error RMS (m)", "final error std (m)", "lateral RMS (m)"},
+             rows);
+  std::vector<RunSection> sections;
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    const eval::EntryResult& r = *entries[k];
+    if (r.paths.empty()) continue;
+    const sim::Scenario scenario = sim::LoadScenario(r.scenario);
+    RunSection s;
+    const std::string what = experiments[k].empty() ? r.controller : experiments[k];
+    s.title = r.scenario + ": " + what;
+    s.slug = r.scenario + "_" + what;
+    s.summary = std::to_string(r.successes) + " of " + std::to_string(r.runs) +
+                " runs succeeded; " + std::to_string(r.collisions) + " collisions.";
+    for (const std::string& f : r.failures) s.summary += " " + f + ".";
+    s.world = sim::ApplyVariant(scenario.world, scenario.repeat_variant);
+    s.markers = scenario.destinations;
+    if (!r.reference_path.empty()) s.paths.push_back({r.reference_path, "#d62728", "reference"});
+    report::PlotSpec errors{"Error along the path",
+                            "distance driven (m)",
+                            "to the reference (m, left +)",
+                            {},
+                            640,
+                            240};
+    for (std::size_t i = 0; i < r.paths.size(); ++i) {
+      const std::string colour = RunColour(i, r.paths.size());
+      s.paths.push_back({r.paths[i], colour, i == 0 ? "runs" : "", 1.2});
+      if (!r.reference_path.empty())
+        errors.series.push_back(
+            ErrorAlongPath(r.reference_path, r.paths[i], colour, i == 0 ? "runs" : ""));
+    }
+    if (!errors.series.empty()) s.plots.push_back(errors);
+    AddRunSection(&html, s);
+    sections.push_back(std::move(s));
+  }
+  WriteReport(dir, html, sections);
+}
+
+}  // namespace mapless::app

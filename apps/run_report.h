@@ -1,0 +1,51 @@
+// The HTML report of `mapless demo` and `mapless eval SUITE --report DIR` (issue 20): what was
+// run, the results table, per run or scenario a top-down view with the reference and every
+// driven path, plots (error along the path, commands over time, the belief), pictures of chosen
+// frames; DIR/index.html (self-contained) and PNG twins of the main plots (DIR/*.png).
+#pragma once
+
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "mapless/eval/suite.h"
+#include "mapless/report/html.h"
+#include "mapless/report/svg.h"
+#include "mapless/sim/world.h"
+
+namespace mapless::app {
+
+// One run (or one suite entry) as the report shows it.
+struct RunSection {
+  std::string title;  // e.g. "Teach & repeat: sloped funnel lane"
+  std::string slug;   // file names of its PNGs: SLUG_topdown.png, SLUG_plot1.png, ...
+  std::string summary;
+  sim::World world;
+  std::vector<Eigen::Vector2d> markers;
+  std::vector<report::PathSpec> paths;  // the first is the reference
+  std::vector<report::PlotSpec> plots;
+  std::vector<std::pair<cv::Mat, std::string>> pictures;  // chosen frames
+  std::string pictures_caption;
+};
+
+// The reference path's signed distance (m, left positive) of each pose of `path`, against the
+// distance driven along it (m): the "error along the path" plot's series.
+report::Series ErrorAlongPath(const std::vector<Pose2>& reference, const std::vector<Pose2>& path,
+                              const std::string& color, const std::string& label);
+
+void AddRunSection(report::HtmlReport* html, const RunSection& section);
+
+// Writes DIR/index.html and every section's PNG twins (DIR/SLUG_topdown.png, DIR/SLUG_plotN.png),
+// each atomically; returns the path of index.html.
+std::string WriteReport(const std::string& dir, const report::HtmlReport& html,
+                        const std::vector<RunSection>& sections);
+
+// `mapless eval SUITE --report DIR`: the results table and, for each entry with paths, a section:
+// the scenario's world, the reference path and every run, the error along the path.
+void WriteSuiteReport(const std::string& dir, const std::string& suite, int runs,
+                      std::uint64_t seed, const std::vector<const eval::EntryResult*>& entries,
+                      const std::vector<std::string>& experiments);
+
+}  // namespace mapless::app
