@@ -203,9 +203,10 @@ else
   wait "$pid"; check "recording was still running when killed (machine too fast?)" 1
 fi
 
-# Demo on a short scenario: teach, route, repeat, picture.
+# Demo on a short scenario: teach, route, repeat; the eigenspace follower and the visual potential;
+# the report and its PNG plots.
 expect_exit "demo on rotation_in_place" 0 "$MAPLESS" demo --scenario rotation_in_place --out "$TMP/demo"
-for f in topdown.png summary.json repeat.jsonl route/manifest.json teach/groundtruth.tum teach/frames/000000.png; do
+for f in report/index.html report/repeat_topdown.png report/eigenspace_plot3.png report/potential_topdown.png summary.json repeat.jsonl route/manifest.json teach/groundtruth.tum teach/frames/000000.png; do
   [ -s "$TMP/demo/$f" ]; check "demo writes $f" $?
 done
 grep -q '"success": true' "$TMP/demo/summary.json"; check "demo repeat succeeded" $?
