@@ -14,12 +14,6 @@
 namespace mapless::app {
 namespace {
 
-std::string Fixed(double v, int digits) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.*f", digits, v);
-  return buf;
-}
-
 report::PlotSpec CommandsPlot(const std::vector<double>& t, const std::vector<double>& v,
                               const std::vector<double>& omega) {
   report::PlotSpec p{"Commands over time", "time (s)", "v (m/s), omega (rad/s)", {}, 640, 240};

@@ -13,19 +13,6 @@
 namespace mapless::app {
 namespace {
 
-// "#rrggbb" -> BGR for the PNG twins.
-cv::Scalar Bgr(const std::string& css) {
-  unsigned r = 128, g = 128, b = 128;
-  if (css.size() == 7 && css[0] == '#') std::sscanf(css.c_str() + 1, "%2x%2x%2x", &r, &g, &b);
-  return cv::Scalar(b, g, r);
-}
-
-std::string Fixed(double v, int digits) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.*f", digits, v);
-  return buf;
-}
-
 // Colours of the runs of a suite entry: one hue, light to dark.
 std::string RunColour(std::size_t i, std::size_t n) {
   const int shade = n <= 1 ? 120 : 60 + static_cast<int>(140 * i / (n - 1));
@@ -35,6 +22,12 @@ std::string RunColour(std::size_t i, std::size_t n) {
 }
 
 }  // namespace
+
+std::string Fixed(double value, int digits) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.*f", digits, value);
+  return buf;
+}
 
 report::Series ErrorAlongPath(const std::vector<Pose2>& reference, const std::vector<Pose2>& path,
                               const std::string& color, const std::string& label) {
@@ -68,7 +61,8 @@ std::string WriteReport(const std::string& dir, const report::HtmlReport& html,
   const std::filesystem::path out(dir);
   for (const RunSection& s : sections) {
     std::vector<viz::TopDownPath> paths;
-    for (const report::PathSpec& p : s.paths) paths.push_back({p.poses, Bgr(p.color), p.label});
+    for (const report::PathSpec& p : s.paths)
+      paths.push_back({p.poses, report::CssToBgr(p.color), p.label});
     io::WriteImageAtomic((out / (s.slug + "_topdown.png")).string(),
                          viz::DrawTopDown(s.world, paths, s.markers));
     for (std::size_t k = 0; k < s.plots.size(); ++k)

@@ -32,6 +32,9 @@ struct RunSection {
 
 // The reference path's signed distance (m, left positive) of each pose of `path`, against the
 // distance driven along it (m): the "error along the path" plot's series.
+// A number with `digits` decimals, for the report's text and tables.
+std::string Fixed(double value, int digits);
+
 report::Series ErrorAlongPath(const std::vector<Pose2>& reference, const std::vector<Pose2>& path,
                               const std::string& color, const std::string& label);
 

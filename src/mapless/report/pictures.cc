@@ -28,16 +28,15 @@ void Caption(cv::Mat* img, const std::string& text) {
               cv::Scalar(20, 20, 20), 1, cv::LINE_AA);
 }
 
-// "#rrggbb" -> BGR; anything else is grey.
-cv::Scalar Colour(const std::string& css) {
+}  // namespace
+
+cv::Scalar CssToBgr(const std::string& css) {
   unsigned r = 0, g = 0, b = 0;
   if (css.size() == 7 && css[0] == '#' &&
       std::sscanf(css.c_str() + 1, "%2x%2x%2x", &r, &g, &b) == 3)
     return cv::Scalar(b, g, r);
   return cv::Scalar(128, 128, 128);
 }
-
-}  // namespace
 
 cv::Mat MatchPicture(const cv::Mat& current, const cv::Mat& keyframe_thumbnail,
                      const std::vector<cv::Point2f>& current_px,
@@ -162,7 +161,7 @@ cv::Mat LinePlotPicture(const PlotSpec& spec) {
               cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(60, 60, 60), 1, cv::LINE_AA);
   int lx = left;
   for (const Series& s : spec.series) {
-    const cv::Scalar c = Colour(s.color);
+    const cv::Scalar c = CssToBgr(s.color);
     std::vector<cv::Point> line;
     const auto flush = [&] {
       if (line.size() >= 2) cv::polylines(img, line, false, c, 1, cv::LINE_AA);

@@ -31,6 +31,9 @@ cv::Mat PlanePicture(const cv::Mat& image, const cv::Mat& plane_mask, double the
 cv::Mat BeliefPicture(const std::vector<std::vector<float>>& beliefs, const std::vector<int>& truth,
                       int height_px = 240);
 
+// A CSS colour "#rrggbb" as an OpenCV BGR colour; anything else is grey.
+cv::Scalar CssToBgr(const std::string& css);
+
 // The PNG twin of LinePlotSvg (CSS colours as #rrggbb).
 cv::Mat LinePlotPicture(const PlotSpec& spec);
 
