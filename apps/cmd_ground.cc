@@ -1,38 +1,167 @@
 // `mapless ground F0 F1 --out MASK.png`: the dominant plane (ground) of F0 from the flow F0 -> F1,
 // as a 0/255 mask at F0's size; with --gt, its IoU against a labelled mask.
+// `mapless ground --source REC`: the same for every frame of a recording, video or image folder
+// against the frame --step frames later, one JSON line per frame and, with --out-dir, the masks.
 #include <spdlog/spdlog.h>
 
+#include <cstdio>
+#include <deque>
+#include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "cli_common.h"
+#include "interrupt.h"
 #include "mapless/core/check.h"
 #include "mapless/flow/flow.h"
 #include "mapless/ground/dominant_plane.h"
 #include "mapless/io/atomic_file.h"
+#include "mapless/io/output_dir.h"
+#include "recording_args.h"
 
 namespace mapless::app {
 
+namespace {
+
+struct GroundArgs {
+  std::string first;
+  std::string second;
+  std::string out;
+  std::string method = "dis_medium";
+  std::string model = "homography";
+  std::string truth;
+  double epsilon_px = 0.4;
+  double epsilon_relative = 0.4;
+  double roi_top = 0.5;
+  double fit_bottom = 0.5;
+  double iou_top = 0.5;
+  // A recording, video or image folder as the source.
+  std::string source;
+  recording::PlaybackOptions playback;
+  double fps = 10.0;
+  int step = 1;
+  int max_frames = 0;
+  std::string out_dir;
+  std::string log = "-";
+};
+
+ground::DominantPlaneOptions PlaneOptions(const GroundArgs& args) {
+  ground::DominantPlaneOptions options;
+  options.model = ground::ParsePlaneModel(args.model);
+  options.epsilon_px = args.epsilon_px;
+  options.epsilon_relative = args.epsilon_relative;
+  options.roi_top_fraction = args.roi_top;
+  options.fit_bottom_fraction = args.fit_bottom;
+  options.Validate();
+  return options;
+}
+
+void GroundOfTwoFiles(const GroundArgs& args) {
+  RefuseOutputOverInputs(args.out, "--out", {args.first, args.second, args.truth});
+  flow::FlowOptions flow_options;
+  flow_options.method = flow::ParseFlowMethod(args.method);
+  const ground::DominantPlaneOptions options = PlaneOptions(args);
+  const cv::Mat a = ReadImageOrThrow(args.first, cv::IMREAD_GRAYSCALE);
+  const cv::Mat b = ReadImageOrThrow(args.second, cv::IMREAD_GRAYSCALE);
+  RequireSameSize(b, args.second, a, args.first);
+  const cv::Mat field = flow::ComputeFlow(a, b, flow_options);
+  const ground::DominantPlane plane = ground::DetectDominantPlane(field, options);
+  if (!plane.found) {
+    spdlog::warn("ground: no dominant plane: it covers {:.0f}% of the region of interest",
+                 100.0 * plane.roi_fraction);
+  }
+  if (!args.out.empty()) io::WriteImageAtomic(args.out, plane.mask);
+  if (!args.truth.empty()) {
+    const cv::Mat truth = ReadImageOrThrow(args.truth, cv::IMREAD_GRAYSCALE);
+    RequireSameSize(truth, args.truth, a, args.first);
+    const cv::Mat gt = truth > 127;
+    const int top = static_cast<int>(args.iou_top * a.rows);
+    nlohmann::json j;
+    j["found"] = plane.found;
+    j["plane_fraction"] = plane.roi_fraction;
+    j["iou"] = ground::MaskIoU(plane.mask, gt, cv::Rect(0, top, a.cols, a.rows - top));
+    std::cout << j.dump() << "\n";
+  }
+  if (args.out.empty() && args.truth.empty())
+    throw InputError("ground: nothing to do: give --out, --gt or both");
+}
+
+// Frame i against frame i + step, for every frame that has one.
+void GroundOfSource(const GroundArgs& args) {
+  if (!args.first.empty() || !args.second.empty())
+    throw InputError("ground: give F0 F1 or --source, not both");
+  if (!args.out.empty() || !args.truth.empty())
+    throw InputError("ground --source: --out and --gt are for F0 F1; use --out-dir for masks");
+  RefuseOutputOverInputs(args.log == "-" ? "" : args.log, "--log",
+                         {args.source, args.playback.poses});
+  RefuseOutputOverInputs(args.out_dir, "--out-dir", {args.source, args.playback.poses});
+  flow::FlowOptions flow_options;
+  flow_options.method = flow::ParseFlowMethod(args.method);
+  const ground::DominantPlaneOptions options = PlaneOptions(args);
+  recording::PlaybackOptions playback = args.playback;
+  playback.fps = args.fps;
+  const std::unique_ptr<io::FrameSource> source = recording::OpenSource(args.source, playback);
+  std::unique_ptr<io::OutputDirectory> out;
+  if (!args.out_dir.empty()) {
+    out = std::make_unique<io::OutputDirectory>(args.out_dir, false, "ground masks", "");
+  }
+  JsonLines log(args.log);
+  StopCleanlyOnInterrupt();
+  std::deque<io::Frame> window;  // the last `step` + 1 frames
+  int index = 0;
+  int done = 0;
+  int found = 0;
+  double fraction_sum = 0.0;
+  io::Frame frame;
+  while ((args.max_frames == 0 || done < args.max_frames) && source->Next(&frame)) {
+    ThrowIfInterrupted();
+    if (!window.empty() && frame.image.size() != window.front().image.size())
+      throw InputError(args.source + ": frame " + frame.name + " changes the image size");
+    window.push_back(frame);
+    if (static_cast<int>(window.size()) <= args.step) continue;
+    const io::Frame& a = window.front();
+    const cv::Mat field = flow::ComputeFlow(a.image, window.back().image, flow_options);
+    const ground::DominantPlane plane = ground::DetectDominantPlane(field, options);
+    nlohmann::json j;
+    j["frame"] = index;
+    j["name"] = a.name;
+    j["t_s"] = ToSeconds(a.t_ns);
+    j["found"] = plane.found;
+    j["plane_fraction"] = plane.roi_fraction;
+    if (out) {
+      char name[32];
+      std::snprintf(name, sizeof(name), "%06d.png", index);
+      io::WriteImageAtomic((std::filesystem::path(out->path()) / name).string(), plane.mask);
+      j["mask"] = name;
+    }
+    log.Write(j);
+    found += plane.found ? 1 : 0;
+    fraction_sum += plane.roi_fraction;
+    ++done;
+    ++index;
+    window.pop_front();
+  }
+  if (done == 0) {
+    throw InputError(args.source + ": fewer than " + std::to_string(args.step + 1) +
+                     " frames, so no frame has one " + std::to_string(args.step) + " later");
+  }
+  if (out) out->Commit();
+  spdlog::info("ground: {} frames, dominant plane found in {} ({:.0f}%), mean {:.0f}% of the "
+               "region of interest",
+               done, found, 100.0 * found / done, 100.0 * fraction_sum / done);
+}
+
+}  // namespace
+
 void AddGroundCommand(CLI::App* app) {
-  struct Args {
-    std::string first;
-    std::string second;
-    std::string out;
-    std::string method = "dis_medium";
-    std::string model = "homography";
-    std::string truth;
-    double epsilon_px = 0.4;
-    double epsilon_relative = 0.4;
-    double roi_top = 0.5;
-    double fit_bottom = 0.5;
-    double iou_top = 0.5;
-  };
-  auto args = std::make_shared<Args>();
+  auto args = std::make_shared<GroundArgs>();
   CLI::App* cmd = app->add_subcommand(
-      "ground", "Dominant plane (ground) of F0 from the optical flow F0 -> F1, as a 0/255 mask");
-  cmd->add_option("F0", args->first, "Frame at time t")->required();
-  cmd->add_option("F1", args->second, "Frame at time t+1")->required();
+      "ground",
+      "Dominant plane (ground) of F0 from the optical flow F0 -> F1, as a 0/255 mask; or of "
+      "every frame of a --source");
+  cmd->add_option("F0", args->first, "Frame at time t");
+  cmd->add_option("F1", args->second, "Frame at time t+1");
   cmd->add_option("--out", args->out, "Write the mask (PNG, F0's size)");
   cmd->add_option("--method", args->method, "Flow: dis, dis_medium, farneback or lk")
       ->capture_default_str();
@@ -57,40 +186,31 @@ void AddGroundCommand(CLI::App* app) {
   cmd->add_option("--iou-top", args->iou_top, "IoU over the rows below this fraction of the height")
       ->capture_default_str()
       ->check(FiniteIn(0.0, 0.99));
+  cmd->add_option("--source", args->source,
+                  "Instead of F0 F1: every frame of a recording (.mcap, .bag), video or image "
+                  "folder, against the frame --step later; one JSON line per frame");
+  AddPlaybackOptions(cmd, &args->playback);
+  cmd->add_option("--fps", args->fps, "--source: frame rate of image folders (timestamps)")
+      ->capture_default_str()
+      ->check(FiniteIn(io::kMinFolderFps, io::kMaxFolderFps));
+  cmd->add_option("--step", args->step, "--source: F1 is this many frames after F0")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100));
+  cmd->add_option("--max-frames", args->max_frames, "--source: stop after this many (0: all)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100'000'000));
+  cmd->add_option("--out-dir", args->out_dir,
+                  "--source: write each frame's mask as DIR/NNNNNN.png (a new or empty directory)");
+  cmd->add_option("--log", args->log, "--source: the JSON lines (- for stdout)")
+      ->capture_default_str();
   cmd->callback([args] {
-    RefuseOutputOverInputs(args->out, "--out", {args->first, args->second, args->truth});
-    flow::FlowOptions flow_options;
-    flow_options.method = flow::ParseFlowMethod(args->method);
-    ground::DominantPlaneOptions options;
-    options.model = ground::ParsePlaneModel(args->model);
-    options.epsilon_px = args->epsilon_px;
-    options.epsilon_relative = args->epsilon_relative;
-    options.roi_top_fraction = args->roi_top;
-    options.fit_bottom_fraction = args->fit_bottom;
-    options.Validate();
-    const cv::Mat a = ReadImageOrThrow(args->first, cv::IMREAD_GRAYSCALE);
-    const cv::Mat b = ReadImageOrThrow(args->second, cv::IMREAD_GRAYSCALE);
-    RequireSameSize(b, args->second, a, args->first);
-    const cv::Mat field = flow::ComputeFlow(a, b, flow_options);
-    const ground::DominantPlane plane = ground::DetectDominantPlane(field, options);
-    if (!plane.found) {
-      spdlog::warn("ground: no dominant plane: it covers {:.0f}% of the region of interest",
-                   100.0 * plane.roi_fraction);
+    if (!args->source.empty()) {
+      GroundOfSource(*args);
+      return;
     }
-    if (!args->out.empty()) io::WriteImageAtomic(args->out, plane.mask);
-    if (!args->truth.empty()) {
-      const cv::Mat truth = ReadImageOrThrow(args->truth, cv::IMREAD_GRAYSCALE);
-      RequireSameSize(truth, args->truth, a, args->first);
-      const cv::Mat gt = truth > 127;
-      const int top = static_cast<int>(args->iou_top * a.rows);
-      nlohmann::json j;
-      j["found"] = plane.found;
-      j["plane_fraction"] = plane.roi_fraction;
-      j["iou"] = ground::MaskIoU(plane.mask, gt, cv::Rect(0, top, a.cols, a.rows - top));
-      std::cout << j.dump() << "\n";
-    }
-    if (args->out.empty() && args->truth.empty())
-      throw InputError("ground: nothing to do: give --out, --gt or both");
+    if (args->first.empty() || args->second.empty())
+      throw InputError("ground: give two frames F0 F1, or --source");
+    GroundOfTwoFiles(*args);
   });
 }
 

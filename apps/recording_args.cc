@@ -39,6 +39,9 @@ void AddPlaybackOptions(CLI::App* cmd, recording::PlaybackOptions* options, bool
       ->capture_default_str()
       ->check(FiniteIn(0.0, 1e9));
   cmd->add_flag("--loop", options->loop, "Play the source again from the start when it ends");
+  cmd->add_option("--poses", options->poses,
+                  "Videos and image folders: a TUM trajectory (timestamp tx ty tz qx qy qz qw) "
+                  "as the frames' odometry, e.g. the odometry.tum beside a sim drive's frames/");
 }
 
 std::unique_ptr<recording::RunRecorder> OpenRecorder(

@@ -34,10 +34,6 @@ std::string SourceInput(const std::string& source) {
 
 namespace {
 
-bool IsLive(const std::string& source) {
-  return source.rfind("camera:", 0) == 0 || source.rfind("/dev/video", 0) == 0;
-}
-
 // What a teach makes from frames: keyframes (funnel lanes) or appearance route images.
 class Teacher {
  public:
@@ -101,7 +97,8 @@ class AppearanceTeacher : public Teacher {
       if (++without_odometry_ < 30 && !no_odometry_source_) return;
       throw InputError(
           "teach --method eigenspace needs wheel odometry (route images are spaced "
-          "by distance): teach on sim:SCENARIO or on a robot with an odometry topic");
+          "by distance): teach on sim:SCENARIO, on a robot or a recording with an odometry "
+          "topic, or on a video or image folder with --poses FILE.tum");
     }
     if (!writer_) {
       writer_ = std::make_unique<route::AppearanceRouteWriter>(
@@ -179,7 +176,11 @@ void Teach(const TeachArgs& t) {
   StopCleanlyOnInterrupt();
   std::unique_ptr<Teacher> teacher;
   if (eigenspace) {
-    teacher = std::make_unique<AppearanceTeacher>(out.path(), source != nullptr);
+    // A video or folder without --poses never has odometry; a recording's first frames may come
+    // before its first odometry message, as a robot's do.
+    const bool never_odometry =
+        source != nullptr && !recording::IsRecording(t.source) && t.playback.poses.empty();
+    teacher = std::make_unique<AppearanceTeacher>(out.path(), never_odometry);
   } else {
     teacher = std::make_unique<KeyframeTeacher>(out.path(), t.detector);
   }
@@ -225,7 +226,7 @@ void Teach(const TeachArgs& t) {
       while (source->Next(&frame)) frame_in(frame.image, frame.t_ns, frame.odometry);
     }
   } catch (const Interrupted&) {
-    if (frames == 0 || !(IsLive(t.source) || robot_file)) throw;
+    if (frames == 0 || !(io::IsLiveCamera(t.source) || robot_file)) throw;
     interrupted = true;  // the end of a camera or robot teach
   }
   if (frames == 0) throw InputError((robot_file ? t.robot : t.source) + ": no frames");

@@ -153,6 +153,18 @@ grep -q "already holds a route" "$TMP/err"; check "overwrite refusal is explaine
 expect_exit "repeat open loop" 0 "$MAPLESS" repeat --route "$TMP/route" --source "$TMP/d1/frames" --log "$TMP/rep.jsonl"
 [ "$(wc -l <"$TMP/rep.jsonl")" -eq "$n_frames" ]; check "one decision line per frame" $?
 head -1 "$TMP/rep.jsonl" | grep -q '"destination":' && head -1 "$TMP/rep.jsonl" | grep -q '"v_mps":'; check "decision lines carry segment and command" $?
+# An image folder with TUM poses as its odometry (--poses): the eigenspace teach needs odometry.
+expect_exit "eigenspace teach of a folder without poses exits 2" 2 "$MAPLESS" teach --method eigenspace --source "$TMP/d1/frames" --out "$TMP/eroute0"
+grep -q "with --poses FILE.tum" "$TMP/err"; check "eigenspace teach asks for --poses" $?
+expect_exit "eigenspace teach of a folder with poses" 0 "$MAPLESS" teach --method eigenspace --source "$TMP/d1/frames" --poses "$TMP/d1/odometry.tum" --out "$TMP/eroute"
+grep -q '"complete": true' "$TMP/eroute/appearance.json" && [ "$(ls "$TMP/eroute/images" | wc -l)" -ge 10 ]; check "eigenspace route from a folder with poses is complete, >= 10 images" $?
+expect_exit "poses with a recording exits 2" 2 "$MAPLESS" teach --source "$TMP/none.mcap" --poses "$TMP/d1/odometry.tum" --out "$TMP/eroute1"
+grep -q "has its own odometry topic" "$TMP/err"; check "--poses with a recording is refused" $?
+# ground on a source: one JSON line and one mask per frame that has a frame --step later.
+expect_exit "ground --source" 0 "$MAPLESS" ground --source "$TMP/d1/frames" --max-frames 4 --step 2 --out-dir "$TMP/masks" --log "$TMP/ground.jsonl"
+[ "$(wc -l <"$TMP/ground.jsonl")" -eq 4 ] && [ "$(ls "$TMP/masks" | grep -c '\.png$')" -eq 4 ] && grep -q '"plane_fraction":' "$TMP/ground.jsonl"; check "ground --source: 4 lines, 4 masks" $?
+expect_exit "ground with F0 and --source exits 2" 2 "$MAPLESS" ground "$TMP/f0.png" --source "$TMP/d1/frames"
+grep -q "not both" "$TMP/err"; check "ground says F0 F1 or --source" $?
 # The route's end: the local scale by default, the paper's StdRatio with --end switching.
 expect_exit "teach on the simulator" 0 "$MAPLESS" teach --source sim:rotation_in_place --out "$TMP/simroute"
 expect_exit "repeat with the paper's end rule" 0 "$MAPLESS" repeat --route "$TMP/simroute" --source sim:rotation_in_place --end switching --log "$TMP/rep2.jsonl"

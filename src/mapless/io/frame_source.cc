@@ -125,6 +125,10 @@ class CameraSource : public FrameSource {
 
 }  // namespace
 
+bool IsLiveCamera(const std::string& spec) {
+  return spec.rfind("camera:", 0) == 0 || spec.rfind("/dev/video", 0) == 0;
+}
+
 std::unique_ptr<FrameSource> OpenFrameSource(const std::string& spec, double folder_fps) {
   MAPLESS_CHECK(folder_fps >= kMinFolderFps && folder_fps <= kMaxFolderFps,
                 "--fps " << folder_fps << ": must be in [" << kMinFolderFps << ", " << kMaxFolderFps

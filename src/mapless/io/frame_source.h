@@ -30,6 +30,9 @@ class FrameSource {
 inline constexpr double kMinFolderFps = 0.01;
 inline constexpr double kMaxFolderFps = 1000.0;
 
+// True for "camera:N" and "/dev/videoN": a live camera, not a recording.
+bool IsLiveCamera(const std::string& spec);
+
 // Opens `spec`: "camera:N" or "/dev/videoN" for a camera, a directory for an image folder
 // (.png .jpg .jpeg .bmp .pgm .ppm .tif .tiff), anything else as a video file. `folder_fps` gives
 // the timestamps of folder frames. Throws InputError naming the source when it cannot be opened.

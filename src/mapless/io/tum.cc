@@ -39,6 +39,14 @@ std::vector<StampedPose> ParseTum(const std::string& text, const std::string& na
       if (in.eof() && !text.empty() && text.back() != '\n') break;
       throw InputError(name + ":" + std::to_string(line_no) + ": expected 8 numbers per line");
     }
+    for (const double v : {t, x, y, z, qx, qy, qz, qw}) {
+      if (!std::isfinite(v))
+        throw InputError(name + ":" + std::to_string(line_no) + ": a number is not finite");
+    }
+    if (std::abs(t) > kMaxTumSeconds) {
+      throw InputError(name + ":" + std::to_string(line_no) + ": timestamp " + std::to_string(t) +
+                       " s is out of range");
+    }
     out.push_back({FromSeconds(t), Pose2{x, y, 2.0 * std::atan2(qz, qw)}});
     out.back().pose.theta_rad = WrapAngle(out.back().pose.theta_rad);
   }

@@ -7,6 +7,7 @@
 
 #include "mapless/core/check.h"
 #include "mapless/recording/mcap_source.h"
+#include "mapless/recording/tum_poses.h"
 
 namespace mapless::recording {
 
@@ -118,6 +119,12 @@ std::unique_ptr<io::FrameSource> OpenSource(const std::string& spec,
                                             const PlaybackOptions& options) {
   options.Validate();
   PlaybackSource::Factory factory;
+  if (!options.poses.empty() && (IsRecording(spec) || io::IsLiveCamera(spec))) {
+    throw InputError("--poses " + options.poses + ": " + spec +
+                     (IsRecording(spec) ? " has its own odometry topic (--odom-topic)"
+                                        : " is a live camera; poses go with a video or an image "
+                                          "folder"));
+  }
   if (EndsWith(spec, ".mcap")) {
     factory = [spec, options] { return OpenMcapSource(spec, options.topic, options.odom_topic); };
   } else if (EndsWith(spec, ".bag")) {
@@ -126,7 +133,14 @@ std::unique_ptr<io::FrameSource> OpenSource(const std::string& spec,
     if (!options.topic.empty())
       throw InputError("--topic " + options.topic + ": " + spec +
                        " is not a recording with topics (.mcap, .bag)");
-    factory = [spec, options] { return io::OpenFrameSource(spec, options.fps); };
+    if (options.poses.empty()) {
+      factory = [spec, options] { return io::OpenFrameSource(spec, options.fps); };
+    } else {
+      auto poses = std::make_shared<const std::vector<io::StampedPose>>(ReadPoses(options.poses));
+      factory = [spec, options, poses] {
+        return WithPoses(io::OpenFrameSource(spec, options.fps), *poses);
+      };
+    }
   }
   return std::make_unique<PlaybackSource>(std::move(factory), options);
 }

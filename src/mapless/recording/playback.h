@@ -24,6 +24,9 @@ struct PlaybackOptions {
   double start_s = 0.0;  // begin this far into the recording (ros2 bag play --start-offset)
   bool loop = false;     // play again from the start; times go on from the end
   double fps = 10.0;     // image folders: their frame rate
+  // A TUM trajectory as the odometry of a video's or an image folder's frames (tum_poses.h); "":
+  // none. Recordings (.mcap, .bag) have their odometry topic instead.
+  std::string poses;
   void Validate() const;
 };
 

@@ -12,6 +12,7 @@
 #include "mapless/recording/mcap_source.h"
 #include "mapless/recording/playback.h"
 #include "mapless/recording/run_recorder.h"
+#include "mapless/recording/tum_poses.h"
 #include "mapless/rosmsg/messages.h"
 
 namespace mapless::recording {
@@ -154,6 +155,63 @@ TEST(Recording, RecorderRefusesToOverwrite) {
 
 // The fixtures of foxglove/rosbag (tests/data/rosbag1/README.md): the same recording stored
 // uncompressed, with lz4 and with bz2 chunks.
+// An image folder at 10 Hz with TUM poses (--poses): each frame carries the newest pose not later
+// than its time, counted from the first pose; past the trajectory's end (plus kPosesCoverS), none.
+TEST(Recording, TumPosesAreTheOdometryOfAFolder) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "mapless_recording_poses";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "frames");
+  for (int i = 0; i < 30; ++i) {
+    char name[16];
+    std::snprintf(name, sizeof(name), "%03d.png", i);
+    io::WriteImageAtomic((dir / "frames" / name).string(), Pattern(i));
+  }
+  // Poses every 0.2 s from t = 1000 s to 1001.4 s: frame i is at 1000 + i / 10 s.
+  std::string tum = "# timestamp tx ty tz qx qy qz qw\n";
+  for (int k = 0; k <= 7; ++k) {
+    tum += std::to_string(1000.0 + 0.2 * k) + " " + std::to_string(k) + " 0 0 0 0 0 1\n";
+  }
+  io::WriteFileAtomic((dir / "odometry.tum").string(), tum);
+  PlaybackOptions options;
+  options.poses = (dir / "odometry.tum").string();
+  const auto source = OpenSource((dir / "frames").string(), options);
+  io::Frame frame;
+  for (int i = 0; i < 30; ++i) {
+    ASSERT_TRUE(source->Next(&frame)) << i;
+    EXPECT_NEAR(ToSeconds(frame.t_ns), 1000.0 + 0.1 * i, 1e-6) << i;
+    if (i <= 24) {  // the last pose is at 1001.4 s; frames up to 1002.4 s still carry it
+      ASSERT_TRUE(frame.odometry.has_value()) << i;
+      EXPECT_DOUBLE_EQ(frame.odometry->x_m, std::min(i / 2, 7)) << i;
+    } else {
+      EXPECT_FALSE(frame.odometry.has_value()) << i;
+    }
+  }
+  EXPECT_FALSE(source->Next(&frame));
+
+  // Bad trajectories: one error naming the file and the pose or line.
+  const auto refused = [&](const std::string& text, const std::string& what) {
+    io::WriteFileAtomic((dir / "bad.tum").string(), text);
+    options.poses = (dir / "bad.tum").string();
+    try {
+      OpenSource((dir / "frames").string(), options);
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("bad.tum"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  refused("# only a header\n", "no poses");
+  refused("1 0 0 0 0 0 0 1\n0.5 0 0 0 0 0 0 1\n", "pose 2 at 0.5");
+  refused("1 0 0 0 0 0 0 1\n2 1e999 0 0 0 0 0 1\n", ":2: ");  // overflows: not a number
+  refused("1e12 0 0 0 0 0 0 1\n", ":1: timestamp");
+  refused("1 0 0 0\n2 0 0 0 0 0 0 1\n", ":1: expected 8 numbers");
+  // A recording has its own odometry topic; a camera has no time to match poses with.
+  options.poses = (dir / "odometry.tum").string();
+  EXPECT_THROW(OpenSource((dir / "run.mcap").string(), options), InputError);
+  EXPECT_THROW(OpenSource("camera:0", options), InputError);
+  fs::remove_all(dir);
+}
+
 TEST(RosBag, TheThreeCompressionsGiveTheSameMessages) {
   if (!CanReadBags()) GTEST_SKIP() << "mapless was built without ROS 1 bags (setup.sh --ros)";
   const std::string dir = std::string(MAPLESS_SOURCE_DIR) + "/tests/data/rosbag1/";
