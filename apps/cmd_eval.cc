@@ -8,6 +8,7 @@
 #include <future>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
@@ -18,6 +19,7 @@
 #include "mapless/eval/suite.h"
 #include "progress.h"
 #include "run_report.h"
+#include "run_traces.h"
 
 namespace mapless::app {
 
@@ -39,6 +41,13 @@ void RunInBatches(std::size_t n, int jobs, const std::function<void(std::size_t)
       batch.push_back(std::async(std::launch::async, run, next));
     for (auto& f : batch) f.get();
   }
+}
+
+template <typename Trace>
+std::vector<const RunTrace*> TracePointers(const std::vector<std::unique_ptr<Trace>>& traces) {
+  std::vector<const RunTrace*> out;
+  for (const auto& t : traces) out.push_back(t.get());
+  return out;
 }
 
 nlohmann::json SuiteJson(const std::string& suite, int runs, std::uint64_t seed) {
@@ -71,8 +80,16 @@ void RunPotentialSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
   if (entries.empty()) throw InputError("--only '" + only + "': not a scenario of suite potential");
   const navigation::PotentialNavOptions nav;
   std::vector<eval::PotentialEntryResult> results(entries.size());
+  // With --report, the first run of each entry frame by frame.
+  std::vector<std::unique_ptr<PotentialTrace>> traces(entries.size());
   RunInBatches(entries.size(), jobs, [&](std::size_t k) {
-    results[k] = eval::RunPotentialEntry(entries[k], runs, seed, nav);
+    eval::PotentialObserver observer;
+    if (!report_dir.empty()) {
+      traces[k] = std::make_unique<PotentialTrace>(
+          1.0 / sim::LoadScenario(entries[k].scenario).camera.rate_hz);
+      observer = traces[k]->Observer();
+    }
+    results[k] = eval::RunPotentialEntry(entries[k], runs, seed, nav, observer);
     spdlog::info("eval: {} {}: {}/{} successes", entries[k].scenario, entries[k].experiment,
                  results[k].successes, results[k].runs);
   });
@@ -117,7 +134,8 @@ void RunPotentialSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
     std::vector<const eval::EntryResult*> entries_out;
     std::vector<std::string> experiments;
     for (const auto& r : results) entries_out.push_back(&r), experiments.push_back(r.experiment);
-    WriteSuiteReport(report_dir, "potential", runs, seed, entries_out, experiments);
+    WriteSuiteReport(report_dir, "potential", runs, seed, entries_out, experiments,
+                     TracePointers(traces));
     spdlog::info("eval: report in {}/index.html", report_dir);
   }
 }
@@ -131,8 +149,15 @@ void RunEigenspaceSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
   if (entries.empty())
     throw InputError("--only '" + only + "': not a scenario of suite eigenspace");
   std::vector<eval::EigenspaceEntryResult> results(entries.size());
+  std::vector<std::unique_ptr<EigenspaceTrace>> traces(entries.size());
   RunInBatches(entries.size(), jobs, [&](std::size_t k) {
-    results[k] = eval::RunEigenspaceEntry(entries[k], runs, seed);
+    eval::EigenspaceObserver observer;
+    if (!report_dir.empty()) {
+      traces[k] = std::make_unique<EigenspaceTrace>(
+          1.0 / sim::LoadScenario(entries[k].scenario).camera.rate_hz);
+      observer = traces[k]->Observer();
+    }
+    results[k] = eval::RunEigenspaceEntry(entries[k], runs, seed, observer);
     spdlog::info("eval: {} {}: {}/{} successes", entries[k].scenario, entries[k].experiment,
                  results[k].successes, results[k].runs);
   });
@@ -158,7 +183,8 @@ void RunEigenspaceSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
     std::vector<const eval::EntryResult*> entries_out;
     std::vector<std::string> experiments;
     for (const auto& r : results) entries_out.push_back(&r), experiments.push_back(r.experiment);
-    WriteSuiteReport(report_dir, "eigenspace", runs, seed, entries_out, experiments);
+    WriteSuiteReport(report_dir, "eigenspace", runs, seed, entries_out, experiments,
+                     TracePointers(traces));
     spdlog::info("eval: report in {}/index.html", report_dir);
   }
 }
@@ -208,7 +234,8 @@ void AddEvalCommand(CLI::App* app) {
       ->capture_default_str();
   cmd->add_option("--report", args->report,
                   "Write an HTML report (index.html: the results, each scenario from above with "
-                  "every run, the error along the path) and PNG plots into this directory");
+                  "every run, the error along the path; the first run's commands over time, its "
+                  "method's plots and chosen frames) and PNG plots into this directory");
   cmd->callback([args, fleet] {
     if (!args->report.empty()) RefuseOutputOverInputs(args->report, "--report", {});
     if (args->suite == "fleet") {
@@ -257,10 +284,16 @@ void AddEvalCommand(CLI::App* app) {
                      std::make_pair(s, eval::TeachOnSimulator(s, navigation::TeachOptions{})));
     }
     std::vector<eval::EntryResult> results(entries.size());
+    std::vector<std::unique_ptr<RepeatTrace>> traces(entries.size());
     RunInBatches(entries.size(), args->jobs, [&](std::size_t k) {
       const auto& [scenario, route] = taught.at(entries[k].scenario);
-      results[k] =
-          eval::RunEntry(scenario, route, entries[k].controller, args->runs, args->seed, base);
+      eval::RepeatObserver observer;
+      if (!args->report.empty()) {
+        traces[k] = std::make_unique<RepeatTrace>(route, 1.0 / scenario.camera.rate_hz);
+        observer = traces[k]->Observer();
+      }
+      results[k] = eval::RunEntry(scenario, route, entries[k].controller, args->runs, args->seed,
+                                  base, observer);
       spdlog::info("eval: {} {}: {}/{} successes", entries[k].scenario, results[k].controller,
                    results[k].successes, results[k].runs);
     });
@@ -281,7 +314,7 @@ void AddEvalCommand(CLI::App* app) {
       std::vector<const eval::EntryResult*> entries_out;
       for (const auto& r : results) entries_out.push_back(&r);
       WriteSuiteReport(args->report, args->suite, args->runs, args->seed, entries_out,
-                       std::vector<std::string>(results.size()));
+                       std::vector<std::string>(results.size()), TracePointers(traces));
       spdlog::info("eval: report in {}/index.html", args->report);
     }
   });

@@ -147,9 +147,10 @@ void GroundOfSource(const GroundArgs& args) {
                      " frames, so no frame has one " + std::to_string(args.step) + " later");
   }
   if (out) out->Commit();
-  spdlog::info("ground: {} frames, dominant plane found in {} ({:.0f}%), mean {:.0f}% of the "
-               "region of interest",
-               done, found, 100.0 * found / done, 100.0 * fraction_sum / done);
+  spdlog::info(
+      "ground: {} frames, dominant plane found in {} ({:.0f}%), mean {:.0f}% of the "
+      "region of interest",
+      done, found, 100.0 * found / done, 100.0 * fraction_sum / done);
 }
 
 }  // namespace

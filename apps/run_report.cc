@@ -9,6 +9,7 @@
 #include "mapless/report/pictures.h"
 #include "mapless/sim/scenario.h"
 #include "mapless/viz/topdown.h"
+#include "run_traces.h"
 
 namespace mapless::app {
 namespace {
@@ -76,7 +77,8 @@ std::string WriteReport(const std::string& dir, const report::HtmlReport& html,
 
 void WriteSuiteReport(const std::string& dir, const std::string& suite, int runs,
                       std::uint64_t seed, const std::vector<const eval::EntryResult*>& entries,
-                      const std::vector<std::string>& experiments) {
+                      const std::vector<std::string>& experiments,
+                      const std::vector<const RunTrace*>& traces) {
   report::HtmlReport html("mapless eval " + suite);
   html.Paragraph("Runs per line: " + std::to_string(runs) +
                  "; first seed: " + std::to_string(seed) +
@@ -122,6 +124,11 @@ void WriteSuiteReport(const std::string& dir, const std::string& suite, int runs
             ErrorAlongPath(r.reference_path, r.paths[i], colour, i == 0 ? "runs" : ""));
     }
     if (!errors.series.empty()) s.plots.push_back(errors);
+    if (k < traces.size() && traces[k]) {
+      s.summary +=
+          " Over time, and the pictures: the first run (seed " + std::to_string(seed) + ").";
+      traces[k]->AddTo(&s);
+    }
     AddRunSection(&html, s);
     sections.push_back(std::move(s));
   }

@@ -17,6 +17,8 @@
 
 namespace mapless::app {
 
+class RunTrace;  // run_traces.h
+
 // One run (or one suite entry) as the report shows it.
 struct RunSection {
   std::string title;  // e.g. "Teach & repeat: sloped funnel lane"
@@ -46,9 +48,12 @@ std::string WriteReport(const std::string& dir, const report::HtmlReport& html,
                         const std::vector<RunSection>& sections);
 
 // `mapless eval SUITE --report DIR`: the results table and, for each entry with paths, a section:
-// the scenario's world, the reference path and every run, the error along the path.
+// the scenario's world, the reference path and every run, the error along the path, and what
+// `traces[k]` (the first run of entry k, frame by frame; may be null) adds: commands over time,
+// the method's own plots, chosen frames.
 void WriteSuiteReport(const std::string& dir, const std::string& suite, int runs,
                       std::uint64_t seed, const std::vector<const eval::EntryResult*>& entries,
-                      const std::vector<std::string>& experiments);
+                      const std::vector<std::string>& experiments,
+                      const std::vector<const RunTrace*>& traces);
 
 }  // namespace mapless::app

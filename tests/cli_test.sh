@@ -141,6 +141,10 @@ expect_exit "eval eigenspace with an unknown scenario exits 2" 2 "$MAPLESS" eval
 grep -q "'nowhere': not a scenario of suite eigenspace" "$TMP/err"; check "eval eigenspace names the unknown scenario" $?
 expect_exit "eval with an unknown switching rule exits 2" 2 "$MAPLESS" eval table1 --runs 1 --switching sideways
 grep -q "unknown switching rule 'sideways'" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "eval names the unknown switching rule in one line" $?
+# eval --report: per entry the world from above, the error along the path, and the first run frame
+# by frame (commands; the slopes only for the sloped funnel lane; chosen frames).
+expect_exit "eval table1 --report" 0 "$MAPLESS" eval table1 --runs 1 --only table1_almost_straight --jobs 2 --report "$TMP/evalreport"
+[ "$(grep -o 'Commands over time' "$TMP/evalreport/index.html" | wc -l)" -eq 2 ] && [ "$(grep -o 'Funnel-lane slopes' "$TMP/evalreport/index.html" | wc -l)" -eq 1 ] && [ "$(grep -o '<img' "$TMP/evalreport/index.html" | wc -l)" -ge 4 ] && [ -s "$TMP/evalreport/table1_almost_straight_sloped_plot3.png" ]; check "eval report: commands of both, slopes of the sloped run, chosen frames, PNGs" $?
 expect_exit "eval potential refuses --end" 2 "$MAPLESS" eval potential --runs 1 --end switching
 grep -q "apply to table1 and funnel-scenarios, not potential" "$TMP/err"; check "eval says --end is for teach & repeat suites" $?
 

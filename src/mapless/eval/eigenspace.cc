@@ -279,8 +279,8 @@ EigenspaceRunOptions EigenspaceEntryOptions(const EigenspaceEntry& entry, std::u
   return options;
 }
 
-EigenspaceEntryResult RunEigenspaceEntry(const EigenspaceEntry& entry, int runs,
-                                         std::uint64_t seed) {
+EigenspaceEntryResult RunEigenspaceEntry(const EigenspaceEntry& entry, int runs, std::uint64_t seed,
+                                         const EigenspaceObserver& first_run) {
   MAPLESS_CHECK(runs >= 1, "eigenspace suite: runs = " << runs << "; must be >= 1");
   const sim::Scenario scenario = sim::LoadScenario(entry.scenario);
   EigenspaceEntryResult result;
@@ -293,7 +293,8 @@ EigenspaceEntryResult RunEigenspaceEntry(const EigenspaceEntry& entry, int runs,
   std::vector<double> finals;
   for (int r = 0; r < runs; ++r) {
     const EigenspaceRun run = RunEigenspaceFollow(
-        scenario, EigenspaceEntryOptions(entry, seed + static_cast<std::uint64_t>(r)));
+        scenario, EigenspaceEntryOptions(entry, seed + static_cast<std::uint64_t>(r)),
+        r == 0 ? first_run : EigenspaceObserver{});
     if (result.reference_path.empty()) result.reference_path = run.leader_path;
     result.paths.push_back(run.follower_path);
     result.successes += run.success;

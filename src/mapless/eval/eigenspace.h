@@ -85,7 +85,8 @@ struct EigenspaceEntryResult : EntryResult {
   int stops = 0;                         // total stop frames over runs
 };
 
-EigenspaceEntryResult RunEigenspaceEntry(const EigenspaceEntry& entry, int runs,
-                                         std::uint64_t seed);
+// `first_run` (if set) observes every follower frame of the first run (for reports).
+EigenspaceEntryResult RunEigenspaceEntry(const EigenspaceEntry& entry, int runs, std::uint64_t seed,
+                                         const EigenspaceObserver& first_run = {});
 
 }  // namespace mapless::eval

@@ -244,7 +244,8 @@ std::vector<PotentialEntry> PotentialSuiteEntries() {
 }
 
 PotentialEntryResult RunPotentialEntry(const PotentialEntry& entry, int runs, std::uint64_t seed,
-                                       const navigation::PotentialNavOptions& nav) {
+                                       const navigation::PotentialNavOptions& nav,
+                                       const PotentialObserver& first_run) {
   MAPLESS_CHECK(runs >= 1, "runs = " << runs << "; must be >= 1");
   const sim::Scenario scenario = sim::LoadScenario(entry.scenario);
   const navigation::PlanarFlowCalibration calibration = CalibrateOnSimulator(scenario, nav);
@@ -291,7 +292,8 @@ PotentialEntryResult RunPotentialEntry(const PotentialEntry& entry, int runs, st
     PotentialRunOptions o = base;
     o.seed = seed + static_cast<std::uint64_t>(i);
     o.nav.noise_seed = o.seed;
-    const PotentialRun run = RunPotential(scenario, calibration, o);
+    const PotentialRun run =
+        RunPotential(scenario, calibration, o, i == 0 ? first_run : PotentialObserver{});
     r.paths.push_back(run.path);
     finals.push_back(run.final_error_m);
     if (corridor) {

@@ -107,7 +107,9 @@ struct PotentialEntryResult : EntryResult {
 
 // Runs `runs` noisy runs of an entry with seeds seed, seed + 1, ... (and, for the corridor, one
 // clean run to compare with).
+// `first_run` (if set) observes every frame of the first seeded run (for reports).
 PotentialEntryResult RunPotentialEntry(const PotentialEntry& entry, int runs, std::uint64_t seed,
-                                       const navigation::PotentialNavOptions& nav);
+                                       const navigation::PotentialNavOptions& nav,
+                                       const PotentialObserver& first_run = {});
 
 }  // namespace mapless::eval

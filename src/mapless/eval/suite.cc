@@ -36,7 +36,7 @@ std::vector<SuiteEntry> SuiteEntries(const std::string& suite) {
 
 EntryResult RunEntry(const sim::Scenario& scenario, const TaughtRoute& taught,
                      navigation::Controller controller, int runs, std::uint64_t seed,
-                     const RepeatRunOptions& base) {
+                     const RepeatRunOptions& base, const RepeatObserver& first_run) {
   MAPLESS_CHECK(runs >= 1, "runs = " << runs << "; must be >= 1");
   EntryResult r;
   r.scenario = scenario.name;
@@ -53,7 +53,8 @@ EntryResult RunEntry(const sim::Scenario& scenario, const TaughtRoute& taught,
     const double speed = RepeatSpeedFor(scenario, base.max_repeat_speed_mps);
     o.repeat.sloped.max_speed_mps = speed;
     o.repeat.standard.forward_speed_mps = speed;
-    const RepeatRun run = RepeatOnSimulator(scenario, taught, o);
+    const RepeatRun run =
+        RepeatOnSimulator(scenario, taught, o, i == 0 ? first_run : RepeatObserver{});
     r.paths.push_back(run.path);
     finals.push_back(run.final_error_m);
     for (const Pose2& p : run.path) {

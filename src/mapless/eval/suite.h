@@ -37,9 +37,10 @@ struct EntryResult {
 
 // Runs one entry: the route is taught once (clean), then repeated `runs` times with seeds
 // seed, seed + 1, ... The repeat drives at the scenario's teach speed, capped at
-// base.max_repeat_speed_mps but not below half the teach speed.
+// base.max_repeat_speed_mps but not below half the teach speed. `first_run` (if set) observes
+// every frame of the first run (for reports).
 EntryResult RunEntry(const sim::Scenario& scenario, const TaughtRoute& taught,
                      navigation::Controller controller, int runs, std::uint64_t seed,
-                     const RepeatRunOptions& base);
+                     const RepeatRunOptions& base, const RepeatObserver& first_run = {});
 
 }  // namespace mapless::eval

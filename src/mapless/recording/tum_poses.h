@@ -21,8 +21,8 @@ std::vector<io::StampedPose> ReadPoses(const std::string& path);
 inline constexpr double kPosesCoverS = 1.0;
 
 // The poses as the frames' odometry. Frame times are shifted by the first pose's time (a folder's
-// frames are index / fps from 0, a video's from its first frame), then each frame carries the newest
-// pose not later than its time (1 ms of rounding allowed), as with an odometry topic.
+// frames are index / fps from 0, a video's from its first frame), then each frame carries the
+// newest pose not later than its time (1 ms of rounding allowed), as with an odometry topic.
 std::unique_ptr<io::FrameSource> WithPoses(std::unique_ptr<io::FrameSource> source,
                                            std::vector<io::StampedPose> poses);
 
