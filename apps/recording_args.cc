@@ -4,6 +4,7 @@
 
 #include "cli_common.h"
 #include "mapless/core/check.h"
+#include "mapless/recording/camera_info_yaml.h"
 #include "mapless/recording/recording_link.h"
 
 namespace mapless::app {
@@ -20,6 +21,10 @@ void AddRecordOptions(CLI::App* cmd, RecordArgs* args) {
   cmd->add_option("--record-compression", args->compression, "MCAP chunks: zstd, lz4 or none")
       ->capture_default_str()
       ->check(CLI::IsMember({"zstd", "lz4", "none"}));
+  cmd->add_option("--camera-info", args->camera_info,
+                  "With --record: the camera's intrinsics (ROS camera_info YAML, as "
+                  "camera_calibration writes it), recorded as sensor_msgs/CameraInfo with every "
+                  "frame");
 }
 
 void AddPlaybackOptions(CLI::App* cmd, recording::PlaybackOptions* options, bool with_rate) {
@@ -46,7 +51,13 @@ void AddPlaybackOptions(CLI::App* cmd, recording::PlaybackOptions* options, bool
 
 std::unique_ptr<recording::RunRecorder> OpenRecorder(
     const RecordArgs& args, std::optional<rosmsg::CameraInfoFields> camera_info) {
-  if (args.path.empty()) return nullptr;
+  if (args.path.empty()) {
+    if (!args.camera_info.empty())
+      throw InputError("--camera-info " + args.camera_info +
+                       ": the intrinsics go into recordings; give --record FILE.mcap too");
+    return nullptr;
+  }
+  if (!args.camera_info.empty()) camera_info = recording::LoadCameraInfoYaml(args.camera_info);
   recording::RunRecorderOptions options;
   options.images = args.images;
   options.mcap.compression = args.compression == "none" ? "" : args.compression;

@@ -17,9 +17,11 @@ struct RecordArgs {
   std::string path;
   std::string images = "raw";
   std::string compression = "zstd";
+  std::string camera_info;  // ROS camera_info YAML: the intrinsics recorded with every frame
 };
 
-// --record FILE, --record-images raw|png|jpeg, --record-compression zstd|lz4|none.
+// --record FILE, --record-images raw|png|jpeg, --record-compression zstd|lz4|none,
+// --camera-info FILE.yaml.
 void AddRecordOptions(CLI::App* cmd, RecordArgs* args);
 
 // --topic, --odom-topic, --start, --loop, and --rate unless `with_rate` is false (a command whose
@@ -27,7 +29,8 @@ void AddRecordOptions(CLI::App* cmd, RecordArgs* args);
 void AddPlaybackOptions(CLI::App* cmd, recording::PlaybackOptions* options, bool with_rate = true);
 
 // The recorder --record asks for (nullptr without it). Created before the run starts, so a bad
-// path fails before anything moves.
+// path fails before anything moves. `camera_info`: the intrinsics where mapless knows them (the
+// simulator); --camera-info FILE.yaml replaces them.
 std::unique_ptr<recording::RunRecorder> OpenRecorder(
     const RecordArgs& args, std::optional<rosmsg::CameraInfoFields> camera_info = std::nullopt);
 

@@ -164,6 +164,9 @@ expect_exit "eigenspace teach of a folder with poses" 0 "$MAPLESS" teach --metho
 grep -q '"complete": true' "$TMP/eroute/appearance.json" && [ "$(ls "$TMP/eroute/images" | wc -l)" -ge 10 ]; check "eigenspace route from a folder with poses is complete, >= 10 images" $?
 expect_exit "poses with a recording exits 2" 2 "$MAPLESS" teach --source "$TMP/none.mcap" --poses "$TMP/d1/odometry.tum" --out "$TMP/eroute1"
 grep -q "has its own odometry topic" "$TMP/err"; check "--poses with a recording is refused" $?
+printf 'image_width: 320\nimage_height: 240\ncamera_matrix: {rows: 3, cols: 2, data: [1, 0, 0, 1, 0, 0]}\n' > "$TMP/cam.yaml"
+expect_exit "a 3x2 camera matrix exits 2" 2 "$MAPLESS" teach --source sim:rotation_in_place --out "$TMP/camroute" --record "$TMP/cam.mcap" --camera-info "$TMP/cam.yaml"
+grep -q "cam.yaml:3:.*camera_matrix.*expected 3 x 3" "$TMP/err" && [ ! -e "$TMP/cam.mcap" ] && [ ! -e "$TMP/camroute" ]; check "camera_info YAML errors name the file, line and field; nothing written" $?
 # ground on a source: one JSON line and one mask per frame that has a frame --step later.
 expect_exit "ground --source" 0 "$MAPLESS" ground --source "$TMP/d1/frames" --max-frames 4 --step 2 --out-dir "$TMP/masks" --log "$TMP/ground.jsonl"
 [ "$(wc -l <"$TMP/ground.jsonl")" -eq 4 ] && [ "$(ls "$TMP/masks" | grep -c '\.png$')" -eq 4 ] && grep -q '"plane_fraction":' "$TMP/ground.jsonl"; check "ground --source: 4 lines, 4 masks" $?

@@ -92,6 +92,12 @@ void RunRecorder::Image(Timestamp t_ns, const cv::Mat& grey) {
   }
   if (options_.camera_info) {
     rosmsg::CameraInfoFields info = *options_.camera_info;
+    if (info.width != static_cast<std::uint32_t>(grey.cols) ||
+        info.height != static_cast<std::uint32_t>(grey.rows)) {
+      throw InputError("camera info: the intrinsics are for " + std::to_string(info.width) + "x" +
+                       std::to_string(info.height) + " images but the camera's are " +
+                       std::to_string(grey.cols) + "x" + std::to_string(grey.rows));
+    }
     info.header = header;
     Write(kCameraInfoTopic, "sensor_msgs/msg/CameraInfo", t_ns,
           View(rosmsg::EncodeCameraInfo(info)));
