@@ -17,6 +17,7 @@
 #include "mapless/io/output_dir.h"
 #include "mapless/recording/recording_link.h"
 #include "mapless/robot/methods.h"
+#include "mapless/route/appearance_store.h"
 #include "mapless/route/route_store.h"
 #include "recording_args.h"
 #include "robot_run.h"
@@ -255,10 +256,34 @@ void AddTeachRepeatCommands(CLI::App* app) {
   info->add_option("ROUTE", i->route, "Route directory")->required();
   info->add_flag("--json", i->json, "Print one JSON object");
   info->callback([i] {
+    if (std::filesystem::exists(std::filesystem::path(i->route) / "appearance.json") &&
+        !std::filesystem::exists(std::filesystem::path(i->route) / "manifest.json")) {
+      // An appearance route (teach --method eigenspace).
+      const route::StoredAppearanceRoute a = route::LoadAppearanceRoute(i->route);
+      nlohmann::json j;
+      j["kind"] = "appearance";
+      j["images"] = a.images.size();
+      j["complete"] = a.complete;
+      j["image_width"] = a.image_width;
+      j["image_height"] = a.image_height;
+      j["low_width"] = a.low_width;
+      j["low_height"] = a.low_height;
+      j["length_m"] = a.images.empty() ? 0.0 : a.images.back().distance_m;
+      if (i->json) {
+        std::cout << j.dump() << "\n";
+      } else {
+        std::printf("%s: appearance route of %zu images (%s), %dx%d camera, %dx%d stored, %.1f m\n",
+                    i->route.c_str(), a.images.size(),
+                    a.complete ? "complete" : "INTERRUPTED teach", a.image_width, a.image_height,
+                    a.low_width, a.low_height, j["length_m"].get<double>());
+      }
+      return;
+    }
     const route::Route route = route::LoadRoute(i->route);
     std::size_t keypoints = 0;
     for (const auto& kf : route.keyframes) keypoints += kf.keypoints.size();
     nlohmann::json j;
+    j["kind"] = "keyframes";
     j["keyframes"] = route.keyframes.size();
     j["complete"] = route.complete;
     j["detector"] = route.detector;

@@ -161,7 +161,8 @@ head -1 "$TMP/rep.jsonl" | grep -q '"destination":' && head -1 "$TMP/rep.jsonl" 
 expect_exit "eigenspace teach of a folder without poses exits 2" 2 "$MAPLESS" teach --method eigenspace --source "$TMP/d1/frames" --out "$TMP/eroute0"
 grep -q "with --poses FILE.tum" "$TMP/err"; check "eigenspace teach asks for --poses" $?
 expect_exit "eigenspace teach of a folder with poses" 0 "$MAPLESS" teach --method eigenspace --source "$TMP/d1/frames" --poses "$TMP/d1/odometry.tum" --out "$TMP/eroute"
-grep -q '"complete": true' "$TMP/eroute/appearance.json" && [ "$(ls "$TMP/eroute/images" | wc -l)" -ge 10 ]; check "eigenspace route from a folder with poses is complete, >= 10 images" $?
+expect_exit "route info of an appearance route" 0 "$MAPLESS" route info "$TMP/eroute" --json
+grep -q '"kind":"appearance"' "$TMP/out" && grep -q '"complete":true' "$TMP/out" && grep -Eq '"images":([1-9][0-9]+)[,}]' "$TMP/out"; check "eigenspace route from a folder with poses is complete, >= 10 images" $?
 expect_exit "poses with a recording exits 2" 2 "$MAPLESS" teach --source "$TMP/none.mcap" --poses "$TMP/d1/odometry.tum" --out "$TMP/eroute1"
 grep -q "has its own odometry topic" "$TMP/err"; check "--poses with a recording is refused" $?
 printf 'image_width: 320\nimage_height: 240\ncamera_matrix: {rows: 3, cols: 2, data: [1, 0, 0, 1, 0, 0]}\n' > "$TMP/cam.yaml"
