@@ -69,10 +69,18 @@ void RequirePositive(const YamlMap& m, const std::string& key, double v) {
 void ParseObject(const YamlMap& m, std::uint64_t seed, const std::string& base_dir,
                  std::vector<WorldObject>* out) {
   m.CheckKnownKeys({"type", "tag", "texture", "points", "min", "max", "center", "size_m",
-                    "height_m", "radius_m", "yaw_deg", "facing_deg", "repeat"});
+                    "height_m", "radius_m", "yaw_deg", "facing_deg", "repeat", "appears_s",
+                    "leaves_s"});
   const std::string type = m.GetString("type");
   WorldObject o;
   o.tag = m.GetString("tag", "");
+  o.appears_s = m.GetDouble("appears_s", 0.0);
+  if (!(o.appears_s >= 0.0 && o.appears_s < 1e6)) m.Fail("appears_s", "must be in [0, 1e6) s");
+  if (m.Has("leaves_s")) {
+    o.leaves_s = m.GetDouble("leaves_s");
+    if (!(o.leaves_s > o.appears_s && o.leaves_s < 1e6))
+      m.Fail("leaves_s", "must be after appears_s and below 1e6 s");
+  }
   o.texture = m.Has("texture") ? ParseTexture(m.GetMap("texture"), seed, base_dir) : TextureSpec{};
   if (!m.Has("texture")) o.texture.seed = seed;
   std::vector<WorldObject> made;
@@ -410,14 +418,30 @@ static Scenario ParseScenarioUnchecked(const std::string& yaml_text, const std::
     if (repeat.Has("start")) s.repeat_start = PoseDeg(repeat, "start");
     if (repeat.Has("variant")) {
       const YamlMap v = repeat.GetMap("variant");
-      v.CheckKnownKeys({"remove", "move"});
+      v.CheckKnownKeys({"remove", "move", "add", "leave_s"});
       if (v.Has("remove")) s.repeat_variant.remove = v.GetStrings("remove");
       if (v.Has("move")) {
         const YamlMap mv = v.GetMap("move");
         for (const std::string& tag : mv.Keys()) s.repeat_variant.move_m[tag] = Vec2(mv, tag);
       }
+      if (v.Has("add")) {
+        const auto objects = v.GetMapList("add");
+        for (std::size_t i = 0; i < objects.size(); ++i) {
+          ParseObject(objects[i], MixSeed(s.seed, 5000 + i), base_dir, &s.repeat_variant.add);
+          if (s.repeat_variant.add.size() > kMaxWorldObjects)
+            v.Fail("add", "more than " + std::to_string(kMaxWorldObjects) + " objects");
+        }
+      }
+      if (v.Has("leave_s")) {
+        const YamlMap l = v.GetMap("leave_s");
+        for (const std::string& tag : l.Keys()) {
+          const double t = l.GetDouble(tag);
+          if (!(t >= 0.0 && t < 1e6)) l.Fail(tag, "must be in [0, 1e6) s");
+          s.repeat_variant.leave_s[tag] = t;
+        }
+      }
       try {
-        ApplyVariant(s.world, s.repeat_variant);
+        ApplyVariant(s.world, s.repeat_variant).Validate();
       } catch (const InputError& e) {
         v.Fail("", e.what());
       }

@@ -97,6 +97,45 @@ TEST(Scenario, UnknownFieldAndUnknownTagAreErrors) {
             std::string::npos);
 }
 
+// At repeat time a box is new on the path and the parked car drives off after 5 s.
+TEST(Scenario, VariantsAddObjectsAndTimeTheirLeaving) {
+  const std::string text = std::string(kMinimal) +
+                           "repeat:\n  variant:\n    add:\n      - {type: box, tag: parcel, "
+                           "center: [1, 0], size_m: [0.4, 0.4, 0.4]}\n    leave_s: {car: 5}\n";
+  const Scenario s = ParseScenario(text, "t.yaml", "");
+  const World repeat = ApplyVariant(s.world, s.repeat_variant);
+  ASSERT_EQ(repeat.objects.size(), 2u);
+  EXPECT_EQ(repeat.objects[1].tag, "parcel");
+  EXPECT_EQ(repeat.objects[0].leaves_s, 5.0);
+  EXPECT_EQ(WorldAt(repeat, 4.9).objects.size(), 2u);
+  ASSERT_EQ(WorldAt(repeat, 5.0).objects.size(), 1u);
+  EXPECT_EQ(WorldAt(repeat, 5.0).objects[0].tag, "parcel");
+  EXPECT_EQ(ChangeTimes(repeat), std::vector<double>{5.0});
+  // The teach world is untouched.
+  EXPECT_EQ(s.world.objects.size(), 1u);
+  EXPECT_FALSE(s.world.objects[0].timed());
+  // An object's own times; errors name the field.
+  const std::string timed = std::string(kMinimal) +
+                            "repeat:\n  variant:\n    add:\n      - {type: cylinder, center: [1, "
+                            "0], radius_m: 0.2, appears_s: 2, leaves_s: 9}\n";
+  const World w = ApplyVariant(ParseScenario(timed, "t.yaml", "").world,
+                               ParseScenario(timed, "t.yaml", "").repeat_variant);
+  EXPECT_EQ(ChangeTimes(w), (std::vector<double>{2.0, 9.0}));
+  EXPECT_EQ(WorldAt(w, 1.0).objects.size(), 1u);
+  EXPECT_EQ(WorldAt(w, 3.0).objects.size(), 2u);
+  const std::string backwards = std::string(kMinimal) +
+                                "repeat:\n  variant:\n    add:\n      - {type: cylinder, center: "
+                                "[1, 0], radius_m: 0.2, appears_s: 4, leaves_s: 3}\n";
+  EXPECT_NE(testing::InputErrorOf([&] { ParseScenario(backwards, "t.yaml", ""); }).find("leaves_s"),
+            std::string::npos);
+  const std::string unknown =
+      std::string(kMinimal) + "repeat:\n  variant:\n    leave_s: {truck: 3}\n";
+  EXPECT_NE(testing::InputErrorOf([&] {
+              ParseScenario(unknown, "t.yaml", "");
+            }).find("no object has tag 'truck'"),
+            std::string::npos);
+}
+
 // The limits of docs/hardening.md, each named in its error; the built-in scenarios are far inside.
 TEST(Scenario, ValuesThatWouldHangOrExhaustTheSimulatorAreRefusedByName) {
   const auto error_of = [](const std::string& from, const std::string& to) {

@@ -27,10 +27,20 @@ void DriveOptions::Validate() const {
 
 Simulation::Simulation(const World& world, CameraSpec camera, SimulationOptions options,
                        std::uint64_t seed)
-    : world_(world), camera_(std::move(camera)), options_(options), seed_(seed) {
+    : all_objects_(world), camera_(std::move(camera)), options_(options), seed_(seed) {
   options_.Validate();
   camera_.Validate();
-  world_.Validate();
+  all_objects_.Validate();
+  changes_s_ = ChangeTimes(all_objects_);
+  world_ = changes_s_.empty() ? all_objects_ : WorldAt(all_objects_, 0.0);
+}
+
+void Simulation::UpdateTimedObjects() {
+  if (next_change_ >= changes_s_.size() || ToSeconds(t_ns_) < changes_s_[next_change_]) return;
+  while (next_change_ < changes_s_.size() && ToSeconds(t_ns_) >= changes_s_[next_change_])
+    ++next_change_;
+  world_ = WorldAt(all_objects_, ToSeconds(t_ns_));
+  renderer_.reset();  // rebuilt (with its textures) at the next render
 }
 
 const Renderer& Simulation::renderer() const {
@@ -80,6 +90,7 @@ void Simulation::Advance(double dt_s) {
       if (!stopped_[i]) robots_[i].Step(options_.physics_dt_s);
     }
     t_ns_ += FromSeconds(options_.physics_dt_s);
+    UpdateTimedObjects();
     CheckCollisions();
   }
 }

@@ -43,7 +43,8 @@ class Simulation {
   // Puts a robot at a pose, at rest (clears a collision stop).
   void PlaceRobot(int robot, const Pose2& pose);
   // Advances every robot by dt (rounded to whole physics steps); records collisions. A robot that
-  // collided stops and stays where it hit.
+  // collided stops and stays where it hit. Objects appear and leave at their times (WorldObject::
+  // appears_s, leaves_s), checked at every physics step.
   void Advance(double dt_s);
   Timestamp now_ns() const { return t_ns_; }
 
@@ -55,6 +56,7 @@ class Simulation {
 
   const std::vector<Collision>& collisions() const { return collisions_; }
   bool collided(int robot) const;
+  // The world now: the objects present at this time.
   const World& world() const { return world_; }
   const CameraSpec& camera() const { return camera_; }
   // The renderer; its textures are generated on first use (drives that never render skip that).
@@ -63,7 +65,11 @@ class Simulation {
  private:
   std::vector<Surface> OtherRobots(int robot) const;
   void CheckCollisions();
+  void UpdateTimedObjects();
 
+  World all_objects_;              // as given, with every object's times
+  std::vector<double> changes_s_;  // when an object appears or leaves
+  std::size_t next_change_ = 0;
   World world_;
   CameraSpec camera_;
   SimulationOptions options_;

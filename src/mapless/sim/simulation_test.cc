@@ -131,6 +131,54 @@ TEST(Simulation, DrivingIntoAWallIsACollisionEventAndTheRobotStops) {
   EXPECT_LT(ClearanceTo(s.world, at.x_m, at.y_m), s.robot.radius_m + 1e-9);
 }
 
+// A box on the path that is taken away at 3 s: seen and in the way before, gone after.
+TEST(Simulation, TimedObjectsAppearAndLeaveAtTheirTimes) {
+  const Scenario s = LoadScenario("corridor_25m");
+  World world = s.world;
+  WorldObject box;
+  box.kind = ObjectKind::kBox;
+  const Pose2 ahead = s.teach_start * Pose2{1.0, 0.0, 0.0};
+  box.center = {ahead.x_m, ahead.y_m};
+  box.size_m = {0.4, 0.6};
+  box.height_m = 0.5;
+  box.leaves_s = 3.0;
+  world.objects.push_back(box);
+  WorldObject late = box;  // put down at 2 s, behind the robot
+  const Pose2 behind = s.teach_start * Pose2{-1.0, 0.0, 0.0};
+  late.center = {behind.x_m, behind.y_m};
+  late.appears_s = 2.0;
+  late.leaves_s = std::numeric_limits<double>::infinity();
+  world.objects.push_back(late);
+  Simulation sim(world, s.camera, {}, 1);
+  const int r = sim.AddRobot(s.teach_start, s.robot);
+  Simulation empty(s.world, s.camera, {}, 1);
+  empty.AddRobot(s.teach_start, s.robot);
+  cv::Mat diff;
+  cv::absdiff(sim.RenderClean(r), empty.RenderClean(0), diff);
+  EXPECT_GT(cv::countNonZero(diff > 20), 1000);  // the box is in view
+  EXPECT_EQ(sim.world().objects.size(), s.world.objects.size() + 1);
+  sim.Advance(2.5);
+  EXPECT_EQ(sim.world().objects.size(), s.world.objects.size() + 2);
+  sim.Advance(0.6);  // 3.1 s: the box has gone
+  EXPECT_EQ(sim.world().objects.size(), s.world.objects.size() + 1);
+  cv::absdiff(sim.RenderClean(r), empty.RenderClean(0), diff);
+  EXPECT_EQ(cv::countNonZero(diff > 20), 0);  // the late one is behind the camera
+  // Driving through where the box stood is no collision any more.
+  for (int i = 0; i < 30; ++i) {
+    sim.SetCommand(r, Twist2{0.5, 0.0});
+    sim.Advance(0.1);
+  }
+  EXPECT_FALSE(sim.collided(r));
+  // Before 3 s the same drive hits it.
+  Simulation early(world, s.camera, {}, 1);
+  early.AddRobot(s.teach_start, s.robot);
+  for (int i = 0; i < 30 && !early.collided(0); ++i) {
+    early.SetCommand(0, Twist2{0.5, 0.0});
+    early.Advance(0.1);
+  }
+  EXPECT_TRUE(early.collided(0));
+}
+
 TEST(Simulation, TwoRobotsCollidingIsReported) {
   const Scenario s = LoadScenario("corridor_25m");
   Simulation sim(s.world, s.camera, {}, 1);

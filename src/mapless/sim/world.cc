@@ -93,6 +93,10 @@ void World::Validate() const {
     MAPLESS_CHECK(
         o.kind != ObjectKind::kCylinder || size_ok(o.radius_m),
         name << ".radius_m = " << o.radius_m << "; must be in (0, " << kMaxObjectSizeM << "]");
+    MAPLESS_CHECK(std::isfinite(o.appears_s) && o.appears_s >= 0.0 && !std::isnan(o.leaves_s) &&
+                      o.leaves_s > o.appears_s,
+                  name << ": appears at " << o.appears_s << " s, leaves at " << o.leaves_s
+                       << " s; expected 0 <= appears < leaves");
     switch (o.kind) {
       case ObjectKind::kWall:
         MAPLESS_CHECK((o.b - o.a).norm() > 1e-6, name << ": wall ends must differ");
@@ -121,6 +125,13 @@ World ApplyVariant(const World& world, const WorldVariant& variant) {
   for (const auto& [tag, delta] : variant.move_m) {
     MAPLESS_CHECK(has_tag(tag), "variant.move: no object has tag '" << tag << "'");
   }
+  for (const auto& [tag, t] : variant.leave_s) {
+    const bool added = std::any_of(variant.add.begin(), variant.add.end(),
+                                   [&](const WorldObject& o) { return o.tag == tag; });
+    MAPLESS_CHECK(has_tag(tag) || added, "variant.leave_s: no object has tag '" << tag << "'");
+    MAPLESS_CHECK(std::isfinite(t) && t >= 0.0,
+                  "variant.leave_s." << tag << " = " << t << "; must be a time >= 0 s");
+  }
   World out = world;
   out.objects.clear();
   for (const WorldObject& o : world.objects) {
@@ -137,6 +148,30 @@ World ApplyVariant(const World& world, const WorldVariant& variant) {
     }
     out.objects.push_back(moved);
   }
+  out.objects.insert(out.objects.end(), variant.add.begin(), variant.add.end());
+  for (WorldObject& o : out.objects) {
+    const auto it = variant.leave_s.find(o.tag);
+    if (!o.tag.empty() && it != variant.leave_s.end()) o.leaves_s = it->second;
+  }
+  return out;
+}
+
+World WorldAt(const World& world, double t_s) {
+  World out = world;
+  out.objects.clear();
+  for (const WorldObject& o : world.objects)
+    if (o.appears_s <= t_s && t_s < o.leaves_s) out.objects.push_back(o);
+  return out;
+}
+
+std::vector<double> ChangeTimes(const World& world) {
+  std::vector<double> out;
+  for (const WorldObject& o : world.objects) {
+    if (o.appears_s > 0.0) out.push_back(o.appears_s);
+    if (std::isfinite(o.leaves_s) && o.leaves_s > 0.0) out.push_back(o.leaves_s);
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
 }
 

@@ -5,6 +5,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -40,6 +42,11 @@ struct WorldObject {
   double radius_m = 0.2;
   double yaw_rad = 0.0;
   double z_m = 1.0;
+  // Simulated time (s) at which the object is put down and taken away: it is in the world for
+  // appears_s <= t < leaves_s (a box left on the path, a parked car that drives off).
+  double appears_s = 0.0;
+  double leaves_s = std::numeric_limits<double>::infinity();
+  bool timed() const { return appears_s > 0.0 || std::isfinite(leaves_s); }
 };
 
 struct World {
@@ -53,14 +60,23 @@ struct World {
   void Validate() const;  // throws InputError naming the object and field
 };
 
-// A variant of a world: objects removed or moved by tag.
+// A variant of a world (what has changed at repeat time): objects removed or moved by tag, objects
+// that are new, and objects that leave during the repeat.
 struct WorldVariant {
   std::vector<std::string> remove;                // tags to remove
   std::map<std::string, Eigen::Vector2d> move_m;  // tag -> displacement (dx, dy)
+  std::vector<WorldObject> add;                   // new objects (they may carry their own times)
+  std::map<std::string, double> leave_s;          // tag -> simulated time (s) it leaves at
 };
 
-// Returns the world with the variant applied; throws InputError for a tag no object has.
+// Returns the world with the variant applied (remove, move, add, then the leaving times); throws
+// InputError for a tag no object has.
 World ApplyVariant(const World& world, const WorldVariant& variant);
+
+// The objects in the world at simulated time t_s (appears_s <= t_s < leaves_s).
+World WorldAt(const World& world, double t_s);
+// The times (s, > 0, sorted, distinct) at which an object of `world` appears or leaves.
+std::vector<double> ChangeTimes(const World& world);
 
 // Distance from point (x, y) to the nearest obstacle footprint (walls, boxes, cylinders; posters
 // hang on walls and do not count). Negative inside a box or cylinder.
