@@ -16,6 +16,7 @@
 #include "mapless/io/tum.h"
 #include "mapless/navigation/potential.h"
 #include "mapless/recording/bag_check.h"
+#include "mapless/recording/camera_info_yaml.h"
 #include "mapless/recording/mcap_reader.h"
 #include "mapless/recording/mcap_source.h"
 #include "mapless/robot/camera_image.h"
@@ -70,6 +71,23 @@ void Flo(const std::string& input) {
 
 void Tum(const std::string& input) {
   AcceptInputError([&] { io::ParseTum(input, "fuzz.txt"); });
+}
+
+void CameraInfo(const std::string& input) {
+  rosmsg::CameraInfoFields info;
+  try {
+    info = recording::ParseCameraInfoYaml(input, "fuzz.yaml");
+  } catch (const InputError&) {
+    return;
+  }
+  // What mapless writes it reads back, the same (an InputError here is a bug: it escapes).
+  const rosmsg::CameraInfoFields again =
+      recording::ParseCameraInfoYaml(recording::FormatCameraInfoYaml(info), "again.yaml");
+  if (again.k != info.k || again.d != info.d || again.r != info.r || again.p != info.p ||
+      again.width != info.width || again.height != info.height ||
+      again.distortion_model != info.distortion_model) {
+    std::abort();
+  }
 }
 
 namespace {
@@ -343,7 +361,8 @@ const std::vector<NamedHarness>& Harnesses() {
                                                       {"camera_message", CameraMessage},
                                                       {"fleet_record", FleetRecord},
                                                       {"mcap", McapFile},
-                                                      {"rosbag", RosBag}};
+                                                      {"rosbag", RosBag},
+                                                      {"camera_info", CameraInfo}};
   return harnesses;
 }
 

@@ -24,6 +24,7 @@ void Config(const std::string& input);         // run configuration YAML (--conf
 void Calibration(const std::string& input);    // planar-flow calibration YAML (navigate)
 void Flo(const std::string& input);            // Middlebury .flo
 void Tum(const std::string& input);            // TUM trajectory text
+void CameraInfo(const std::string& input);     // ROS camera_info YAML (--camera-info)
 // The image-folder front end: the input as one to three image files of a folder (split at the
 // marker "\xffNXT"), opened and read to the end by io::OpenFrameSource, limits included.
 void ImageFolder(const std::string& input);

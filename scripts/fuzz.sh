@@ -7,7 +7,7 @@
 #     -t SECONDS  time limit per target (default 600)
 #     TARGET      route_manifest route_keyframe scenario config calibration flo tum image_folder
 #                 video_file scenario_world robot_file appearance_manifest camera_message
-#                 fleet_record mcap rosbag
+#                 fleet_record mcap rosbag camera_info
 #                 (default: all)
 #
 # Each target starts from fuzz/corpus/<target>/ (kept inputs) and grows a working corpus in
@@ -32,7 +32,8 @@ shift $((OPTIND - 1))
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
   targets=(route_manifest route_keyframe scenario config calibration flo tum image_folder video_file
-           scenario_world robot_file appearance_manifest camera_message fleet_record mcap rosbag)
+           scenario_world robot_file appearance_manifest camera_message fleet_record mcap rosbag
+           camera_info)
 fi
 
 bash scripts/setup.sh

@@ -1,5 +1,7 @@
 #include "mapless/recording/camera_info_yaml.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <sstream>
 
@@ -53,6 +55,13 @@ rosmsg::CameraInfoFields ParseCameraInfoYaml(const std::string& text, const std:
       y.Fail("camera_matrix", "the focal lengths fx, fy (data[0], data[4]) must be positive");
     std::copy(k.begin(), k.end(), info.k.begin());
     info.distortion_model = y.GetString("distortion_model", "plumb_bob");
+    // ROS names them plumb_bob, rational_polynomial, equidistant: a plain word.
+    if (info.distortion_model.empty() || info.distortion_model.size() > 64 ||
+        !std::all_of(info.distortion_model.begin(), info.distortion_model.end(), [](char c) {
+          return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+        })) {
+      y.Fail("distortion_model", "expected a model name such as plumb_bob (letters, digits, _)");
+    }
     if (y.Has("distortion_coefficients")) info.d = Matrix(y, "distortion_coefficients", 1, -1);
     info.r = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     if (y.Has("rectification_matrix")) {

@@ -125,7 +125,9 @@ World ApplyVariant(const World& world, const WorldVariant& variant) {
   for (const auto& [tag, delta] : variant.move_m) {
     MAPLESS_CHECK(has_tag(tag), "variant.move: no object has tag '" << tag << "'");
   }
-  for (const auto& [tag, t] : variant.leave_s) {
+  for (const auto& leaving : variant.leave_s) {
+    const std::string& tag = leaving.first;
+    const double t = leaving.second;
     const bool added = std::any_of(variant.add.begin(), variant.add.end(),
                                    [&](const WorldObject& o) { return o.tag == tag; });
     MAPLESS_CHECK(has_tag(tag) || added, "variant.leave_s: no object has tag '" << tag << "'");
