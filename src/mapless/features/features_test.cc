@@ -145,7 +145,8 @@ TEST(MatchFeatures, BinaryMatchesAreExactlyOpenCvBruteForceMatches) {
       for (int k = 0; k < 3; ++k) {
         const double x = 0.5 + 1.5 * k;
         const Features a = extractor.Extract(SimFrame(scenario, Pose2{x, 0.05, 0.02}));
-        const Features b = extractor.Extract(SimFrame(scenario, Pose2{x + 0.4 + 0.3 * k, 0.0, 0.0}));
+        const Features b =
+            extractor.Extract(SimFrame(scenario, Pose2{x + 0.4 + 0.3 * k, 0.0, 0.0}));
         for (int variant = 0; variant < 4; ++variant) {
           MatchOptions m;
           m.ratio = 0.8;
@@ -157,7 +158,8 @@ TEST(MatchFeatures, BinaryMatchesAreExactlyOpenCvBruteForceMatches) {
           }
           const auto got = MatchFeatures(a, b, m);
           const auto want = BfMatcherReference(a, b, m);
-          ASSERT_EQ(got.size(), want.size()) << scenario << " " << detector << " " << k << " " << variant;
+          ASSERT_EQ(got.size(), want.size())
+              << scenario << " " << detector << " " << k << " " << variant;
           for (std::size_t i = 0; i < got.size(); ++i) {
             EXPECT_EQ(got[i].queryIdx, want[i].queryIdx);
             EXPECT_EQ(got[i].trainIdx, want[i].trainIdx);

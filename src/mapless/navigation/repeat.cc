@@ -82,6 +82,15 @@ void RepeatOptions::Validate() const {
                 "RepeatOptions.guided_window_px = " << guided_window_px << "; must be >= 0");
   MAPLESS_CHECK(guided_release_s > 0.0,
                 "RepeatOptions.guided_release_s = " << guided_release_s << "; must be > 0");
+  MAPLESS_CHECK(recovery_keyframes >= 0,
+                "RepeatOptions.recovery_keyframes = " << recovery_keyframes << "; must be >= 0");
+  MAPLESS_CHECK(recovery_time_factor > 0.0,
+                "RepeatOptions.recovery_time_factor = " << recovery_time_factor << "; must be > 0");
+  MAPLESS_CHECK(recovery_min_features >= 2, "RepeatOptions.recovery_min_features = "
+                                                << recovery_min_features << "; must be >= 2");
+  MAPLESS_CHECK(
+      recovery_after_s >= 0.0 && recovery_after_s < abort_after_s,
+      "RepeatOptions.recovery_after_s = " << recovery_after_s << "; must be in [0, abort_after_s)");
   MAPLESS_CHECK(mse_rising_frames >= 1,
                 "RepeatOptions.mse_rising_frames = " << mse_rising_frames << "; must be >= 1");
 }
@@ -135,51 +144,90 @@ std::vector<control::FeaturePair> RepeatSession::Pairs() const {
   return pairs;
 }
 
-void RepeatSession::DetectAndMatch(const cv::Mat& grey, RepeatStep* step) {
-  const features::Features current = extractor_.Extract(grey);
-  const auto& kf = keyframe_features_[static_cast<std::size_t>(destination_)];
+void RepeatSession::MatchKeyframe(int k, std::vector<cv::Point2f>* current_px,
+                                  std::vector<cv::Point2f>* keyframe_px) const {
+  const auto& kf = keyframe_features_[static_cast<std::size_t>(k)];
   features::MatchOptions matching = options_.matching;
-  if (options_.guided_window_px > 0.0 && have_expected_dx_) {
+  if (options_.guided_window_px > 0.0 && have_expected_dx_ && k == destination_) {
     matching.expected_dx_px = expected_dx_;
     matching.max_ddx_px = options_.guided_window_px;
   }
-  const std::vector<cv::DMatch> matches = features::MatchFeatures(current, kf, matching);
-  current_px_.clear();
-  destination_px_.clear();
+  const std::vector<cv::DMatch> matches = features::MatchFeatures(current_, kf, matching);
+  current_px->clear();
+  keyframe_px->clear();
   for (const auto& m : matches) {
-    current_px_.push_back(current.keypoints[static_cast<std::size_t>(m.queryIdx)].pt);
-    destination_px_.push_back(kf.keypoints[static_cast<std::size_t>(m.trainIdx)].pt);
+    current_px->push_back(current_.keypoints[static_cast<std::size_t>(m.queryIdx)].pt);
+    keyframe_px->push_back(kf.keypoints[static_cast<std::size_t>(m.trainIdx)].pt);
   }
   // Outlier rejection: matches must agree with one epipolar geometry, or, for a rotation in place
   // or a distant scene (where the epipolar geometry degenerates), with one homography. Whichever
   // model explains more matches wins. Neither needs calibration.
-  if (options_.ransac_threshold_px > 0.0 && current_px_.size() >= 12) {
+  if (options_.ransac_threshold_px > 0.0 && current_px->size() >= 12) {
     std::vector<uchar> inlier_f;
     std::vector<uchar> inlier_h;
-    const cv::Mat f = cv::findFundamentalMat(current_px_, destination_px_, cv::FM_RANSAC,
+    const cv::Mat f = cv::findFundamentalMat(*current_px, *keyframe_px, cv::FM_RANSAC,
                                              options_.ransac_threshold_px, 0.99, inlier_f);
-    const cv::Mat hom = cv::findHomography(current_px_, destination_px_, cv::RANSAC,
+    const cv::Mat hom = cv::findHomography(*current_px, *keyframe_px, cv::RANSAC,
                                            options_.ransac_threshold_px, inlier_h);
     const auto count = [](const std::vector<uchar>& m) {
       return std::count(m.begin(), m.end(), 1);
     };
-    const long nf = f.empty() || inlier_f.size() != current_px_.size() ? 0 : count(inlier_f);
-    const long nh = hom.empty() || inlier_h.size() != current_px_.size() ? 0 : count(inlier_h);
+    const long nf = f.empty() || inlier_f.size() != current_px->size() ? 0 : count(inlier_f);
+    const long nh = hom.empty() || inlier_h.size() != current_px->size() ? 0 : count(inlier_h);
     if (nf > 0 || nh > 0) {
       const std::vector<uchar>& inlier = nf >= nh ? inlier_f : inlier_h;
       std::vector<cv::Point2f> cur, dst;
       for (std::size_t i = 0; i < inlier.size(); ++i) {
         if (!inlier[i]) continue;
-        cur.push_back(current_px_[i]);
-        dst.push_back(destination_px_[i]);
+        cur.push_back((*current_px)[i]);
+        dst.push_back((*keyframe_px)[i]);
       }
-      current_px_ = std::move(cur);
-      destination_px_ = std::move(dst);
+      *current_px = std::move(cur);
+      *keyframe_px = std::move(dst);
     }
   }
+}
+
+void RepeatSession::DetectAndMatch(const cv::Mat& grey, RepeatStep* step) {
+  current_ = extractor_.Extract(grey);
+  MatchKeyframe(destination_, &current_px_, &destination_px_);
   last_matches_ = static_cast<int>(current_px_.size());
   step->redetected = true;
   frames_since_detect_ = 0;
+}
+
+bool RepeatSession::Recover(RepeatStep* step) {
+  if (options_.recovery_keyframes <= 0 || !step->redetected) return false;
+  const auto& kfs = route_->keyframes;
+  const int known = static_cast<int>(kfs.size());
+  const auto taught_at = [&](int k) { return ToSeconds(kfs[static_cast<std::size_t>(k)].t_ns); };
+  for (int k = destination_ + 1; k <= destination_ + options_.recovery_keyframes && k < known;
+       ++k) {
+    // Keyframe k as the destination puts the robot past keyframe k - 1: the keyframe after the
+    // unmatched one always qualifies (the robot is somewhere before the unmatched keyframe, the
+    // next one is the next place it can head for), those farther only as far as the robot may
+    // have driven since the last switch.
+    const double taught_s = taught_at(k - 1) - taught_at(destination_);
+    if (taught_s > options_.recovery_time_factor * driven_since_switch_s_) break;
+    std::vector<cv::Point2f> cur, dst;
+    MatchKeyframe(k, &cur, &dst);
+    if (static_cast<int>(cur.size()) <
+        std::max(options_.recovery_min_features, options_.min_features)) {
+      continue;
+    }
+    step->recovered_from = destination_;
+    step->switched = true;
+    destination_ = k;
+    step->destination = k;
+    current_px_ = std::move(cur);
+    destination_px_ = std::move(dst);
+    last_matches_ = static_cast<int>(current_px_.size());
+    mse_.Reset();
+    switch_votes_ = 0;
+    driven_since_switch_s_ = 0.0;
+    return true;
+  }
+  return false;
 }
 
 RepeatStep RepeatSession::Stop(RepeatStep step, RepeatStatus status, const std::string& reason) {
@@ -196,6 +244,11 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
   step.destination = destination_;
   if (finished())
     return Stop(step, status_, status_ == RepeatStatus::kCompleted ? "route completed" : "aborted");
+  // Keyframe recovery's measure of progress: the time spent with a moving command.
+  if (have_last_t_ && (last_command_.v_mps != 0.0 || last_command_.omega_radps != 0.0))
+    driven_since_switch_s_ += std::max(0.0, ToSeconds(t_ns - last_t_ns_));
+  last_t_ns_ = t_ns;
+  have_last_t_ = true;
   const CameraCheck camera = camera_.Check(image, last_command_);
   if (!camera.usable()) {
     step.matches = last_matches_;
@@ -233,6 +286,7 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
     }
     // The leader taught the next keyframe: switch to it as at any segment switch.
     waiting_for_route_ = false;
+    driven_since_switch_s_ = 0.0;
     ++destination_;
     step.switched = true;
     step.destination = destination_;
@@ -265,6 +319,13 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
     DetectAndMatch(grey, &step);
   step.matches = last_matches_;
   step.tracked = static_cast<int>(current_px_.size());
+  // Keyframe recovery, once the destination has stayed unmatched for recovery_after_s (a
+  // shortage that passes by itself is waited out, not skipped).
+  if (step.tracked < options_.min_features && waiting_ &&
+      ToSeconds(t_ns - waiting_since_ns_) >= options_.recovery_after_s && Recover(&step)) {
+    step.matches = last_matches_;
+    step.tracked = static_cast<int>(current_px_.size());
+  }
   if (step.tracked < options_.min_features) {
     // Stop while features are insufficient; abort if that lasts too long.
     if (!waiting_) {
@@ -316,6 +377,7 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
       options_.switching != Switching::kMse || by_scale ? switch_votes_ >= confirm : mse_says;
   if (switch_now) {
     step.switched = true;
+    driven_since_switch_s_ = 0.0;
     ++destination_;
     mse_.Reset();
     switch_votes_ = 0;

@@ -64,8 +64,22 @@ struct RepeatOptions {
   // Also detect and match afresh every this many frames (0: only when features run short, as in
   // Algorithm 1). KLT tracks drift over long segments and bias StdRatio (the switch then comes
   // up to 1 m early or late); fresh matches do not. Default: every frame.
-  int redetect_every_frames = 1;
+  int redetect_every_frames = 3;
   double abort_after_s = 10.0;  // stopped this long without enough features: abort
+  // Keyframe recovery (not in the paper): while the destination keyframe cannot be matched (its
+  // landmarks gone: a parked car that has left), the current frame is also matched with the
+  // following keyframes, at most recovery_keyframes ahead: the one after the unmatched keyframe,
+  // and farther ones only as far as the robot may have driven: keyframe k - 1 taught at most
+  // recovery_time_factor times the time the robot has driven since the last switch after the
+  // unmatched keyframe (the funnel lane has no odometry; the time with a moving command is its
+  // measure). The nearest one with at least recovery_min_features matches becomes the
+  // destination; with none the robot stops and aborts as before. 0 keyframes: off (the paper).
+  // Recovery starts once the robot has waited recovery_after_s for its destination: a shortage
+  // that passes by itself (a few frames of blur) is waited out, not skipped.
+  int recovery_keyframes = 3;
+  double recovery_after_s = 2.0;
+  double recovery_time_factor = 1.5;
+  int recovery_min_features = 20;
   // Guided matching (not in the paper): matches must lie within this many pixels of the
   // horizontal displacement predicted from the previous frame (at a segment switch: the previous
   // displacement minus the teach-time shift between the two keyframes). A repeating texture then
@@ -93,6 +107,7 @@ struct RepeatStep {
   int tracked = 0;          // features in use this frame
   bool redetected = false;  // features were detected and matched this frame
   bool switched = false;    // the segment switched this frame
+  int recovered_from = -1;  // the switch skipped this keyframe, which could not be matched
   control::SwitchDecision switching;
   control::LocalScale local_scale;  // measured on the last segment only (end_by_local_scale)
   control::SlopedFunnelLaneResult sloped;
@@ -124,6 +139,13 @@ class RepeatSession {
  private:
   RepeatStep Decide(const cv::Mat& image, Timestamp t_ns);
   void DetectAndMatch(const cv::Mat& grey, RepeatStep* step);
+  // The current frame's features (extracted once per frame) matched with keyframe k, outliers
+  // rejected: current pixels and keyframe pixels.
+  void MatchKeyframe(int k, std::vector<cv::Point2f>* current_px,
+                     std::vector<cv::Point2f>* keyframe_px) const;
+  // Keyframe recovery (RepeatOptions::recovery_keyframes): the nearest following keyframe the
+  // robot may have reached that the current frame matches, switched to; false when none does.
+  bool Recover(RepeatStep* step);
   std::vector<control::FeaturePair> Pairs() const;
   RepeatStep Stop(RepeatStep step, RepeatStatus status, const std::string& reason);
 
@@ -146,6 +168,10 @@ class RepeatSession {
   int switch_votes_ = 0;
   bool waiting_for_route_ = false;  // passed the last keyframe of an incomplete route
   int frames_since_detect_ = 0;
+  features::Features current_;  // the features of the last frame detected afresh
+  Timestamp last_t_ns_ = 0;
+  bool have_last_t_ = false;
+  double driven_since_switch_s_ = 0.0;  // time with a moving command since the last switch
   bool waiting_ = false;
   Timestamp waiting_since_ns_ = 0;
 };

@@ -15,6 +15,7 @@ void RepeatFields(const navigation::RepeatStep& s, nlohmann::json* j) {
   (*j)["matches"] = s.matches;
   (*j)["tracked"] = s.tracked;
   (*j)["switched"] = s.switched;
+  if (s.recovered_from >= 0) (*j)["recovered_from"] = s.recovered_from;
   (*j)["std_ratio"] = s.switching.std_ratio;
   (*j)["ed_px"] = s.switching.ed_px;
   if (s.local_scale.ok) (*j)["local_scale"] = s.local_scale.ratio;
