@@ -55,8 +55,7 @@ TEST_F(KeyframeRecovery, ARepeatSkipsAKeyframeWhoseLandmarksAreGone) {
       << stuck.status;
 
   RepeatRunOptions on = off;
-  on.repeat.recovery_keyframes = RepeatRunOptions{}.repeat.recovery_keyframes;
-  ASSERT_GT(on.repeat.recovery_keyframes, 0);  // recovery is the default
+  on.repeat.recovery_keyframes = 3;
   const RepeatRun run = RepeatOnSimulator(scenario, broken, on);
   EXPECT_TRUE(run.success) << run.status << ", final error " << run.final_error_m;
   int recovered = 0;
@@ -77,6 +76,7 @@ TEST_F(KeyframeRecovery, AnIntactRouteIsRepeatedInOrder) {
   for (const std::uint64_t seed : {3u, 4u}) {
     RepeatRunOptions options;
     options.seed = seed;
+    options.repeat.recovery_keyframes = 3;
     const RepeatRun run = RepeatOnSimulator(*scenario_, *taught_, options);
     EXPECT_TRUE(run.success) << run.status;
     int last = 1;

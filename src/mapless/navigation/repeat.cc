@@ -88,9 +88,9 @@ void RepeatOptions::Validate() const {
                 "RepeatOptions.recovery_time_factor = " << recovery_time_factor << "; must be > 0");
   MAPLESS_CHECK(recovery_min_features >= 2, "RepeatOptions.recovery_min_features = "
                                                 << recovery_min_features << "; must be >= 2");
-  MAPLESS_CHECK(
-      recovery_after_s >= 0.0 && recovery_after_s < abort_after_s,
-      "RepeatOptions.recovery_after_s = " << recovery_after_s << "; must be in [0, abort_after_s)");
+  // recovery_after_s >= abort_after_s is allowed: the repeat then aborts before it recovers.
+  MAPLESS_CHECK(recovery_after_s >= 0.0,
+                "RepeatOptions.recovery_after_s = " << recovery_after_s << "; must be >= 0");
   MAPLESS_CHECK(mse_rising_frames >= 1,
                 "RepeatOptions.mse_rising_frames = " << mse_rising_frames << "; must be >= 1");
 }
