@@ -201,6 +201,8 @@ void AddEvalCommand(CLI::App* app) {
     std::string only;
     std::string switching = "stdratio";
     std::string end = "scale";
+    int redetect_every = navigation::RepeatOptions{}.redetect_every_frames;
+    int recover_keyframes = navigation::RepeatOptions{}.recovery_keyframes;
     std::string report;
   };
   auto args = std::make_shared<Args>();
@@ -232,6 +234,16 @@ void AddEvalCommand(CLI::App* app) {
                   "table1, funnel-scenarios: the last keyframe by scale, or by the switching rule "
                   "(switching)")
       ->capture_default_str();
+  cmd->add_option("--redetect-every", args->redetect_every,
+                  "table1, funnel-scenarios: detect and match afresh every N frames, KLT in "
+                  "between (0: Algorithm 1's)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000));
+  cmd->add_option("--recover-keyframes", args->recover_keyframes,
+                  "table1, funnel-scenarios: keyframe recovery, up to N following keyframes (0: "
+                  "off)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 20));
   cmd->add_option("--report", args->report,
                   "Write an HTML report (index.html: the results, each scenario from above with "
                   "every run, the error along the path; the first run's commands over time, its "
@@ -249,12 +261,19 @@ void AddEvalCommand(CLI::App* app) {
       return;
     }
     const bool teach_repeat = args->suite != "potential" && args->suite != "eigenspace";
-    if (!teach_repeat && (args->switching != "stdratio" || args->end != "scale"))
-      throw InputError("--switching and --end apply to table1 and funnel-scenarios, not " +
-                       args->suite);
+    const navigation::RepeatOptions defaults;
+    if (!teach_repeat && (args->switching != "stdratio" || args->end != "scale" ||
+                          args->redetect_every != defaults.redetect_every_frames ||
+                          args->recover_keyframes != defaults.recovery_keyframes))
+      throw InputError(
+          "--switching, --end, --redetect-every and --recover-keyframes apply to table1 and "
+          "funnel-scenarios, not " +
+          args->suite);
     eval::RepeatRunOptions base;
     base.repeat.switching = navigation::ParseSwitching(args->switching);
     base.repeat.end_by_local_scale = ParseEndByLocalScale(args->end);
+    base.repeat.redetect_every_frames = args->redetect_every;
+    base.repeat.recovery_keyframes = args->recover_keyframes;
     if (args->suite == "potential") {
       RunPotentialSuite(args->runs, args->seed, args->json, args->jobs, args->only, args->report);
       return;
@@ -299,6 +318,8 @@ void AddEvalCommand(CLI::App* app) {
     });
     nlohmann::json j = SuiteJson(args->suite, args->runs, args->seed);
     j["switching"] = args->switching;
+    j["redetect_every"] = args->redetect_every;
+    j["recover_keyframes"] = args->recover_keyframes;
     j["end"] = args->end;
     FILE* table = args->json ? stderr : stdout;
     std::fprintf(table, "%-30s %-9s %9s %10s %10s %10s %5s\n", "scenario", "control", "success",

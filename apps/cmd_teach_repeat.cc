@@ -86,6 +86,8 @@ void AddTeachRepeatCommands(CLI::App* app) {
     std::string controller = "sloped";
     std::string switching = "stdratio";
     std::string end = "scale";
+    int redetect_every = navigation::RepeatOptions{}.redetect_every_frames;
+    int recover_keyframes = navigation::RepeatOptions{}.recovery_keyframes;
     std::string log;
     std::uint64_t seed = 1;
     double motion_noise = 0.1;
@@ -124,6 +126,19 @@ void AddTeachRepeatCommands(CLI::App* app) {
                    "How the last keyframe is passed: scale (local scale of nearby features, "
                    "robust to a lateral offset) or switching (like every other keyframe)")
       ->capture_default_str();
+  repeat
+      ->add_option("--redetect-every", r->redetect_every,
+                   "Detect and match afresh every N frames, KLT tracking in between (0: only "
+                   "when features run short, as in Algorithm 1)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000));
+  repeat
+      ->add_option("--recover-keyframes", r->recover_keyframes,
+                   "Keyframe recovery: after 2 s waiting for an unmatched keyframe, also try up "
+                   "to N following keyframes (0: off, as in the paper; "
+                   "docs/teach_and_repeat.md#keyframe-recovery)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 20));
   repeat->add_option("--log", r->log,
                      "Per-frame decisions as JSON lines to this file (default: stdout; on a robot: "
                      "none, - for stdout)");
@@ -158,6 +173,8 @@ void AddTeachRepeatCommands(CLI::App* app) {
     options.controller = navigation::ParseController(r->controller);
     options.switching = navigation::ParseSwitching(r->switching);
     options.end_by_local_scale = ParseEndByLocalScale(r->end);
+    options.redetect_every_frames = r->redetect_every;
+    options.recovery_keyframes = r->recover_keyframes;
     options.features.type = features::ParseDetectorType(route->detector);
     if (!r->robot.empty()) {
       options.sloped.max_speed_mps = r->speed;
