@@ -269,8 +269,16 @@ std::vector<cv::DMatch> MatchFeatures(const Features& query, const Features& tra
   MAPLESS_CHECK(query.binary == train.binary && query.descriptors.cols == train.descriptors.cols,
                 "MatchFeatures: descriptors of different kinds");
   if (query.binary) return MatchBinary(query, train, options);
-  // Float descriptors (SIFT): OpenCV's brute-force matcher.
-  cv::BFMatcher matcher(cv::NORM_L2);
+  return MatchFeaturesBruteForce(query, train, options);  // float descriptors (SIFT)
+}
+
+std::vector<cv::DMatch> MatchFeaturesBruteForce(const Features& query, const Features& train,
+                                                const MatchOptions& options) {
+  std::vector<cv::DMatch> out;
+  if (query.descriptors.empty() || train.descriptors.empty()) return out;
+  MAPLESS_CHECK(query.binary == train.binary && query.descriptors.cols == train.descriptors.cols,
+                "MatchFeaturesBruteForce: descriptors of different kinds");
+  cv::BFMatcher matcher(query.binary ? cv::NORM_HAMMING : cv::NORM_L2);
   const bool guided = options.max_ddx_px < 1e8;
   cv::Mat mask;  // query x train, 1 where a match is allowed (guided matching only)
   if (guided) {

@@ -70,4 +70,10 @@ struct MatchOptions {
 std::vector<cv::DMatch> MatchFeatures(const Features& query, const Features& train,
                                       const MatchOptions& options);
 
+// The same matches with OpenCV's BFMatcher (the guided window as its mask), for any descriptor.
+// MatchFeatures uses it for float descriptors; binary ones have a faster matcher that gives
+// exactly these matches (tested against this function).
+std::vector<cv::DMatch> MatchFeaturesBruteForce(const Features& query, const Features& train,
+                                                const MatchOptions& options);
+
 }  // namespace mapless::features

@@ -86,54 +86,9 @@ TEST(MatchFeatures, GuidedMatchingResolvesARepeatingPattern) {
   EXPECT_TRUE(MatchFeatures(query, train, guided).empty());
 }
 
-// What MatchFeatures did with OpenCV's BFMatcher before the binary matcher of its own (kept here
-// as the reference: the matches must stay exactly these).
-std::vector<cv::DMatch> BfMatcherReference(const Features& query, const Features& train,
-                                           const MatchOptions& options) {
-  std::vector<cv::DMatch> out;
-  cv::BFMatcher matcher(cv::NORM_HAMMING);
-  const bool guided = options.max_ddx_px < 1e8;
-  cv::Mat mask;
-  if (guided) {
-    mask = cv::Mat::zeros(static_cast<int>(query.keypoints.size()),
-                          static_cast<int>(train.keypoints.size()), CV_8U);
-    for (int i = 0; i < mask.rows; ++i) {
-      const cv::Point2f& a = query.keypoints[static_cast<std::size_t>(i)].pt;
-      for (int j = 0; j < mask.cols; ++j) {
-        const cv::Point2f& b = train.keypoints[static_cast<std::size_t>(j)].pt;
-        mask.at<uchar>(i, j) = std::abs(a.x - b.x - options.expected_dx_px) <= options.max_ddx_px &&
-                               std::abs(a.y - b.y) <= options.max_dy_px;
-      }
-    }
-  }
-  std::vector<std::vector<cv::DMatch>> knn;
-  matcher.knnMatch(query.descriptors, train.descriptors, knn, 2, mask);
-  std::vector<int> best_query_for_train;
-  if (options.mutual) {
-    std::vector<cv::DMatch> back;
-    matcher.match(train.descriptors, query.descriptors, back,
-                  guided ? cv::Mat(mask.t()) : cv::Mat());
-    best_query_for_train.assign(train.keypoints.size(), -1);
-    for (const auto& m : back)
-      best_query_for_train[static_cast<std::size_t>(m.queryIdx)] = m.trainIdx;
-  }
-  for (const auto& k : knn) {
-    if (k.empty()) continue;
-    if (k.size() >= 2 && !(k[0].distance < options.ratio * k[1].distance)) continue;
-    const cv::Point2f& a = query.keypoints[static_cast<std::size_t>(k[0].queryIdx)].pt;
-    const cv::Point2f& b = train.keypoints[static_cast<std::size_t>(k[0].trainIdx)].pt;
-    if (std::abs(b.y - a.y) > options.max_dy_px) continue;
-    if (options.mutual &&
-        best_query_for_train[static_cast<std::size_t>(k[0].trainIdx)] != k[0].queryIdx) {
-      continue;
-    }
-    out.push_back(k[0]);
-  }
-  return out;
-}
-
 // Frames along two routes matched with frames up to 1 m ahead, ORB and AKAZE, plain and guided,
-// with and without the mutual check: every match (indices and distance) equals BFMatcher's.
+// with and without the mutual check: every match (indices and distance) equals BFMatcher's
+// (MatchFeaturesBruteForce, what MatchFeatures did for every descriptor before).
 TEST(MatchFeatures, BinaryMatchesAreExactlyOpenCvBruteForceMatches) {
   int compared = 0;
   std::size_t matches_seen = 0;
@@ -157,7 +112,7 @@ TEST(MatchFeatures, BinaryMatchesAreExactlyOpenCvBruteForceMatches) {
             m.max_ddx_px = 40.0;
           }
           const auto got = MatchFeatures(a, b, m);
-          const auto want = BfMatcherReference(a, b, m);
+          const auto want = MatchFeaturesBruteForce(a, b, m);
           ASSERT_EQ(got.size(), want.size())
               << scenario << " " << detector << " " << k << " " << variant;
           for (std::size_t i = 0; i < got.size(); ++i) {
