@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "bench_util.h"
 #include "cli_common.h"
 #include "mapless/appearance/image.h"
 #include "mapless/appearance/pca.h"
@@ -27,23 +28,9 @@ namespace mapless::app {
 void BenchRos1(nlohmann::json* j);   // bench_links.cc
 void BenchRos2(nlohmann::json* j);   // bench_links.cc
 void BenchFleet(nlohmann::json* j);  // bench_fleet.cc
+void BenchTeachRepeat(nlohmann::json* j);  // bench_repeat.cc
 
 namespace {
-
-// Median over `repeats` calls of `fn(i)`, in milliseconds (after `warmup` untimed calls).
-double MedianMs(int repeats, int warmup, const std::function<void(int)>& fn) {
-  for (int i = 0; i < warmup; ++i) fn(i);
-  std::vector<double> ms;
-  ms.reserve(static_cast<std::size_t>(repeats));
-  for (int i = 0; i < repeats; ++i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    fn(i);
-    const auto t1 = std::chrono::steady_clock::now();
-    ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
-  }
-  std::nth_element(ms.begin(), ms.begin() + static_cast<long>(ms.size() / 2), ms.end());
-  return ms[ms.size() / 2];
-}
 
 // Poses along a scenario's taught path (ground truth of a clean drive), for typical views.
 std::vector<Pose2> PosesAlong(const sim::Scenario& scenario, int count) {
@@ -64,24 +51,6 @@ std::vector<Pose2> PosesAlong(const sim::Scenario& scenario, int count) {
   return picked;
 }
 
-// Per-call times of `fn(i)` for i in [0, n), in milliseconds.
-std::vector<double> TimesMs(int n, const std::function<void(int)>& fn) {
-  std::vector<double> ms;
-  for (int i = 0; i < n; ++i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    fn(i);
-    ms.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  }
-  return ms;
-}
-
-double Median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
-
-// Teach & repeat stages (issue 3) on the frames of the table1_almost_straight teach drive.
 // Issue 4: one visual-potential control step (flow + dominant plane + potential + command) on
 // the downward camera of the corridor scenario, against DIS fast alone on the same frames.
 void BenchPotential(int repeats, nlohmann::json* j) {
@@ -127,99 +96,6 @@ void BenchPotential(int repeats, nlohmann::json* j) {
   (*j)["dominant_plane_step_over_dis_fast"] =
       (*j)["dominant_plane_step_ms"].get<double>() /
       (*j)["opencv_dis_fast_ground_320x240_ms"].get<double>();
-}
-
-void BenchTeachRepeat(nlohmann::json* j) {
-  const sim::Scenario scenario = sim::LoadScenario("table1_almost_straight");
-  std::vector<cv::Mat> frames;
-  sim::DriveOptions drive;
-  sim::DriveTaughtPath(scenario, drive,
-                       [&](const sim::DriveFrame& f) { frames.push_back(f.image); });
-  const int n = static_cast<int>(frames.size());
-  // Teach: KLT tracking + keyframe test per frame (keyframe frames also detect and describe).
-  {
-    navigation::TeachSession teach(navigation::TeachOptions{});
-    (*j)["teach_step_ms"] = Median(TimesMs(n, [&](int i) {
-      teach.Update(frames[static_cast<std::size_t>(i)], FromSeconds(0.1 * i));
-    }));
-  }
-  const eval::TaughtRoute taught = eval::TeachOnSimulator(scenario, navigation::TeachOptions{});
-  // Repeat along the taught frames: in-segment KLT tracking + control (Algorithm 1 as written).
-  auto repeat_median = [&](std::shared_ptr<const route::Route> route, int redetect,
-                           bool only_tracking, bool only_last = false) {
-    navigation::RepeatOptions o;
-    o.redetect_every_frames = redetect;
-    navigation::RepeatSession session(route, o);
-    std::vector<double> ms;
-    for (int i = 0; i < n; ++i) {
-      const auto t0 = std::chrono::steady_clock::now();
-      const navigation::RepeatStep step =
-          session.Update(frames[static_cast<std::size_t>(i)], FromSeconds(0.1 * i));
-      const double dt =
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      const bool last = step.destination + 1 == static_cast<int>(route->keyframes.size());
-      if ((!only_tracking || !step.redetected) && (!only_last || last)) ms.push_back(dt);
-      if (session.finished()) break;
-    }
-    return Median(ms);
-  };
-  // The default step (RepeatOptions{}): KLT tracking with fresh matching every
-  // redetect_every_frames frames; every frame counts. Median, mean and 90th percentile: the
-  // frames that detect afresh cost more than the others.
-  {
-    navigation::RepeatSession session(taught.route, navigation::RepeatOptions{});
-    std::vector<double> ms;
-    for (int i = 0; i < n && !session.finished(); ++i) {
-      const auto t0 = std::chrono::steady_clock::now();
-      session.Update(frames[static_cast<std::size_t>(i)], FromSeconds(0.1 * i));
-      ms.push_back(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    }
-    double sum = 0.0;
-    for (const double v : ms) sum += v;
-    (*j)["repeat_step_default_ms"] = Median(ms);
-    (*j)["repeat_step_default_mean_ms"] = ms.empty() ? 0.0 : sum / static_cast<double>(ms.size());
-    std::sort(ms.begin(), ms.end());
-    (*j)["repeat_step_default_p90_ms"] =
-        ms.empty() ? 0.0 : ms[static_cast<std::size_t>(0.9 * static_cast<double>(ms.size() - 1))];
-  }
-  (*j)["repeat_step_ms"] = repeat_median(taught.route, 0, true);
-  (*j)["repeat_step_fresh_ms"] = repeat_median(taught.route, 1, false);
-  // The last segment, where the local scale of nearby feature pairs also decides the route's end.
-  (*j)["repeat_step_fresh_end_ms"] = repeat_median(taught.route, 1, false, true);
-  // The same on a 1 km route (the 10 m route's keyframes repeated 100 times): the per-frame cost
-  // depends only on the current segment.
-  auto long_route = std::make_shared<route::Route>(*taught.route);
-  long_route->keyframes.clear();
-  for (int k = 0; k < 100; ++k) {
-    for (const auto& kf : taught.route->keyframes) {
-      route::Keyframe copy = kf;
-      copy.index = static_cast<int>(long_route->keyframes.size());
-      long_route->keyframes.push_back(copy);
-    }
-  }
-  (*j)["route_1km_keyframes"] = long_route->keyframes.size();
-  (*j)["repeat_step_1km_ms"] = repeat_median(long_route, 0, true);
-  (*j)["repeat_step_fresh_1km_ms"] = repeat_median(long_route, 1, false);
-  // Segment start: detect + describe the current frame, match it with the destination keyframe,
-  // reject outliers. Measured as the first Update of a fresh session (which does exactly that).
-  (*j)["segment_start_ms"] = Median(TimesMs(40, [&](int i) {
-    navigation::RepeatSession session(taught.route, navigation::RepeatOptions{});
-    session.Update(frames[static_cast<std::size_t>(i % std::max(1, n / 2))], 0);
-  }));
-  auto orb = cv::ORB::create(500);
-  std::vector<cv::KeyPoint> kp;
-  cv::Mat desc;
-  (*j)["opencv_orb500_320x240_ms"] = Median(TimesMs(60, [&](int i) {
-    orb->detectAndCompute(frames[static_cast<std::size_t>(i % n)], cv::noArray(), kp, desc);
-  }));
-  const double orb_ms = (*j)["opencv_orb500_320x240_ms"].get<double>();
-  (*j)["repeat_step_over_orb"] = (*j)["repeat_step_ms"].get<double>() / orb_ms;
-  (*j)["repeat_step_default_over_orb"] = (*j)["repeat_step_default_ms"].get<double>() / orb_ms;
-  (*j)["repeat_step_default_mean_over_orb"] =
-      (*j)["repeat_step_default_mean_ms"].get<double>() / orb_ms;
-  (*j)["repeat_step_fresh_over_orb"] = (*j)["repeat_step_fresh_ms"].get<double>() / orb_ms;
-  (*j)["segment_start_over_orb"] = (*j)["segment_start_ms"].get<double>() / orb_ms;
 }
 
 // Issue 5: incremental PCA, Markov localization and sub-window steering (Payá et al.), on the
@@ -467,6 +343,9 @@ void AddBenchCommand(CLI::App* app) {
                             "repeat_step_default_ms",
                             "repeat_step_default_mean_ms",
                             "repeat_step_default_p90_ms",
+                            "repeat_step_default_with_watch_ms",
+                            "obstacle_watch_ms",
+                            "opencv_dis_fast_table1_320x240_ms",
                             "repeat_step_ms",
                             "repeat_step_1km_ms",
                             "repeat_step_fresh_ms",
@@ -492,6 +371,8 @@ void AddBenchCommand(CLI::App* app) {
                 j["repeat_step_default_over_orb"].get<double>());
     std::printf("%-34s %10.2f\n", "repeat_step_default_mean / orb500",
                 j["repeat_step_default_mean_over_orb"].get<double>());
+    std::printf("%-34s %10.2f  (issue 21: <= 1.0)\n", "obstacle_watch / dis_fast",
+                j["obstacle_watch_over_dis_fast"].get<double>());
     std::printf("%-34s %10.2f\n", "repeat_step_fresh / orb500",
                 j["repeat_step_fresh_over_orb"].get<double>());
     std::printf("%-34s %10.2f  (issue 3: <= 6.0)\n", "segment_start / orb500",

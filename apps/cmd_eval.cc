@@ -3,6 +3,7 @@
 // "final_error_m_std", "lateral_rms_m", "collisions"}]} and a readable table.
 #include <spdlog/spdlog.h>
 
+#include <cmath>
 #include <cstdio>
 #include <functional>
 #include <future>
@@ -68,6 +69,10 @@ nlohmann::json EntryJson(const eval::EntryResult& r) {
           {"final_error_m_std", r.final_error_m_std},
           {"lateral_rms_m", r.lateral_rms_m},
           {"collisions", r.collisions},
+          {"obstacle_stops", r.obstacle_stops},
+          {"stops_at_added_object", r.stops_at_added_object},
+          {"min_clearance_m", std::isfinite(r.min_clearance_m) ? nlohmann::json(r.min_clearance_m)
+                                                               : nlohmann::json()},
           {"failures", r.failures}};
 }
 
@@ -203,17 +208,18 @@ void AddEvalCommand(CLI::App* app) {
     std::string end = "scale";
     int redetect_every = navigation::RepeatOptions{}.redetect_every_frames;
     int recover_keyframes = navigation::RepeatOptions{}.recovery_keyframes;
+    std::string on_obstacle = "stop";
     std::string report;
   };
   auto args = std::make_shared<Args>();
   auto fleet = std::make_shared<FleetEvalArgs>();
   CLI::App* cmd = app->add_subcommand(
       "eval",
-      "Run an evaluation suite on the simulator (table1, funnel-scenarios, potential, eigenspace, "
-      "fleet)");
+      "Run an evaluation suite on the simulator (table1, funnel-scenarios, obstacles, potential, "
+      "eigenspace, fleet)");
   cmd->add_option("SUITE", args->suite,
-                  "table1, funnel-scenarios, potential, eigenspace or fleet (a leader and "
-                  "followers as processes)")
+                  "table1, funnel-scenarios, obstacles, potential, eigenspace or fleet (a leader "
+                  "and followers as processes)")
       ->required();
   AddFleetEvalOptions(cmd, fleet.get());
   cmd->add_option("--runs", args->runs, "Repeats per scenario and controller")
@@ -244,6 +250,10 @@ void AddEvalCommand(CLI::App* app) {
                   "off)")
       ->capture_default_str()
       ->check(CLI::Range(0, 20));
+  cmd->add_option("--on-obstacle", args->on_obstacle,
+                  "table1, funnel-scenarios, obstacles: the obstacle watch, stop or off")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"stop", "off"}));
   cmd->add_option("--report", args->report,
                   "Write an HTML report (index.html: the results, each scenario from above with "
                   "every run, the error along the path; the first run's commands over time, its "
@@ -264,16 +274,18 @@ void AddEvalCommand(CLI::App* app) {
     const navigation::RepeatOptions defaults;
     if (!teach_repeat && (args->switching != "stdratio" || args->end != "scale" ||
                           args->redetect_every != defaults.redetect_every_frames ||
-                          args->recover_keyframes != defaults.recovery_keyframes))
+                          args->recover_keyframes != defaults.recovery_keyframes ||
+                          args->on_obstacle != "stop"))
       throw InputError(
-          "--switching, --end, --redetect-every and --recover-keyframes apply to table1 and "
-          "funnel-scenarios, not " +
+          "--switching, --end, --redetect-every, --recover-keyframes and --on-obstacle apply to "
+          "table1, funnel-scenarios and obstacles, not " +
           args->suite);
     eval::RepeatRunOptions base;
     base.repeat.switching = navigation::ParseSwitching(args->switching);
     base.repeat.end_by_local_scale = ParseEndByLocalScale(args->end);
     base.repeat.redetect_every_frames = args->redetect_every;
     base.repeat.recovery_keyframes = args->recover_keyframes;
+    base.repeat.obstacle.enabled = args->on_obstacle == "stop";
     if (args->suite == "potential") {
       RunPotentialSuite(args->runs, args->seed, args->json, args->jobs, args->only, args->report);
       return;
@@ -320,15 +332,20 @@ void AddEvalCommand(CLI::App* app) {
     j["switching"] = args->switching;
     j["redetect_every"] = args->redetect_every;
     j["recover_keyframes"] = args->recover_keyframes;
+    j["on_obstacle"] = args->on_obstacle;
     j["end"] = args->end;
     FILE* table = args->json ? stderr : stdout;
-    std::fprintf(table, "%-30s %-9s %9s %10s %10s %10s %5s\n", "scenario", "control", "success",
-                 "final rms", "final std", "lateral", "coll");
+    std::fprintf(table, "%-30s %-9s %9s %10s %10s %10s %5s %6s %7s %9s\n", "scenario",
+                 "control", "success", "final rms", "final std", "lateral", "coll", "stops",
+                 "at obj", "clearance");
     for (const auto& r : results) {
       j["results"].push_back(EntryJson(r));
-      std::fprintf(table, "%-30s %-9s %4d/%-4d %9.2fm %9.2fm %9.2fm %5d\n", r.scenario.c_str(),
-                   r.controller.c_str(), r.successes, r.runs, r.final_error_m_rms,
-                   r.final_error_m_std, r.lateral_rms_m, r.collisions);
+      const std::string clearance =
+          std::isfinite(r.min_clearance_m) ? Fixed(r.min_clearance_m, 2) + "m" : "-";
+      std::fprintf(table, "%-30s %-9s %4d/%-4d %9.2fm %9.2fm %9.2fm %5d %6d %7d %9s\n",
+                   r.scenario.c_str(), r.controller.c_str(), r.successes, r.runs,
+                   r.final_error_m_rms, r.final_error_m_std, r.lateral_rms_m, r.collisions,
+                   r.obstacle_stops, r.stops_at_added_object, clearance.c_str());
     }
     if (args->json) std::cout << j.dump() << "\n";
     if (!args->report.empty()) {

@@ -17,6 +17,8 @@
 #include "mapless/io/output_dir.h"
 #include "mapless/recording/recording_link.h"
 #include "mapless/robot/methods.h"
+#include "mapless/robot/robot_file.h"
+#include "mapless/robot/status.h"
 #include "mapless/route/appearance_store.h"
 #include "mapless/route/route_store.h"
 #include "recording_args.h"
@@ -31,16 +33,7 @@ nlohmann::json StepJson(int frame, Timestamp t_ns, const navigation::RepeatStep&
   j["frame"] = frame;
   j["t_s"] = ToSeconds(t_ns);
   j["status"] = navigation::RepeatStatusName(s.status);
-  j["destination"] = s.destination;
-  j["matches"] = s.matches;
-  j["tracked"] = s.tracked;
-  j["switched"] = s.switched;
-  if (s.recovered_from >= 0) j["recovered_from"] = s.recovered_from;
-  j["std_ratio"] = s.switching.std_ratio;
-  j["ed_px"] = s.switching.ed_px;
-  if (s.local_scale.ok) j["local_scale"] = s.local_scale.ratio;
-  j["slope_x"] = s.sloped.slope_x;
-  j["slope_y"] = s.sloped.slope_y;
+  robot::RepeatFields(s, &j);
   j["v_mps"] = s.command.v_mps;
   j["omega_radps"] = s.command.omega_radps;
   if (!s.reason.empty()) j["reason"] = s.reason;
@@ -88,6 +81,7 @@ void AddTeachRepeatCommands(CLI::App* app) {
     std::string end = "scale";
     int redetect_every = navigation::RepeatOptions{}.redetect_every_frames;
     int recover_keyframes = navigation::RepeatOptions{}.recovery_keyframes;
+    std::string on_obstacle;  // empty: the robot file's, else stop
     std::string log;
     std::uint64_t seed = 1;
     double motion_noise = 0.1;
@@ -139,6 +133,13 @@ void AddTeachRepeatCommands(CLI::App* app) {
                    "docs/teach_and_repeat.md#keyframe-recovery)")
       ->capture_default_str()
       ->check(CLI::Range(0, 20));
+  repeat
+      ->add_option("--on-obstacle", r->on_obstacle,
+                   "Obstacle watch: stop (halt before something new on the route, status "
+                   "blocked, go on when it is gone) or off (the paper's repeat). Default: the "
+                   "robot file's obstacles.on_obstacle, else stop "
+                   "(docs/teach_and_repeat.md#obstacle-watch)")
+      ->check(CLI::IsMember({"stop", "off"}));
   repeat->add_option("--log", r->log,
                      "Per-frame decisions as JSON lines to this file (default: stdout; on a robot: "
                      "none, - for stdout)");
@@ -176,7 +177,12 @@ void AddTeachRepeatCommands(CLI::App* app) {
     options.redetect_every_frames = r->redetect_every;
     options.recovery_keyframes = r->recover_keyframes;
     options.features.type = features::ParseDetectorType(route->detector);
+    if (!r->on_obstacle.empty()) options.obstacle.enabled = r->on_obstacle == "stop";
     if (!r->robot.empty()) {
+      const robot::RobotFile file = robot::LoadRobotFile(r->robot);
+      const bool enabled = options.obstacle.enabled;
+      options.obstacle = file.obstacle;
+      if (!r->on_obstacle.empty()) options.obstacle.enabled = enabled;
       options.sloped.max_speed_mps = r->speed;
       options.standard.forward_speed_mps = r->speed;
       robot::RepeatMethod method(route, options);

@@ -6,8 +6,45 @@
 #include "mapless/core/check.h"
 
 namespace mapless::eval {
+namespace {
 
-std::vector<std::string> SuiteNames() { return {"table1", "funnel-scenarios"}; }
+struct ObstacleStops {
+  int stops = 0;                 // times the obstacle watch stopped the robot
+  bool at_added_object = false;  // ... once while an object added at repeat time stood there
+  double min_clearance_m = std::numeric_limits<double>::infinity();  // to the added objects
+};
+
+ObstacleStops CountObstacleStops(const sim::Scenario& scenario, const RepeatRun& run) {
+  ObstacleStops out;
+  sim::World added;
+  added.objects = scenario.repeat_variant.add;
+  for (auto& o : added.objects) {
+    const auto leaves = scenario.repeat_variant.leave_s.find(o.tag);
+    if (!o.tag.empty() && leaves != scenario.repeat_variant.leave_s.end())
+      o.leaves_s = leaves->second;
+  }
+  const double period = 1.0 / scenario.camera.rate_hz;
+  bool was_blocked = false;
+  for (std::size_t i = 0; i < run.steps.size() && i < run.path.size(); ++i) {
+    const sim::World now = sim::WorldAt(added, static_cast<double>(i) * period);
+    const bool blocked = run.steps[i].status == navigation::RepeatStatus::kBlocked;
+    if (blocked && !was_blocked) {
+      ++out.stops;
+      if (!now.objects.empty()) out.at_added_object = true;
+    }
+    was_blocked = blocked;
+    if (!now.objects.empty()) {
+      out.min_clearance_m =
+          std::min(out.min_clearance_m, sim::ClearanceTo(now, run.path[i].x_m, run.path[i].y_m) -
+                                            scenario.robot.radius_m);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::string> SuiteNames() { return {"table1", "funnel-scenarios", "obstacles"}; }
 
 std::vector<SuiteEntry> SuiteEntries(const std::string& suite) {
   std::vector<std::string> scenarios;
@@ -23,8 +60,12 @@ std::vector<SuiteEntry> SuiteEntries(const std::string& suite) {
                  "indoor_30m",
                  "outdoor_70m",
                  "rotation_in_place"};
+  } else if (suite == "obstacles") {
+    return {{"obstacle_box_table1", navigation::Controller::kSloped},
+            {"obstacle_box_corridor", navigation::Controller::kSloped},
+            {"obstacle_cylinder_outdoor", navigation::Controller::kSloped}};
   } else {
-    throw InputError("unknown suite '" + suite + "' (known: table1, funnel-scenarios)");
+    throw InputError("unknown suite '" + suite + "' (known: table1, funnel-scenarios, obstacles)");
   }
   std::vector<SuiteEntry> out;
   for (const auto& s : scenarios) {
@@ -72,6 +113,10 @@ EntryResult RunEntry(const sim::Scenario& scenario, const TaughtRoute& taught,
                                       " m from the taught end"
                                 : ""));
     if (run.collided) ++r.collisions;
+    const ObstacleStops stops = CountObstacleStops(scenario, run);
+    if (stops.stops > 0) ++r.obstacle_stops;
+    if (stops.at_added_object) ++r.stops_at_added_object;
+    r.min_clearance_m = std::min(r.min_clearance_m, stops.min_clearance_m);
   }
   double sum_sq = 0.0;
   double sum = 0.0;

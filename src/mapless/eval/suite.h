@@ -2,6 +2,7 @@
 // scenario and a controller, repeated `runs` times with their own noise and start perturbation.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,8 @@ struct SuiteEntry {
 // "table1": the two 10 m paths of Table I, both controllers.
 // "funnel-scenarios": the six scenarios of Section VII-A, the 30 m and 70 m paths, and the
 // rotation in place, both controllers.
+// "obstacles" (issue 21, not in the paper): routes with something new on them at repeat time,
+// the sloped controller.
 std::vector<std::string> SuiteNames();
 std::vector<SuiteEntry> SuiteEntries(const std::string& suite);  // throws InputError if unknown
 
@@ -29,6 +32,14 @@ struct EntryResult {
   double final_error_m_std = 0.0;  // standard deviation of that distance over runs
   double lateral_rms_m = 0.0;      // RMS over all repeated poses of the distance to the taught path
   int collisions = 0;
+  // The obstacle watch (navigation/obstacle_watch.h): runs in which it stopped the robot at
+  // least once (on the table1 and funnel-scenarios suites every such stop is a false alarm), and
+  // on scenarios whose repeat adds objects (the obstacles suite): runs that stopped while one
+  // stood in the world, and the smallest clearance between the robot's footprint and an added
+  // object while it stood there (over all runs; +inf without added objects).
+  int obstacle_stops = 0;
+  int stops_at_added_object = 0;
+  double min_clearance_m = std::numeric_limits<double>::infinity();
   std::vector<std::string> failures;  // one status line per failed run
   // Ground truth for reports: the reference path (taught, or the leader's) and each run's path.
   std::vector<Pose2> reference_path;

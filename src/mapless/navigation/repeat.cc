@@ -51,6 +51,8 @@ const char* RepeatStatusName(RepeatStatus s) {
       return "completed";
     case RepeatStatus::kAborted:
       return "aborted";
+    case RepeatStatus::kBlocked:
+      return "blocked";
   }
   return "?";
 }
@@ -60,6 +62,7 @@ void RepeatOptions::Validate() const {
   matching.Validate();
   klt.Validate();
   camera.Validate();
+  obstacle.Validate();
   sloped.Validate();
   standard.Validate();
   switch_rule.Validate();
@@ -100,6 +103,7 @@ RepeatSession::RepeatSession(std::shared_ptr<const route::Route> route, RepeatOp
       options_(options),
       extractor_((options.Validate(), options.features)),
       camera_(options.camera),
+      watch_(options.obstacle),
       mse_(options.mse_rising_frames) {
   MAPLESS_CHECK(route_ != nullptr, "RepeatSession: no route");
   MAPLESS_CHECK(route_->keyframes.size() >= 2, "RepeatSession: the route has "
@@ -244,9 +248,10 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
   step.destination = destination_;
   if (finished())
     return Stop(step, status_, status_ == RepeatStatus::kCompleted ? "route completed" : "aborted");
+  const double dt = have_last_t_ ? std::max(0.0, ToSeconds(t_ns - last_t_ns_)) : 0.0;
   // Keyframe recovery's measure of progress: the time spent with a moving command.
-  if (have_last_t_ && (last_command_.v_mps != 0.0 || last_command_.omega_radps != 0.0))
-    driven_since_switch_s_ += std::max(0.0, ToSeconds(t_ns - last_t_ns_));
+  if (last_command_.v_mps != 0.0 || last_command_.omega_radps != 0.0)
+    driven_since_switch_s_ += dt;
   last_t_ns_ = t_ns;
   have_last_t_ = true;
   const CameraCheck camera = camera_.Check(image, last_command_);
@@ -254,9 +259,23 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
     step.matches = last_matches_;
     step = Stop(step, RepeatStatus::kWaiting, camera.reason);
   } else {
-    step = Decide(image, t_ns);
-    step.current_px = current_px_;
-    step.destination_px = destination_px_;
+    cv::Mat grey = image;
+    if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+    // The obstacle watch first: a blocked robot does not look for its keyframe.
+    // The features that matched the route on the previous frame are the taught scene.
+    const ObstacleCheck obstacle = watch_.Update(grey, t_ns, last_command_.v_mps * dt,
+                                                 last_command_.omega_radps * dt, current_px_);
+    if (obstacle.blocked) {
+      step.matches = last_matches_;
+      step = Stop(step, RepeatStatus::kBlocked, obstacle.reason);
+    } else {
+      // The time spent blocked is not time spent looking for features.
+      if (obstacle.cleared && waiting_) waiting_since_ns_ = t_ns;
+      step = Decide(grey, t_ns);
+      step.current_px = current_px_;
+      step.destination_px = destination_px_;
+    }
+    step.obstacle = obstacle;
   }
   last_command_ = step.command;
   return step;

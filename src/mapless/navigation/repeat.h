@@ -22,6 +22,7 @@
 #include "mapless/features/features.h"
 #include "mapless/features/klt.h"
 #include "mapless/navigation/camera_check.h"
+#include "mapless/navigation/obstacle_watch.h"
 #include "mapless/route/route.h"
 
 namespace mapless::navigation {
@@ -89,6 +90,9 @@ struct RepeatOptions {
   double guided_window_px = 40.0;
   double guided_release_s = 1.0;
   CameraCheckOptions camera;  // camera faults: the robot waits, the session carries on after
+  // Obstacle watch (not in the paper; obstacle_watch.h): something on the route ahead stops the
+  // robot (status "blocked") until it is gone. enabled = false: the paper's repeat.
+  ObstacleWatchOptions obstacle;
   // At the last keyframe of an incomplete route: false, the repeat ends there (an interrupted
   // teach read from disk); true, the robot waits for the leader that is still teaching it (fleet:
   // see Extend()).
@@ -96,7 +100,8 @@ struct RepeatOptions {
   void Validate() const;
 };
 
-enum class RepeatStatus { kDriving, kWaiting, kCompleted, kAborted };
+// kBlocked: stopped by the obstacle watch, going on by itself when the way is free.
+enum class RepeatStatus { kDriving, kWaiting, kCompleted, kAborted, kBlocked };
 const char* RepeatStatusName(RepeatStatus s);
 
 // What one frame decided (logged as JSON lines by the apps).
@@ -109,6 +114,7 @@ struct RepeatStep {
   bool redetected = false;  // features were detected and matched this frame
   bool switched = false;    // the segment switched this frame
   int recovered_from = -1;  // the switch skipped this keyframe, which could not be matched
+  ObstacleCheck obstacle;   // the obstacle watch on this frame
   control::SwitchDecision switching;
   control::LocalScale local_scale;  // measured on the last segment only (end_by_local_scale)
   control::SlopedFunnelLaneResult sloped;
@@ -154,6 +160,7 @@ class RepeatSession {
   RepeatOptions options_;
   features::FeatureExtractor extractor_;
   CameraMonitor camera_;
+  ObstacleWatch watch_;
   Twist2 last_command_;
   std::vector<features::Features> keyframe_features_;
   control::MseSwitch mse_;

@@ -75,6 +75,7 @@ Decision RepeatMethod::Step(const Observation& observation) {
       state = MethodState::kDriving;
       break;
     case navigation::RepeatStatus::kWaiting:
+    case navigation::RepeatStatus::kBlocked:
       state = MethodState::kStopped;
       break;
     case navigation::RepeatStatus::kCompleted:

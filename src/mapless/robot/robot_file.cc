@@ -74,13 +74,16 @@ LoopOptions RobotFile::Loop() const {
   return o;
 }
 
-void RobotFile::Validate() const { Loop().Validate(); }
+void RobotFile::Validate() const {
+  Loop().Validate();
+  obstacle.Validate();
+}
 
 RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
   return io::WithYamlErrors(name, [&] {
     const io::YamlMap map = io::YamlMap::LoadString(text, name);
     map.CheckKnownKeys({"middleware", "name", "namespace", "node_name", "topics", "limits",
-                        "camera", "safety", "use_sim_time"});
+                        "obstacles", "camera", "safety", "use_sim_time"});
     RobotFile r;
     r.source = name;
     const std::string middleware = map.GetString("middleware", "ros1");
@@ -150,6 +153,27 @@ RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
           r.give_up_without_frames_s > 3600.0)
         s.Fail("give_up_without_frames_s", "must be in [0, 3600] (0: wait for ever)");
       r.connect_timeout_s = Positive(s, "connect_timeout_s", r.connect_timeout_s, 600.0);
+    }
+    if (map.Has("obstacles")) {
+      const io::YamlMap o = map.GetMap("obstacles");
+      o.CheckKnownKeys({"on_obstacle", "region_top", "region_width", "baseline_m",
+                        "min_blocked_fraction"});
+      const std::string on = o.GetString("on_obstacle", "stop");
+      if (on != "stop" && on != "off") o.Fail("on_obstacle", "'" + on + "' is not stop or off");
+      r.obstacle.enabled = on == "stop";
+      const auto fraction = [&](const std::string& key, double fallback, double lo, double hi) {
+        const double v = o.GetDouble(key, fallback);
+        if (!std::isfinite(v) || v < lo || v > hi)
+          o.Fail(key, "must be in [" + std::to_string(lo).substr(0, 4) + ", " +
+                          std::to_string(hi).substr(0, 4) + "]");
+        return v;
+      };
+      r.obstacle.region_top = fraction("region_top", r.obstacle.region_top, 0.0, 0.95);
+      r.obstacle.fit_top = std::min(r.obstacle.fit_top, r.obstacle.region_top);
+      r.obstacle.region_width = fraction("region_width", r.obstacle.region_width, 0.05, 1.0);
+      r.obstacle.baseline_m = fraction("baseline_m", r.obstacle.baseline_m, 0.01, 1.0);
+      r.obstacle.min_blocked_fraction =
+          fraction("min_blocked_fraction", r.obstacle.min_blocked_fraction, 0.01, 0.99);
     }
     r.use_sim_time = map.GetBool("use_sim_time", false);
     r.Validate();

@@ -7,6 +7,7 @@
 
 #include <string>
 
+#include "mapless/navigation/obstacle_watch.h"
 #include "mapless/robot/loop.h"
 
 namespace mapless::robot {
@@ -45,6 +46,9 @@ struct RobotFile {
   double max_frame_age_s = 0.5;
   // No frame for this long: the run ends (exit 1). 0: the robot waits stopped for ever.
   double give_up_without_frames_s = 30.0;
+  // The obstacle watch of `repeat` (section `obstacles`): on_obstacle stop (default) or off, and
+  // the image region the robot drives through next, for this robot's camera.
+  navigation::ObstacleWatchOptions obstacle;
   bool use_sim_time = false;        // ROS `use_sim_time`: the clock comes from /clock
   double connect_timeout_s = 10.0;  // waiting for the master / the first subscriber
   // The full name of a topic: absolute topics stay, relative ones get the namespace.

@@ -10,19 +10,6 @@ namespace mapless::robot {
 
 namespace {
 
-void RepeatFields(const navigation::RepeatStep& s, nlohmann::json* j) {
-  (*j)["destination"] = s.destination;
-  (*j)["matches"] = s.matches;
-  (*j)["tracked"] = s.tracked;
-  (*j)["switched"] = s.switched;
-  if (s.recovered_from >= 0) (*j)["recovered_from"] = s.recovered_from;
-  (*j)["std_ratio"] = s.switching.std_ratio;
-  (*j)["ed_px"] = s.switching.ed_px;
-  if (s.local_scale.ok) (*j)["local_scale"] = s.local_scale.ratio;
-  (*j)["slope_x"] = s.sloped.slope_x;
-  (*j)["slope_y"] = s.sloped.slope_y;
-}
-
 void PotentialFields(const navigation::PotentialStep& s, nlohmann::json* j) {
   (*j)["plane_found"] = s.plane_found;
   (*j)["plane_fraction"] = s.plane_fraction;
@@ -52,6 +39,20 @@ std::string Fixed(double v, int digits) {
 }
 
 }  // namespace
+
+void RepeatFields(const navigation::RepeatStep& s, nlohmann::json* j) {
+  (*j)["destination"] = s.destination;
+  (*j)["matches"] = s.matches;
+  (*j)["tracked"] = s.tracked;
+  (*j)["switched"] = s.switched;
+  if (s.recovered_from >= 0) (*j)["recovered_from"] = s.recovered_from;
+  (*j)["std_ratio"] = s.switching.std_ratio;
+  (*j)["ed_px"] = s.switching.ed_px;
+  if (s.local_scale.ok) (*j)["local_scale"] = s.local_scale.ratio;
+  (*j)["slope_x"] = s.sloped.slope_x;
+  (*j)["slope_y"] = s.sloped.slope_y;
+  if (s.obstacle.observed) (*j)["obstacle_fraction"] = s.obstacle.blocked_fraction;
+}
 
 nlohmann::json StatusJson(const char* method, int frame, const Observation& observation,
                           const Decision& decision) {

@@ -17,6 +17,10 @@ namespace mapless::robot {
 nlohmann::json StatusJson(const char* method, int frame, const Observation& observation,
                           const Decision& decision);
 
+// The repeat's per-frame fields (destination, matches, switching, slopes, obstacle watch), added
+// to `j`: one definition for the live status and the `repeat` log.
+void RepeatFields(const navigation::RepeatStep& s, nlohmann::json* j);
+
 // A status for a stop that no frame decided (no camera, e-stop, interrupted).
 nlohmann::json StopJson(const char* method, Timestamp t_ns, const std::string& reason);
 

@@ -1,0 +1,161 @@
+// `mapless bench`, teach & repeat (issues 3 and 21): the teach step, the repeat step in its
+// modes, the obstacle watch, against stock ORB-500 and DIS fast measured in the same run.
+#include <nlohmann/json.hpp>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include "bench_util.h"
+#include "mapless/eval/teach_repeat.h"
+#include "mapless/navigation/obstacle_watch.h"
+#include "mapless/navigation/repeat.h"
+#include "mapless/navigation/teach.h"
+#include "mapless/sim/driver.h"
+
+namespace mapless::app {
+
+namespace {
+
+// The obstacle watch alone on consecutive frames of a drive (`forward_m` per frame), median ms.
+double WatchMs(const std::vector<cv::Mat>& frames, double forward_m) {
+  navigation::ObstacleWatch watch;
+  std::vector<double> ms;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    cv::Mat grey = frames[i];
+    if (grey.channels() == 3) cv::cvtColor(frames[i], grey, cv::COLOR_BGR2GRAY);
+    const auto t0 = std::chrono::steady_clock::now();
+    const navigation::ObstacleCheck c =
+        watch.Update(grey, FromSeconds(0.1 * static_cast<double>(i)), i > 0 ? forward_m : 0.0, 0.0);
+    const double dt =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (c.observed) ms.push_back(dt);  // frames that compare two views (all but the first few)
+  }
+  return Median(ms);
+}
+
+}  // namespace
+
+// Teach & repeat stages (issue 3) on the frames of the table1_almost_straight teach drive; the
+// method's rows without the obstacle watch (as in the papers), the watch in rows of its own.
+void BenchTeachRepeat(nlohmann::json* j) {
+  const sim::Scenario scenario = sim::LoadScenario("table1_almost_straight");
+  std::vector<cv::Mat> frames;
+  sim::DriveOptions drive;
+  sim::DriveTaughtPath(scenario, drive,
+                       [&](const sim::DriveFrame& f) { frames.push_back(f.image); });
+  const int n = static_cast<int>(frames.size());
+  // Teach: KLT tracking + keyframe test per frame (keyframe frames also detect and describe).
+  {
+    navigation::TeachSession teach(navigation::TeachOptions{});
+    (*j)["teach_step_ms"] = Median(TimesMs(n, [&](int i) {
+      teach.Update(frames[static_cast<std::size_t>(i)], FromSeconds(0.1 * i));
+    }));
+  }
+  const eval::TaughtRoute taught = eval::TeachOnSimulator(scenario, navigation::TeachOptions{});
+  // Repeat along the taught frames: in-segment KLT tracking + control (Algorithm 1 as written).
+  auto repeat_median = [&](std::shared_ptr<const route::Route> route, int redetect,
+                           bool only_tracking, bool only_last = false) {
+    navigation::RepeatOptions o;
+    o.redetect_every_frames = redetect;
+    o.obstacle.enabled = false;
+    navigation::RepeatSession session(route, o);
+    std::vector<double> ms;
+    for (int i = 0; i < n; ++i) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const navigation::RepeatStep step =
+          session.Update(frames[static_cast<std::size_t>(i)], FromSeconds(0.1 * i));
+      const double dt =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      const bool last = step.destination + 1 == static_cast<int>(route->keyframes.size());
+      if ((!only_tracking || !step.redetected) && (!only_last || last)) ms.push_back(dt);
+      if (session.finished()) break;
+    }
+    return Median(ms);
+  };
+  // The default step (RepeatOptions{}): KLT tracking with fresh matching every
+  // redetect_every_frames frames; every frame counts. Median, mean and 90th percentile: the
+  // frames that detect afresh cost more than the others.
+  const auto default_step = [&](bool watch) {
+    navigation::RepeatOptions o;
+    o.obstacle.enabled = watch;
+    navigation::RepeatSession session(taught.route, o);
+    std::vector<double> ms;
+    for (int i = 0; i < n && !session.finished(); ++i) {
+      const auto t0 = std::chrono::steady_clock::now();
+      session.Update(frames[static_cast<std::size_t>(i)], FromSeconds(0.1 * i));
+      ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
+    return ms;
+  };
+  {
+    std::vector<double> ms = default_step(false);
+    double sum = 0.0;
+    for (const double v : ms) sum += v;
+    (*j)["repeat_step_default_ms"] = Median(ms);
+    (*j)["repeat_step_default_mean_ms"] = ms.empty() ? 0.0 : sum / static_cast<double>(ms.size());
+    std::sort(ms.begin(), ms.end());
+    (*j)["repeat_step_default_p90_ms"] =
+        ms.empty() ? 0.0 : ms[static_cast<std::size_t>(0.9 * static_cast<double>(ms.size() - 1))];
+    // What `repeat` runs by default: the step with the obstacle watch.
+    (*j)["repeat_step_default_with_watch_ms"] = Median(default_step(true));
+  }
+  // The obstacle watch alone (issue 21): at the teach drive's 3 cm per frame, against DIS fast
+  // on the same frames (the watch's target: <= 1x DIS fast on top of the step).
+  const double forward_m = scenario.teach_speed_mps / scenario.camera.rate_hz;
+  (*j)["obstacle_watch_ms"] = WatchMs(frames, forward_m);
+  {
+    const auto dis = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_FAST);
+    std::vector<cv::Mat> grey(frames.size());
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      grey[i] = frames[i];
+      if (grey[i].channels() == 3) cv::cvtColor(frames[i], grey[i], cv::COLOR_BGR2GRAY);
+    }
+    cv::Mat flow;
+    (*j)["opencv_dis_fast_table1_320x240_ms"] = Median(TimesMs(n - 1, [&](int i) {
+      dis->calc(grey[static_cast<std::size_t>(i)], grey[static_cast<std::size_t>(i) + 1], flow);
+    }));
+  }
+  (*j)["obstacle_watch_over_dis_fast"] =
+      (*j)["obstacle_watch_ms"].get<double>() /
+      (*j)["opencv_dis_fast_table1_320x240_ms"].get<double>();
+  (*j)["repeat_step_ms"] = repeat_median(taught.route, 0, true);
+  (*j)["repeat_step_fresh_ms"] = repeat_median(taught.route, 1, false);
+  // The last segment, where the local scale of nearby feature pairs also decides the route's end.
+  (*j)["repeat_step_fresh_end_ms"] = repeat_median(taught.route, 1, false, true);
+  // The same on a 1 km route (the 10 m route's keyframes repeated 100 times): the per-frame cost
+  // depends only on the current segment.
+  auto long_route = std::make_shared<route::Route>(*taught.route);
+  long_route->keyframes.clear();
+  for (int k = 0; k < 100; ++k) {
+    for (const auto& kf : taught.route->keyframes) {
+      route::Keyframe copy = kf;
+      copy.index = static_cast<int>(long_route->keyframes.size());
+      long_route->keyframes.push_back(copy);
+    }
+  }
+  (*j)["route_1km_keyframes"] = long_route->keyframes.size();
+  (*j)["repeat_step_1km_ms"] = repeat_median(long_route, 0, true);
+  (*j)["repeat_step_fresh_1km_ms"] = repeat_median(long_route, 1, false);
+  // Segment start: detect + describe the current frame, match it with the destination keyframe,
+  // reject outliers. Measured as the first Update of a fresh session (which does exactly that).
+  (*j)["segment_start_ms"] = Median(TimesMs(40, [&](int i) {
+    navigation::RepeatSession session(taught.route, navigation::RepeatOptions{});
+    session.Update(frames[static_cast<std::size_t>(i % std::max(1, n / 2))], 0);
+  }));
+  auto orb = cv::ORB::create(500);
+  std::vector<cv::KeyPoint> kp;
+  cv::Mat desc;
+  (*j)["opencv_orb500_320x240_ms"] = Median(TimesMs(60, [&](int i) {
+    orb->detectAndCompute(frames[static_cast<std::size_t>(i % n)], cv::noArray(), kp, desc);
+  }));
+  const double orb_ms = (*j)["opencv_orb500_320x240_ms"].get<double>();
+  (*j)["repeat_step_over_orb"] = (*j)["repeat_step_ms"].get<double>() / orb_ms;
+  (*j)["repeat_step_default_over_orb"] = (*j)["repeat_step_default_ms"].get<double>() / orb_ms;
+  (*j)["repeat_step_default_mean_over_orb"] =
+      (*j)["repeat_step_default_mean_ms"].get<double>() / orb_ms;
+  (*j)["repeat_step_fresh_over_orb"] = (*j)["repeat_step_fresh_ms"].get<double>() / orb_ms;
+  (*j)["segment_start_over_orb"] = (*j)["segment_start_ms"].get<double>() / orb_ms;
+}
+
+}  // namespace mapless::app

@@ -1,0 +1,91 @@
+#include "mapless/navigation/obstacle_watch.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "mapless/sim/simulation.h"
+
+namespace mapless::navigation {
+namespace {
+
+struct WatchRun {
+  int first_blocked = -1;          // frame
+  double clearance_at_block = -1;  // robot footprint to the box, m
+  double max_fraction = 0.0;       // over observed frames before any block
+  int cleared_frame = -1;
+};
+
+// Drives straight along +x at `speed` through table1_almost_straight's hall (with a 0.5 m box at
+// `box_x` when > 0, taken away at `box_leaves_s`), the watch deciding every frame; stops for good
+// when it blocks (the command is zero while blocked).
+WatchRun DriveAt(double box_x, double box_leaves_s, double drive_s, std::uint64_t seed,
+                 const ObstacleWatchOptions& options = {}) {
+  sim::Scenario s = sim::LoadScenario("table1_almost_straight");
+  sim::World world = s.world;
+  if (box_x > 0.0) {
+    sim::WorldObject box;
+    box.kind = sim::ObjectKind::kBox;
+    box.center = {box_x, 0.0};
+    box.size_m = {0.5, 0.5};
+    box.height_m = 0.5;
+    box.leaves_s = box_leaves_s;
+    box.texture.type = sim::TextureType::kBlobs;
+    box.texture.texel_m = 0.004;
+    box.texture.mean = 110;
+    world.objects.push_back(box);
+  }
+  sim::CameraSpec camera = s.camera;
+  camera.effects.noise_sigma = 2.0;
+  sim::Simulation simulation(world, camera, {}, seed);
+  sim::RobotOptions robot = s.robot;
+  robot.motion_noise_v_frac = 0.1;
+  robot.motion_noise_omega_frac = 0.1;
+  const int r = simulation.AddRobot(Pose2{0.0, 0.0, 0.0}, robot);
+  ObstacleWatch watch(options);
+  WatchRun out;
+  const double period = 0.1;
+  Twist2 command{0.2, 0.0};
+  for (int i = 0; i * period < drive_s; ++i) {
+    cv::Mat image = simulation.Render(r);
+    cv::Mat grey;
+    if (image.channels() == 3) {
+      cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+    } else {
+      grey = image;
+    }
+    const ObstacleCheck c =
+        watch.Update(grey, FromSeconds(i * period), command.v_mps * (i > 0 ? period : 0.0), 0.0);
+    if (c.observed && out.first_blocked < 0)
+      out.max_fraction = std::max(out.max_fraction, c.blocked_fraction);
+    if (c.blocked && out.first_blocked < 0) {
+      out.first_blocked = i;
+      out.clearance_at_block = box_x - 0.25 - simulation.robot(r).pose().x_m - robot.radius_m;
+    }
+    if (c.cleared && out.cleared_frame < 0) out.cleared_frame = i;
+    command = watch.blocked() ? Twist2{} : Twist2{0.2, 0.0};
+    simulation.SetCommand(r, command);
+    simulation.Advance(period);
+  }
+  return out;
+}
+
+TEST(ObstacleWatch, NoAlarmOnTheEmptyHall) {
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    const WatchRun run = DriveAt(-1.0, 0.0, 20.0, seed);
+    EXPECT_EQ(run.first_blocked, -1) << "seed " << seed;
+    EXPECT_LT(run.max_fraction, ObstacleWatchOptions{}.min_blocked_fraction) << "seed " << seed;
+  }
+}
+
+TEST(ObstacleWatch, StopsBeforeABoxAndGoesOnWhenItIsGone) {
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    const WatchRun run = DriveAt(3.0, 20.0, 30.0, seed);
+    ASSERT_GE(run.first_blocked, 0) << "seed " << seed;
+    EXPECT_GE(run.clearance_at_block, 0.3) << "seed " << seed;
+    EXPECT_GT(run.cleared_frame, 200) << "seed " << seed;  // after the box left (20 s)
+  }
+}
+
+}  // namespace
+}  // namespace mapless::navigation
