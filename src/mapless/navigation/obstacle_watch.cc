@@ -207,10 +207,7 @@ ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, Timestamp t_ns,
     if (!ok[i] || !ok_back[i]) continue;
     if (cv::norm(back[i] - here[i]) > options_.max_round_trip_px) continue;
     kept.push_back(i);
-    // The support: the ground beside the way ahead and the rows just in front of the robot (an
-    // obstacle on the way must not vote for its own plane).
-    const bool beside = here[i].x < region.x || here[i].x >= region.x + region.width;
-    if (here[i].y >= fit_row && (beside || here[i].y >= draw_row)) {
+    if (here[i].y >= fit_row) {
       if (here[i].y >= draw_row) draw.push_back(static_cast<int>(fit_here.size()));
       fit_here.push_back(here[i]);
       fit_there.push_back(there[i]);
