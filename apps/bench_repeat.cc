@@ -38,7 +38,7 @@ double WatchMs(const std::vector<cv::Mat>& frames, double forward_m) {
 // Teach & repeat stages (issue 3) on the frames of the table1_almost_straight teach drive; the
 // method's rows without the obstacle watch (as in the papers), the watch in rows of its own.
 void BenchTeachRepeat(nlohmann::json* j) {
-  const sim::Scenario scenario = sim::LoadScenario("table1_almost_straight");
+  const sim::Scenario scenario = BenchScenario("table1_almost_straight");
   std::vector<cv::Mat> frames;
   sim::DriveOptions drive;
   sim::DriveTaughtPath(scenario, drive,

@@ -4,9 +4,31 @@
 #include <algorithm>
 #include <chrono>
 #include <functional>
+#include <cmath>
+#include <opencv2/core.hpp>
+#include <string>
 #include <vector>
 
+#include "mapless/sim/scenario.h"
+
 namespace mapless::app {
+
+// `mapless bench --size WxH`: the frame size every stage runs at (default 320x240), each
+// scenario's camera keeping its horizontal field of view. The JSON keys keep their "320x240".
+inline cv::Size& BenchFrameSize() {
+  static cv::Size size(320, 240);
+  return size;
+}
+
+inline sim::Scenario BenchScenario(const std::string& name) {
+  sim::Scenario s = sim::LoadScenario(name);
+  const cv::Size size = BenchFrameSize();
+  if (size.width != s.camera.model.width || size.height != s.camera.model.height) {
+    const double hfov = 2.0 * std::atan(0.5 * s.camera.model.width / s.camera.model.fx);
+    s.camera.model = sim::CameraModel::FromFov(size.width, size.height, hfov);
+  }
+  return s;
+}
 
 // Median over `repeats` calls of `fn(i)`, in milliseconds (after `warmup` untimed calls).
 inline double MedianMs(int repeats, int warmup, const std::function<void(int)>& fn) {

@@ -6,6 +6,7 @@
 #include <functional>
 #include <iostream>
 #include <memory>
+#include <sstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/video/tracking.hpp>
@@ -54,7 +55,7 @@ std::vector<Pose2> PosesAlong(const sim::Scenario& scenario, int count) {
 // Issue 4: one visual-potential control step (flow + dominant plane + potential + command) on
 // the downward camera of the corridor scenario, against DIS fast alone on the same frames.
 void BenchPotential(int repeats, nlohmann::json* j) {
-  const sim::Scenario scenario = sim::LoadScenario("corridor_straight_3p5m");
+  const sim::Scenario scenario = BenchScenario("corridor_straight_3p5m");
   navigation::PotentialNavOptions nav;
   const navigation::PlanarFlowCalibration calibration = eval::CalibrateOnSimulator(scenario, nav);
   std::vector<cv::Mat> frames;
@@ -101,7 +102,7 @@ void BenchPotential(int repeats, nlohmann::json* j) {
 // Issue 5: incremental PCA, Markov localization and sub-window steering (Payá et al.), on the
 // images of a drive along outdoor_70m.
 void BenchEigenspace(int repeats, nlohmann::json* j) {
-  const sim::Scenario scenario = sim::LoadScenario("outdoor_70m");
+  const sim::Scenario scenario = BenchScenario("outdoor_70m");
   const appearance::AppearanceImageOptions image_options;
   std::vector<appearance::Vector> vectors;
   std::vector<cv::Mat> frames;
@@ -213,6 +214,7 @@ void AddBenchCommand(CLI::App* app) {
     bool ros1 = false;
     bool ros2 = false;
     bool links_only = false;
+    std::string size;
     bool fleet = false;
   };
   auto args = std::make_shared<Args>();
@@ -226,6 +228,9 @@ void AddBenchCommand(CLI::App* app) {
   bench->add_option("--scenario", args->scenario,
                     "Render views of this scenario only (default: narrow_room_sharp_turn, "
                     "outdoor_70m and office_aliasing, 12 views along each taught path)");
+  bench->add_option("--size", args->size,
+                    "Frame size of every stage, WxH (default 320x240; e.g. 640x480 for a larger "
+                    "camera; the JSON keys keep their 320x240)");
   bench->add_flag("--ros1", args->ros1,
                   "Also the ROS 1 adapter's latency, frame received to command published "
                   "(starts a ROS master on loopback)");
@@ -252,6 +257,15 @@ void AddBenchCommand(CLI::App* app) {
       }
       return;
     }
+    if (!args->size.empty()) {
+      int w = 0, h = 0;
+      char x = 0;
+      std::istringstream in(args->size);
+      if (!(in >> w >> x >> h) || x != 'x' || !in.eof() || w < 64 || h < 48 || w > 4096 ||
+          h > 4096)
+        throw InputError("--size '" + args->size + "': expected WxH, 64x48 to 4096x4096");
+      BenchFrameSize() = cv::Size(w, h);
+    }
     cv::setNumThreads(1);
     const std::vector<std::string> names =
         args->scenario.empty()
@@ -267,17 +281,19 @@ void AddBenchCommand(CLI::App* app) {
     std::vector<View> views;
     for (const std::string& name : names) {
       sim::Scenario scenario = sim::LoadScenario(name);
-      scenario.camera.model = sim::CameraModel::FromFov(320, 240, DegToRad(60.0));
+      scenario.camera.model = sim::CameraModel::FromFov(BenchFrameSize().width,
+                                                        BenchFrameSize().height, DegToRad(60.0));
       renderers.push_back(std::make_unique<sim::Renderer>(scenario.world, sim::RenderOptions{}));
       for (const Pose2& p : PosesAlong(scenario, 12))
         views.push_back({renderers.back().get(), scenario.camera, p});
     }
-    const sim::Scenario scenario = sim::LoadScenario(names.front());
+    const sim::Scenario scenario = BenchScenario(names.front());
 
     nlohmann::json j;
     j["scenarios"] = names;
     j["threads"] = cv::getNumThreads();
-    j["frame"] = "320x240";
+    j["frame"] = std::to_string(BenchFrameSize().width) + "x" +
+                 std::to_string(BenchFrameSize().height);
     j["repeats"] = args->repeats;
     cv::Mat sink;
     j["sim_render_320x240_ms"] = MedianMs(args->repeats, 3, [&](int i) {
