@@ -18,7 +18,9 @@ namespace {
 
 // The obstacle watch alone on consecutive frames of a drive (`forward_m` per frame), median ms.
 double WatchMs(const std::vector<cv::Mat>& frames, double forward_m) {
-  navigation::ObstacleWatch watch;
+  navigation::ObstacleWatchOptions on;
+  on.enabled = true;
+  navigation::ObstacleWatch watch(on);
   std::vector<double> ms;
   for (std::size_t i = 0; i < frames.size(); ++i) {
     cv::Mat grey = frames[i];

@@ -16,6 +16,7 @@ struct WatchRun {
   int first_blocked = -1;          // frame
   double clearance_at_block = -1;  // robot footprint to the box, m
   double max_fraction = 0.0;       // over observed frames before any block
+  int observed = 0;                // frames that compared two views
   int cleared_frame = -1;
 };
 
@@ -45,7 +46,9 @@ WatchRun DriveAt(double box_x, double box_leaves_s, double drive_s, std::uint64_
   robot.motion_noise_v_frac = 0.1;
   robot.motion_noise_omega_frac = 0.1;
   const int r = simulation.AddRobot(Pose2{0.0, 0.0, 0.0}, robot);
-  ObstacleWatch watch(options);
+  ObstacleWatchOptions on = options;
+  on.enabled = true;
+  ObstacleWatch watch(on);
   WatchRun out;
   const double period = 0.1;
   Twist2 command{0.2, 0.0};
@@ -59,6 +62,7 @@ WatchRun DriveAt(double box_x, double box_leaves_s, double drive_s, std::uint64_
     }
     const ObstacleCheck c =
         watch.Update(grey, FromSeconds(i * period), command.v_mps * (i > 0 ? period : 0.0), 0.0);
+    if (c.observed) ++out.observed;
     if (c.observed && out.first_blocked < 0)
       out.max_fraction = std::max(out.max_fraction, c.blocked_fraction);
     if (c.blocked && out.first_blocked < 0) {
@@ -91,6 +95,7 @@ TEST(ObstacleWatch, NoAlarmOnTheEmptyHall) {
     const WatchRun run = DriveAt(-1.0, 0.0, 20.0, seed);
     EXPECT_EQ(run.first_blocked, -1) << "seed " << seed;
     EXPECT_LT(run.max_fraction, ObstacleWatchOptions{}.min_blocked_fraction) << "seed " << seed;
+    EXPECT_GT(run.observed, 100) << "seed " << seed;  // the watch did look
   }
 }
 
@@ -104,7 +109,9 @@ TEST(ObstacleWatch, StopsBeforeABoxAndGoesOnWhenItIsGone) {
 }
 
 TEST(ObstacleWatch, AStandingRobotSeesNoParallaxAndDecidesNothing) {
-  ObstacleWatch watch;
+  ObstacleWatchOptions on;
+  on.enabled = true;
+  ObstacleWatch watch(on);
   cv::Mat image(240, 320, CV_8UC1);
   cv::randu(image, 0, 255);
   for (int i = 0; i < 20; ++i) {
