@@ -12,18 +12,63 @@
 #include "mapless/core/rng.h"
 
 namespace mapless::navigation {
+
 namespace {
 
 constexpr std::size_t kMaxHistory = 64;
 constexpr int kSettleFrames = 3;  // frames after the stop whose view is still the reference
+constexpr int kRefineRounds = 4;  // least-squares rounds after RANSAC (FitGround)
+
+// Hartley's normalisation of a point set: centroid to the origin, mean distance sqrt(2).
+cv::Matx33d Normaliser(const std::vector<cv::Point2f>& p) {
+  double cx = 0.0, cy = 0.0;
+  for (const auto& q : p) {
+    cx += q.x;
+    cy += q.y;
+  }
+  cx /= static_cast<double>(p.size());
+  cy /= static_cast<double>(p.size());
+  double d = 0.0;
+  for (const auto& q : p) d += std::sqrt((q.x - cx) * (q.x - cx) + (q.y - cy) * (q.y - cy));
+  d /= static_cast<double>(p.size());
+  const double s = d > 1e-9 ? std::sqrt(2.0) / d : 1.0;
+  return {s, 0.0, -s * cx, 0.0, s, -s * cy, 0.0, 0.0, 1.0};
+}
+
+// The homography a -> b in the least-squares (algebraic) sense: the normalised DLT. Unlike
+// cv::findHomography(method 0) no Levenberg-Marquardt polish follows, which on a few hundred
+// points is most of that call's cost and changes nothing here (the support is re-counted).
+cv::Mat FitHomographyLsq(const std::vector<cv::Point2f>& a, const std::vector<cv::Point2f>& b) {
+  const cv::Matx33d ta = Normaliser(a), tb = Normaliser(b);
+  cv::Matx<double, 9, 9> ata = cv::Matx<double, 9, 9>::zeros();
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const double x = ta(0, 0) * a[i].x + ta(0, 2), y = ta(1, 1) * a[i].y + ta(1, 2);
+    const double u = tb(0, 0) * b[i].x + tb(0, 2), v = tb(1, 1) * b[i].y + tb(1, 2);
+    const double r1[9] = {x, y, 1.0, 0.0, 0.0, 0.0, -u * x, -u * y, -u};
+    const double r2[9] = {0.0, 0.0, 0.0, x, y, 1.0, -v * x, -v * y, -v};
+    for (int j = 0; j < 9; ++j) {
+      for (int k = j; k < 9; ++k) ata(j, k) += r1[j] * r1[k] + r2[j] * r2[k];
+    }
+  }
+  for (int j = 0; j < 9; ++j) {
+    for (int k = 0; k < j; ++k) ata(j, k) = ata(k, j);
+  }
+  cv::Mat values, vectors;
+  if (!cv::eigen(cv::Mat(ata), values, vectors)) return {};
+  cv::Matx33d hn;
+  for (int k = 0; k < 9; ++k) hn(k / 3, k % 3) = vectors.at<double>(8, k);  // the smallest
+  const cv::Matx33d h = tb.inv() * hn * ta;
+  if (std::abs(h(2, 2)) < 1e-12) return {};
+  return cv::Mat(h * (1.0 / h(2, 2)), true);
+}
 
 }  // namespace
 
 void ObstacleWatchOptions::Validate() const {
   MAPLESS_CHECK(baseline_m > 0.0,
                 "ObstacleWatchOptions.baseline_m = " << baseline_m << "; must be > 0");
-  MAPLESS_CHECK(max_baseline_rad > 0.0, "ObstacleWatchOptions.max_baseline_rad = "
-                                            << max_baseline_rad << "; must be > 0");
+  MAPLESS_CHECK(max_baseline_rad > 0.0,
+                "ObstacleWatchOptions.max_baseline_rad = " << max_baseline_rad << "; must be > 0");
   MAPLESS_CHECK(max_age_s > 0.0,
                 "ObstacleWatchOptions.max_age_s = " << max_age_s << "; must be > 0");
   MAPLESS_CHECK(region_top >= 0.0 && region_top < 1.0,
@@ -40,9 +85,8 @@ void ObstacleWatchOptions::Validate() const {
                 "ObstacleWatchOptions.levels = " << levels << "; must be in [0, 6]");
   MAPLESS_CHECK(max_round_trip_px > 0.0, "ObstacleWatchOptions.max_round_trip_px = "
                                              << max_round_trip_px << "; must be > 0");
-  MAPLESS_CHECK(draw_top >= fit_top && draw_top < 1.0, "ObstacleWatchOptions.draw_top = "
-                                                         << draw_top
-                                                         << "; must be in [fit_top, 1)");
+  MAPLESS_CHECK(draw_top >= fit_top && draw_top < 1.0,
+                "ObstacleWatchOptions.draw_top = " << draw_top << "; must be in [fit_top, 1)");
   MAPLESS_CHECK(ransac_iterations >= 1, "ObstacleWatchOptions.ransac_iterations = "
                                             << ransac_iterations << "; must be >= 1");
   MAPLESS_CHECK(min_eigen > 0.0,
@@ -53,8 +97,8 @@ void ObstacleWatchOptions::Validate() const {
                 "ObstacleWatchOptions.tolerance_px = " << tolerance_px << ", tolerance_relative = "
                                                        << tolerance_relative
                                                        << "; must be > 0 and >= 0");
-  MAPLESS_CHECK(known_radius_px >= 0.0, "ObstacleWatchOptions.known_radius_px = "
-                                           << known_radius_px << "; must be >= 0");
+  MAPLESS_CHECK(known_radius_px >= 0.0,
+                "ObstacleWatchOptions.known_radius_px = " << known_radius_px << "; must be >= 0");
   MAPLESS_CHECK(min_region_points >= 1, "ObstacleWatchOptions.min_region_points = "
                                             << min_region_points << "; must be >= 1");
   MAPLESS_CHECK(min_blocked_fraction > 0.0 && min_blocked_fraction < 1.0,
@@ -62,8 +106,8 @@ void ObstacleWatchOptions::Validate() const {
                                                                << "; must be in (0, 1)");
   MAPLESS_CHECK(confirm_frames >= 1,
                 "ObstacleWatchOptions.confirm_frames = " << confirm_frames << "; must be >= 1");
-  MAPLESS_CHECK(free_difference > 0.0, "ObstacleWatchOptions.free_difference = "
-                                           << free_difference << "; must be > 0");
+  MAPLESS_CHECK(free_difference > 0.0,
+                "ObstacleWatchOptions.free_difference = " << free_difference << "; must be > 0");
 }
 
 ObstacleWatch::ObstacleWatch(ObstacleWatchOptions options) : options_(std::move(options)) {
@@ -73,8 +117,8 @@ ObstacleWatch::ObstacleWatch(ObstacleWatchOptions options) : options_(std::move(
 cv::Rect ObstacleWatch::Region(cv::Size size) const {
   const int top = std::clamp(static_cast<int>(std::lround(options_.region_top * size.height)), 0,
                              size.height - 1);
-  const int w = std::clamp(static_cast<int>(std::lround(options_.region_width * size.width)), 1,
-                           size.width);
+  const int w =
+      std::clamp(static_cast<int>(std::lround(options_.region_width * size.width)), 1, size.width);
   return {(size.width - w) / 2, top, w, size.height - top};
 }
 
@@ -86,14 +130,26 @@ ObstacleCheck ObstacleWatch::Update(const cv::Mat& grey, Timestamp t_ns, double 
   if (!options_.enabled) return check;
   forward_m_ += std::max(0.0, forward_m);
   turned_rad_ += std::abs(turned_rad);
-  check = blocked_ ? WatchBlocked(grey) : Look(grey, t_ns, known_px);
+  if (blocked_) {
+    check = WatchBlocked(grey);
+  } else {
+    // The frame's pyramid with its derivatives (this frame is Lucas-Kanade's first image); kept
+    // without them (when it is the earlier frame, only candidates are tracked from it).
+    std::vector<cv::Mat> pyramid;
+    cv::buildOpticalFlowPyramid(grey, pyramid, cv::Size(options_.window_px, options_.window_px),
+                                options_.levels, true);
+    check = Look(grey, pyramid, t_ns, known_px);
+    if (!blocked_) {
+      Frame frame{{}, t_ns, forward_m_, turned_rad_};
+      for (std::size_t l = 0; l < pyramid.size(); l += 2) frame.pyramid.push_back(pyramid[l]);
+      history_.push_back(std::move(frame));
+    }
+  }
   if (blocked_) {
     history_.clear();  // a stopped robot: the next check needs a new baseline
   } else {
-    history_.push_back({grey.clone(), t_ns, forward_m_, turned_rad_});
     while (history_.size() > kMaxHistory ||
-           (!history_.empty() &&
-            ToSeconds(t_ns - history_.front().t_ns) > options_.max_age_s)) {
+           (!history_.empty() && ToSeconds(t_ns - history_.front().t_ns) > options_.max_age_s)) {
       history_.pop_front();
     }
   }
@@ -113,14 +169,19 @@ cv::Mat ObstacleWatch::FitGround(const std::vector<cv::Point2f>& here,
     const double x = here[i].x, y = here[i].y;
     const double w = m[6] * x + m[7] * y + m[8];
     if (std::abs(w) < 1e-9) return false;
-    const double px = (m[0] * x + m[1] * y + m[2]) / w, py = (m[3] * x + m[4] * y + m[5]) / w;
-    const double flow = std::hypot(there[i].x - x, there[i].y - y);
-    return std::hypot(there[i].x - px, there[i].y - py) <=
-           options_.ransac_px + options_.tolerance_relative * flow;
+    const double ex = there[i].x - (m[0] * x + m[1] * y + m[2]) / w;
+    const double ey = there[i].y - (m[3] * x + m[4] * y + m[5]) / w;
+    const double fx = there[i].x - x, fy = there[i].y - y;
+    const double allowed =
+        options_.ransac_px + options_.tolerance_relative * std::sqrt(fx * fx + fy * fy);
+    return ex * ex + ey * ey <= allowed * allowed;
   };
+  std::vector<char> is_draw(here.size(), 0);
+  for (int i : draw) is_draw[static_cast<std::size_t>(i)] = 1;
   cv::Mat best;
   std::size_t best_count = 0;
-  for (int it = 0; it < options_.ransac_iterations; ++it) {
+  double needed = options_.ransac_iterations;  // adaptive: hypotheses still worth drawing
+  for (int it = 0; it < options_.ransac_iterations && it < needed; ++it) {
     std::array<int, 4> pick{};
     for (int k = 0; k < 4; ++k) {
       bool fresh = false;
@@ -137,11 +198,24 @@ cv::Mat ObstacleWatch::FitGround(const std::vector<cv::Point2f>& here,
     }
     const cv::Mat h = cv::getPerspectiveTransform(src, dst);
     if (h.empty() || !cv::checkRange(h)) continue;
-    std::size_t count = 0;
-    for (std::size_t i = 0; i < here.size(); ++i) count += inlier(h, i) ? 1 : 0;
+    std::size_t count = 0, count_draw = 0;
+    for (std::size_t i = 0; i < here.size(); ++i) {
+      if (!inlier(h, i)) continue;
+      ++count;
+      count_draw += static_cast<std::size_t>(is_draw[i]);
+    }
     if (count > best_count) {
       best_count = count;
       best = h;
+      // The chance that 4 points drawn from the bottom rows are all ground, from this
+      // hypothesis's share there; stop once a better hypothesis is unlikely to be drawn.
+      const double share = static_cast<double>(count_draw) / static_cast<double>(draw.size());
+      const double all4 = share * share * share * share;
+      if (all4 >= 1.0) {
+        needed = 0.0;
+      } else if (all4 > 0.0) {
+        needed = std::log(1.0 - 0.999) / std::log(1.0 - all4);
+      }
     }
   }
   // The plane must explain most of the bottom rows, or it is not the ground.
@@ -150,26 +224,38 @@ cv::Mat ObstacleWatch::FitGround(const std::vector<cv::Point2f>& here,
     for (int i : draw) bottom += inlier(best, static_cast<std::size_t>(i)) ? 1 : 0;
   }
   if (best.empty() || 2 * bottom < draw.size()) return {};
-  // Least squares on the support.
-  std::vector<cv::Point2f> a, b;
-  for (std::size_t i = 0; i < here.size(); ++i) {
-    if (!inlier(best, i)) continue;
-    a.push_back(here[i]);
-    b.push_back(there[i]);
+  // Least squares on the support, repeated while the support grows (local optimisation: a
+  // hypothesis from four bottom points extrapolates to the far rows with their noise; the fit on
+  // its support does not).
+  std::size_t count = best_count;
+  for (int round = 0; round < kRefineRounds; ++round) {
+    std::vector<cv::Point2f> a, b;
+    for (std::size_t i = 0; i < here.size(); ++i) {
+      if (!inlier(best, i)) continue;
+      a.push_back(here[i]);
+      b.push_back(there[i]);
+    }
+    const cv::Mat refined = a.size() >= 8 ? FitHomographyLsq(a, b) : cv::Mat();
+    if (refined.empty() || !cv::checkRange(refined)) break;
+    std::size_t refined_count = 0;
+    for (std::size_t i = 0; i < here.size(); ++i) refined_count += inlier(refined, i) ? 1 : 0;
+    if (round > 0 && refined_count <= count) break;
+    best = refined;
+    count = refined_count;
   }
-  const cv::Mat refined = a.size() >= 8 ? cv::findHomography(a, b, 0) : cv::Mat();
-  return refined.empty() ? best : refined;
+  return best;
 }
 
-ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, Timestamp t_ns,
-                                  const std::vector<cv::Point2f>& known_px) {
+ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, const std::vector<cv::Mat>& pyramid,
+                                  Timestamp t_ns, const std::vector<cv::Point2f>& known_px) {
   ObstacleCheck check;
   // The newest frame at least a baseline behind; none when the robot turned too much since.
   const Frame* earlier = nullptr;
   for (auto it = history_.rbegin(); it != history_.rend(); ++it) {
     if (forward_m_ - it->forward_m < options_.baseline_m) continue;
     if (turned_rad_ - it->turned_rad <= options_.max_baseline_rad &&
-        ToSeconds(t_ns - it->t_ns) <= options_.max_age_s && it->image.size() == grey.size()) {
+        ToSeconds(t_ns - it->t_ns) <= options_.max_age_s &&
+        it->pyramid.front().size() == grey.size()) {
       earlier = &*it;
     }
     break;
@@ -177,74 +263,87 @@ ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, Timestamp t_ns,
   if (earlier == nullptr) return check;  // not observable: keep the votes as they are
   const cv::Size size = grey.size();
   const cv::Rect region = Region(size);
-  // A grid over the ground ahead and the region, tracked back to the earlier frame and forward
-  // again; a point whose round trip does not close is dropped (no texture, an occlusion).
+  // A grid over the ground ahead and the region, tracked to the earlier frame; a point without
+  // texture (min_eigen) or lost is dropped.
   const int g = options_.grid_px;
   const int margin = options_.window_px / 2;
   const int top = std::min(region.y, static_cast<int>(std::lround(options_.fit_top * size.height)));
-  std::vector<cv::Point2f> here;
+  std::vector<cv::Point2f> grid;
   for (int y = top + g / 2; y < size.height - margin / 2; y += g) {
     for (int x = margin; x < size.width - margin; x += g)
-      here.emplace_back(static_cast<float>(x), static_cast<float>(y));
+      grid.emplace_back(static_cast<float>(x), static_cast<float>(y));
   }
-  if (here.size() < 8) return check;
-  std::vector<cv::Point2f> there, back;
-  std::vector<uchar> ok, ok_back;
+  if (grid.size() < 8) return check;
+  std::vector<cv::Point2f> moved;
+  std::vector<uchar> ok;
   std::vector<float> err;
   const cv::Size window(options_.window_px, options_.window_px);
   const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.03);
-  const double min_eigen = options_.min_eigen;
-  cv::calcOpticalFlowPyrLK(grey, earlier->image, here, there, ok, err, window, options_.levels,
-                           stop, 0, min_eigen);
-  cv::calcOpticalFlowPyrLK(earlier->image, grey, there, back, ok_back, err, window,
-                           options_.levels, stop, 0, min_eigen);
+  cv::calcOpticalFlowPyrLK(pyramid, earlier->pyramid, grid, moved, ok, err, window, options_.levels,
+                           stop, 0, options_.min_eigen);
   const double fit_row = options_.fit_top * size.height;
   const double draw_row = options_.draw_top * size.height;
-  std::vector<cv::Point2f> fit_here, fit_there;
-  std::vector<std::size_t> kept;
-  std::vector<int> draw;  // indices into fit_here of the points hypotheses are drawn from
-  for (std::size_t i = 0; i < here.size(); ++i) {
-    if (!ok[i] || !ok_back[i]) continue;
-    if (cv::norm(back[i] - here[i]) > options_.max_round_trip_px) continue;
-    kept.push_back(i);
-    if (here[i].y >= fit_row) {
-      if (here[i].y >= draw_row) draw.push_back(static_cast<int>(fit_here.size()));
-      fit_here.push_back(here[i]);
-      fit_there.push_back(there[i]);
-    }
+  std::vector<cv::Point2f> here, there;  // the tracked points below fit_top
+  std::vector<int> draw;                 // indices into here of the points RANSAC draws from
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    if (!ok[i] || grid[i].y < fit_row) continue;
+    if (grid[i].y >= draw_row) draw.push_back(static_cast<int>(here.size()));
+    here.push_back(grid[i]);
+    there.push_back(moved[i]);
   }
   if (draw.size() < 8) return check;  // a plain floor: nothing to measure
-  const cv::Mat h = FitGround(fit_here, fit_there, draw);
+  const cv::Mat h = FitGround(here, there, draw);
   if (h.empty()) return check;
   check.plane_found = true;
-  std::vector<cv::Point2f> in_region, predicted;
-  for (std::size_t i : kept) {
-    if (region.contains(cv::Point(static_cast<int>(here[i].x), static_cast<int>(here[i].y))))
-      in_region.push_back(here[i]);
+  // The region's points off the plane (and not next to the taught scene) are the candidates.
+  std::vector<std::size_t> in_region;
+  std::vector<cv::Point2f> region_here, predicted;
+  for (std::size_t i = 0; i < here.size(); ++i) {
+    if (!region.contains(cv::Point(static_cast<int>(here[i].x), static_cast<int>(here[i].y))))
+      continue;
+    in_region.push_back(i);
+    region_here.push_back(here[i]);
   }
-  check.region_points = static_cast<int>(in_region.size());
-  if (!check.plane_found || check.region_points < options_.min_region_points) return check;
-  check.observed = true;
-  cv::perspectiveTransform(in_region, predicted, h);
-  int obstacle_points = 0;
-  std::size_t r = 0;
-  for (std::size_t i : kept) {
-    if (r >= in_region.size() || here[i] != in_region[r]) continue;
+  if (region_here.empty()) return check;
+  cv::perspectiveTransform(region_here, predicted, h);
+  const double r2 = options_.known_radius_px * options_.known_radius_px;
+  const auto known = [&](const cv::Point2f& p) {
+    return std::any_of(known_px.begin(), known_px.end(), [&](const cv::Point2f& k) {
+      const double dx = k.x - p.x, dy = k.y - p.y;
+      return dx * dx + dy * dy <= r2;
+    });
+  };
+  std::vector<cv::Point2f> candidates, candidates_there;
+  for (std::size_t r = 0; r < in_region.size(); ++r) {
+    const std::size_t i = in_region[r];
     const double flow = cv::norm(there[i] - here[i]);
     const double off = cv::norm(there[i] - predicted[r]);
-    ++r;
-    const auto known = [&](const cv::Point2f& p) {
-      const double r2 = options_.known_radius_px * options_.known_radius_px;
-      return std::any_of(known_px.begin(), known_px.end(), [&](const cv::Point2f& k) {
-        const double dx = k.x - p.x, dy = k.y - p.y;
-        return dx * dx + dy * dy <= r2;
-      });
-    };
     if (off > options_.tolerance_px + options_.tolerance_relative * flow && !known(here[i])) {
-      ++obstacle_points;
-      check.obstacle_px.push_back(here[i]);
+      candidates.push_back(here[i]);
+      candidates_there.push_back(there[i]);
     }
   }
+  // A candidate counts when its track is right: tracked back, it returns to where it started.
+  // One that does not is a wrong track, neither obstacle nor ground: out of the count.
+  int region_points = static_cast<int>(in_region.size());
+  int obstacle_points = 0;
+  if (!candidates.empty()) {
+    std::vector<cv::Point2f> back;
+    std::vector<uchar> ok_back;
+    cv::calcOpticalFlowPyrLK(earlier->pyramid, pyramid, candidates_there, back, ok_back, err,
+                             window, options_.levels, stop, 0, options_.min_eigen);
+    for (std::size_t c = 0; c < candidates.size(); ++c) {
+      if (ok_back[c] && cv::norm(back[c] - candidates[c]) <= options_.max_round_trip_px) {
+        ++obstacle_points;
+        check.obstacle_px.push_back(candidates[c]);
+      } else {
+        --region_points;
+      }
+    }
+  }
+  check.region_points = region_points;
+  if (check.region_points < options_.min_region_points) return check;
+  check.observed = true;
   check.blocked_fraction = static_cast<double>(obstacle_points) / check.region_points;
   votes_ = check.blocked_fraction > options_.min_blocked_fraction ? votes_ + 1 : 0;
   if (votes_ >= options_.confirm_frames) {
@@ -253,8 +352,8 @@ ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, Timestamp t_ns,
     blocked_image_ = grey.clone();
     blocked_mask_ = cv::Mat::zeros(region.size(), CV_8UC1);
     for (const cv::Point2f& p : check.obstacle_px) {
-      cv::circle(blocked_mask_, cv::Point(static_cast<int>(p.x) - region.x,
-                                          static_cast<int>(p.y) - region.y),
+      cv::circle(blocked_mask_,
+                 cv::Point(static_cast<int>(p.x) - region.x, static_cast<int>(p.y) - region.y),
                  options_.grid_px, cv::Scalar(255), cv::FILLED);
     }
     check.blocked = true;

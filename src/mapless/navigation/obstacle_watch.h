@@ -5,16 +5,19 @@
 // The current frame is compared with an earlier one taken at least `baseline_m` of commanded
 // forward motion before (a 2 cm frame-to-frame step gives sub-pixel parallax at 1.5 m; 8 cm gives
 // several pixels). The flow between them is measured on a grid of points in the lower image
-// (pyramidal Lucas-Kanade, a point kept only when its backward track returns to within
-// `max_round_trip_px`); the ground's flow is fitted to it as one homography by RANSAC (the
+// (pyramidal Lucas-Kanade; each frame's pyramid is built once and kept with it); the ground's
+// flow is fitted to it as one homography by RANSAC (the
 // dominant plane), with the hypotheses drawn from the bottom rows (the ground a robot that is not
 // touching anything stands on: a box 1.1 m ahead covers more of the lower image than the ground
-// and moves like a plane too) and their support counted on the whole lower image; the points of the region the robot will drive through next (a band of rows above
-// the bottom of the image, a centred band of columns) that do not move like that plane are
-// obstacle points, unless they lie next to a feature that matches the route (the taught scene:
-// a wall the route turns in front of is not new). When more than `min_blocked_fraction` of the region's points are obstacle
-// points on `confirm_frames` successive checks, the watch reports an obstacle and stays blocked:
-// the robot stops.
+// and moves like a plane too) and their support counted on the whole lower image; the points of the
+// region the robot will drive through next (a band of rows above the bottom of the image, a centred
+// band of columns) that do not move like that plane are obstacle points, unless they lie next to a
+// feature that matches the route (the taught scene: a wall the route turns in front of is not new)
+// or their backward track does not return to within `max_round_trip_px` (a wrong track, dropped
+// from the region's count; only the points off the plane are tracked back, which halves the cost of
+// the check). When more than `min_blocked_fraction` of the region's points are obstacle points on
+// `confirm_frames` successive checks, the watch reports an obstacle and stays blocked: the robot
+// stops.
 //
 // Departure from the paper: sparse flow on a grid instead of dense flow. With DIS (fast or
 // medium, at full or half resolution) on the 8 cm pairs the ground's flow was wrong over whole
@@ -54,22 +57,24 @@ struct ObstacleWatchOptions {
   double region_top = 0.6;
   double region_width = 0.4;
   double fit_top = 0.55;  // the ground is fitted on the points below this row fraction ...
-  double draw_top = 0.8;    // ... RANSAC drawing its samples below this one (see FitGround)
+  double draw_top = 0.8;  // ... RANSAC drawing its samples below this one (see FitGround)
+  // At most this many RANSAC hypotheses; fewer when the best one so far makes more very unlikely
+  // (the usual adaptive stop, 99.9% confidence, over the bottom rows' inlier share).
   int ransac_iterations = 200;
-  int grid_px = 6;                  // spacing of the tracked points, pixels
-  int window_px = 15;               // Lucas-Kanade window side
-  int levels = 3;                   // pyramid levels above the image
-  double max_round_trip_px = 0.5;   // forward-backward tracking error allowed
+  int grid_px = 10;                // spacing of the tracked points, pixels
+  int window_px = 9;               // Lucas-Kanade window side
+  int levels = 3;                  // pyramid levels above the image
+  double max_round_trip_px = 0.5;  // forward-backward tracking error allowed
   // Texture a tracked point needs: the smaller eigenvalue of its window's gradient matrix per
   // pixel (OpenCV's minEigThreshold). On a plain floor the image noise alone tracks "well" both
   // ways; it must not count as flow.
   double min_eigen = 5e-3;
-  double ransac_px = 1.0;           // RANSAC inlier threshold of the ground fit, pixels
+  double ransac_px = 1.0;  // RANSAC inlier threshold of the ground fit, pixels
   // A point is an obstacle point when it is farther than tolerance_px + tolerance_relative *
   // |its flow| from where the ground's homography puts it.
   double tolerance_px = 1.0;
   double tolerance_relative = 0.15;
-  int min_region_points = 20;          // fewer tracked points in the region: not observed
+  int min_region_points = 20;  // fewer tracked points in the region: not observed
   // A point within this distance of a feature that matches the route (the caller's known_px) is
   // part of the taught scene, not an obstacle: a wall the route turns in front of was there at
   // teach time. Only something new stops the robot.
@@ -105,7 +110,7 @@ class ObstacleWatch {
 
  private:
   struct Frame {
-    cv::Mat image;  // grey
+    std::vector<cv::Mat> pyramid;  // its Lucas-Kanade pyramid, grey levels (built once per frame)
     Timestamp t_ns = 0;
     double forward_m = 0.0;   // odometer of commanded forward motion when it was taken
     double turned_rad = 0.0;  // ... and of commanded |turning|
@@ -115,7 +120,7 @@ class ObstacleWatch {
   // draw_top do not agree on one.
   cv::Mat FitGround(const std::vector<cv::Point2f>& here, const std::vector<cv::Point2f>& there,
                     const std::vector<int>& draw) const;
-  ObstacleCheck Look(const cv::Mat& grey, Timestamp t_ns,
+  ObstacleCheck Look(const cv::Mat& grey, const std::vector<cv::Mat>& pyramid, Timestamp t_ns,
                      const std::vector<cv::Point2f>& known_px);
   ObstacleCheck WatchBlocked(const cv::Mat& grey);
 
