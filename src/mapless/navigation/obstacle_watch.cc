@@ -75,6 +75,9 @@ void ObstacleWatchOptions::Validate() const {
                 "ObstacleWatchOptions.region_top = " << region_top << "; must be in [0, 1)");
   MAPLESS_CHECK(region_width > 0.0 && region_width <= 1.0,
                 "ObstacleWatchOptions.region_width = " << region_width << "; must be in (0, 1]");
+  MAPLESS_CHECK(horizon >= 0.0 && horizon < region_top,
+                "ObstacleWatchOptions.horizon = " << horizon << "; must be in [0, region_top = "
+                                                  << region_top << ")");
   MAPLESS_CHECK(fit_top >= 0.0 && fit_top < 1.0,
                 "ObstacleWatchOptions.fit_top = " << fit_top << "; must be in [0, 1)");
   MAPLESS_CHECK(grid_px >= 2 && grid_px <= 64,
@@ -120,6 +123,14 @@ cv::Rect ObstacleWatch::Region(cv::Size size) const {
   const int w =
       std::clamp(static_cast<int>(std::lround(options_.region_width * size.width)), 1, size.width);
   return {(size.width - w) / 2, top, w, size.height - top};
+}
+
+bool ObstacleWatch::InRegion(cv::Point2f p, cv::Size size) const {
+  if (p.y < options_.region_top * size.height) return false;
+  const double horizon = options_.horizon * size.height;
+  const double half =
+      0.5 * options_.region_width * size.width * (p.y - horizon) / (size.height - horizon);
+  return std::abs(p.x - 0.5 * size.width) <= half;
 }
 
 ObstacleCheck ObstacleWatch::Update(const cv::Mat& grey, Timestamp t_ns, double forward_m,
@@ -299,8 +310,7 @@ ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, const std::vector<cv::Mat
   std::vector<std::size_t> in_region;
   std::vector<cv::Point2f> region_here, predicted;
   for (std::size_t i = 0; i < here.size(); ++i) {
-    if (!region.contains(cv::Point(static_cast<int>(here[i].x), static_cast<int>(here[i].y))))
-      continue;
+    if (!InRegion(here[i], size)) continue;
     in_region.push_back(i);
     region_here.push_back(here[i]);
   }

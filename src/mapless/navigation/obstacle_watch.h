@@ -6,15 +6,15 @@
 // forward motion before (a 2 cm frame-to-frame step gives sub-pixel parallax at 1.5 m; 8 cm gives
 // several pixels). The flow between them is measured on a grid of points in the lower image
 // (pyramidal Lucas-Kanade; each frame's pyramid is built once and kept with it); the ground's
-// flow is fitted to it as one homography by RANSAC (the
-// dominant plane), with the hypotheses drawn from the bottom rows (the ground a robot that is not
-// touching anything stands on: a box 1.1 m ahead covers more of the lower image than the ground
-// and moves like a plane too) and their support counted on the whole lower image; the points of the
-// region the robot will drive through next (a band of rows above the bottom of the image, a centred
-// band of columns) that do not move like that plane are obstacle points, unless they lie next to a
-// feature that matches the route (the taught scene: a wall the route turns in front of is not new)
-// or their backward track does not return to within `max_round_trip_px` (a wrong track, dropped
-// from the region's count; only the points off the plane are tracked back, which halves the cost of
+// flow is fitted to it as one homography by RANSAC (the dominant plane), with the hypotheses
+// drawn from the bottom rows (the ground a robot that is not touching anything stands on: a box
+// 1.1 m ahead covers more of the lower image than the ground and moves like a plane too) and their
+// support counted on the whole lower image; the points of the region the robot will drive over
+// next (the strip of ground as wide as the robot, up to about 2 m ahead) that do not move like
+// that plane are obstacle points, unless they lie next to a feature whose descriptor matches the
+// route (the taught scene: a wall the route turns in front of is not new) or their backward track
+// does not return to within `max_round_trip_px` (a wrong track, dropped from the region's count;
+// only the points off the plane are tracked back, which halves the cost of
 // the check). When more than `min_blocked_fraction` of the region's points are obstacle points on
 // `confirm_frames` successive checks, the watch reports an obstacle and stays blocked: the robot
 // stops.
@@ -31,9 +31,10 @@
 // starts again once the robot has moved a baseline.
 //
 // No calibration: the region is given in image fractions. For the simulator's camera (60 degrees
-// horizontal field of view, 0.4 m above the ground, level) the default rows are the ground from
-// about 0.9 m (the bottom row) to 1.6 m ahead of the camera, and the default columns +-0.2 m at
-// 1 m; a robot whose camera sits higher or sees wider sets them in its YAML file.
+// horizontal field of view, f = 277 px at 320x240, 0.4 m above the ground, level) the default
+// rows are the ground from 0.92 m (the bottom row) to 2.1 m ahead of the camera (row 0.72), and
+// the strip is +-0.27 m wide (the robot's 0.2 m radius and 7 cm); a robot whose camera sits
+// higher, is tilted or sees wider sets them in its YAML file.
 #pragma once
 
 #include <deque>
@@ -52,10 +53,15 @@ struct ObstacleWatchOptions {
   double baseline_m = 0.08;       // commanded forward motion between the two frames compared
   double max_baseline_rad = 0.1;  // ... and at most this much commanded turning
   double max_age_s = 2.0;         // older frames are not used as the earlier frame
-  // The region ahead: rows from region_top (fraction of the image height from the top) to the
-  // bottom, and the centred fraction region_width of the columns.
-  double region_top = 0.6;
-  double region_width = 0.4;
+  // The region ahead: the strip of ground the robot drives over, rows from region_top (fraction
+  // of the image height from the top; 0.72: about 2 m ahead, see above) to the bottom. A strip of
+  // constant width on the ground narrows towards the horizon in the image: region_width is the
+  // centred fraction of the columns at the bottom row, and the strip's sides meet at the horizon
+  // row (`horizon`, a fraction of the height: 0.5 for a level camera). For the simulator's camera
+  // 0.5 at the bottom is +-0.27 m: the robot's 0.2 m radius and 7 cm to spare.
+  double region_top = 0.72;
+  double region_width = 0.5;
+  double horizon = 0.5;
   double fit_top = 0.55;  // the ground is fitted on the points below this row fraction ...
   double draw_top = 0.8;  // ... RANSAC drawing its samples below this one (see FitGround)
   // At most this many RANSAC hypotheses; fewer when the best one so far makes more very unlikely
@@ -115,7 +121,8 @@ class ObstacleWatch {
     double forward_m = 0.0;   // odometer of commanded forward motion when it was taken
     double turned_rad = 0.0;  // ... and of commanded |turning|
   };
-  cv::Rect Region(cv::Size size) const;
+  cv::Rect Region(cv::Size size) const;  // the region's bounding box
+  bool InRegion(cv::Point2f p, cv::Size size) const;
   // The ground's homography (current -> earlier pixels), or empty when the points below
   // draw_top do not agree on one.
   cv::Mat FitGround(const std::vector<cv::Point2f>& here, const std::vector<cv::Point2f>& there,

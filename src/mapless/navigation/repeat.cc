@@ -149,7 +149,8 @@ std::vector<control::FeaturePair> RepeatSession::Pairs() const {
 }
 
 void RepeatSession::MatchKeyframe(int k, std::vector<cv::Point2f>* current_px,
-                                  std::vector<cv::Point2f>* keyframe_px) const {
+                                  std::vector<cv::Point2f>* keyframe_px,
+                                  std::vector<cv::Point2f>* descriptor_matched) const {
   const auto& kf = keyframe_features_[static_cast<std::size_t>(k)];
   features::MatchOptions matching = options_.matching;
   if (options_.guided_window_px > 0.0 && have_expected_dx_ && k == destination_) {
@@ -163,6 +164,7 @@ void RepeatSession::MatchKeyframe(int k, std::vector<cv::Point2f>* current_px,
     current_px->push_back(current_.keypoints[static_cast<std::size_t>(m.queryIdx)].pt);
     keyframe_px->push_back(kf.keypoints[static_cast<std::size_t>(m.trainIdx)].pt);
   }
+  if (descriptor_matched != nullptr) *descriptor_matched = *current_px;
   // Outlier rejection: matches must agree with one epipolar geometry, or, for a rotation in place
   // or a distant scene (where the epipolar geometry degenerates), with one homography. Whichever
   // model explains more matches wins. Neither needs calibration.
@@ -194,7 +196,7 @@ void RepeatSession::MatchKeyframe(int k, std::vector<cv::Point2f>* current_px,
 
 void RepeatSession::DetectAndMatch(const cv::Mat& grey, RepeatStep* step) {
   current_ = extractor_.Extract(grey);
-  MatchKeyframe(destination_, &current_px_, &destination_px_);
+  MatchKeyframe(destination_, &current_px_, &destination_px_, &scene_px_);
   last_matches_ = static_cast<int>(current_px_.size());
   step->redetected = true;
   frames_since_detect_ = 0;
@@ -213,8 +215,8 @@ bool RepeatSession::Recover(RepeatStep* step) {
     // have driven since the last switch.
     const double taught_s = taught_at(k - 1) - taught_at(destination_);
     if (taught_s > options_.recovery_time_factor * driven_since_switch_s_) break;
-    std::vector<cv::Point2f> cur, dst;
-    MatchKeyframe(k, &cur, &dst);
+    std::vector<cv::Point2f> cur, dst, scene;
+    MatchKeyframe(k, &cur, &dst, &scene);
     if (static_cast<int>(cur.size()) <
         std::max(options_.recovery_min_features, options_.min_features)) {
       continue;
@@ -225,6 +227,7 @@ bool RepeatSession::Recover(RepeatStep* step) {
     step->destination = k;
     current_px_ = std::move(cur);
     destination_px_ = std::move(dst);
+    scene_px_ = std::move(scene);
     last_matches_ = static_cast<int>(current_px_.size());
     mse_.Reset();
     switch_votes_ = 0;
@@ -264,7 +267,7 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
     // The obstacle watch first: a blocked robot does not look for its keyframe.
     // The features that matched the route on the previous frame are the taught scene.
     const ObstacleCheck obstacle = watch_.Update(grey, t_ns, last_command_.v_mps * dt,
-                                                 last_command_.omega_radps * dt, current_px_);
+                                                 last_command_.omega_radps * dt, scene_px_);
     if (obstacle.blocked) {
       step.matches = last_matches_;
       step = Stop(step, RepeatStatus::kBlocked, obstacle.reason);
@@ -297,6 +300,7 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
       previous_.release();
       current_px_.clear();
       destination_px_.clear();
+      scene_px_.clear();
       if (route_->complete)
         return Stop(step, RepeatStatus::kCompleted, "route completed: passed the last keyframe");
       return Stop(step, RepeatStatus::kWaiting,
@@ -312,6 +316,7 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
     have_expected_dx_ = false;  // the robot stood still: no prediction from the last segment
     current_px_.clear();
     destination_px_.clear();
+    scene_px_.clear();
   }
 
   // Periodic refresh (an option; see RepeatOptions::redetect_every_frames): no point tracking
@@ -331,6 +336,7 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
     }
     current_px_ = std::move(cur);
     destination_px_ = std::move(dst);
+    scene_px_ = current_px_;
   }
   previous_ = grey.clone();
   // Lines 20-27: too few features left, detect and match again (or refresh).

@@ -149,8 +149,11 @@ class RepeatSession {
   void DetectAndMatch(const cv::Mat& grey, RepeatStep* step);
   // The current frame's features (extracted once per frame) matched with keyframe k, outliers
   // rejected: current pixels and keyframe pixels.
+  // `descriptor_matched` (optional): every current feature whose descriptor matched keyframe k,
+  // before the geometric outlier rejection (the taught scene, for the obstacle watch).
   void MatchKeyframe(int k, std::vector<cv::Point2f>* current_px,
-                     std::vector<cv::Point2f>* keyframe_px) const;
+                     std::vector<cv::Point2f>* keyframe_px,
+                     std::vector<cv::Point2f>* descriptor_matched = nullptr) const;
   // Keyframe recovery (RepeatOptions::recovery_keyframes): the nearest following keyframe the
   // robot may have reached that the current frame matches, switched to; false when none does.
   bool Recover(RepeatStep* step);
@@ -171,6 +174,11 @@ class RepeatSession {
   cv::Mat previous_;
   std::vector<cv::Point2f> current_px_;      // matched features, tracked in the current images
   std::vector<cv::Point2f> destination_px_;  // their matches in the destination keyframe
+  // The taught scene in the last frame, for the obstacle watch: the features whose descriptors
+  // matched the destination (also those the epipolar or homography check then rejected: at a
+  // turn the homography wins and the near objects' matches, right under parallax, are outliers
+  // to it) on a frame detected afresh, the tracked matches otherwise.
+  std::vector<cv::Point2f> scene_px_;
   int last_matches_ = 0;
   bool have_expected_dx_ = false;  // guided matching: a predicted x_current - x_destination
   double expected_dx_ = 0.0;

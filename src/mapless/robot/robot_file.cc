@@ -156,7 +156,7 @@ RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
     }
     if (map.Has("obstacles")) {
       const io::YamlMap o = map.GetMap("obstacles");
-      o.CheckKnownKeys({"on_obstacle", "region_top", "region_width", "baseline_m",
+      o.CheckKnownKeys({"on_obstacle", "region_top", "region_width", "horizon", "baseline_m",
                         "min_blocked_fraction"});
       const std::string on = o.GetString("on_obstacle", "off");
       if (on != "stop" && on != "off") o.Fail("on_obstacle", "'" + on + "' is not stop or off");
@@ -171,6 +171,9 @@ RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
       r.obstacle.region_top = fraction("region_top", r.obstacle.region_top, 0.0, 0.95);
       r.obstacle.fit_top = std::min(r.obstacle.fit_top, r.obstacle.region_top);
       r.obstacle.region_width = fraction("region_width", r.obstacle.region_width, 0.05, 1.0);
+      r.obstacle.horizon = fraction("horizon", r.obstacle.horizon, 0.0, 0.94);
+      if (r.obstacle.horizon >= r.obstacle.region_top)
+        o.Fail("horizon", "must be above region_top (a smaller fraction)");
       r.obstacle.baseline_m = fraction("baseline_m", r.obstacle.baseline_m, 0.01, 1.0);
       r.obstacle.min_blocked_fraction =
           fraction("min_blocked_fraction", r.obstacle.min_blocked_fraction, 0.01, 0.99);
