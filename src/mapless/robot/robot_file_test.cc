@@ -49,6 +49,20 @@ TEST(RobotFile, BadFieldsAreNamed) {
   ExpectError("camera: {mount: sideways}\n", "sideways");
   ExpectError("safety: {camera_timeout_s: 0}\n", "safety.camera_timeout_s");
   ExpectError("[1, 2]\n", "bad.yaml");
+  ExpectError("obstacles: {on_obstacle: swerve}\n", "on_obstacle");
+  ExpectError("obstacles: {region_width: 0}\n", "obstacles.region_width");
+  ExpectError("obstacles: {horizon: 0.8}\n", "obstacles.horizon");  // below region_top
+}
+
+TEST(RobotFile, ObstacleWatchSettings) {
+  const RobotFile r = ParseRobotFile(
+      "obstacles: {on_obstacle: stop, region_top: 0.8, region_width: 0.3, horizon: 0.4}\n",
+      "robot.yaml");
+  EXPECT_TRUE(r.obstacle.enabled);
+  EXPECT_DOUBLE_EQ(r.obstacle.region_top, 0.8);
+  EXPECT_DOUBLE_EQ(r.obstacle.region_width, 0.3);
+  EXPECT_DOUBLE_EQ(r.obstacle.horizon, 0.4);
+  EXPECT_FALSE(ParseRobotFile("{}\n", "robot.yaml").obstacle.enabled);  // off unless asked for
 }
 
 }  // namespace
