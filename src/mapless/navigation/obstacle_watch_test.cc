@@ -21,16 +21,16 @@ struct WatchRun {
 };
 
 // Drives straight along +x at `speed` through table1_almost_straight's hall (with a 0.5 m box at
-// `box_x` when > 0, taken away at `box_leaves_s`), the watch deciding every frame; stops for good
-// when it blocks (the command is zero while blocked).
+// (`box_x`, `box_y`) when box_x > 0, taken away at `box_leaves_s`), the watch deciding every
+// frame; stops for good when it blocks (the command is zero while blocked).
 WatchRun DriveAt(double box_x, double box_leaves_s, double drive_s, std::uint64_t seed,
-                 const ObstacleWatchOptions& options = {}) {
+                 const ObstacleWatchOptions& options = {}, double box_y = 0.0) {
   sim::Scenario s = sim::LoadScenario("table1_almost_straight");
   sim::World world = s.world;
   if (box_x > 0.0) {
     sim::WorldObject box;
     box.kind = sim::ObjectKind::kBox;
-    box.center = {box_x, 0.0};
+    box.center = {box_x, box_y};
     box.size_m = {0.5, 0.5};
     box.height_m = 0.5;
     box.leaves_s = box_leaves_s;
@@ -105,6 +105,17 @@ TEST(ObstacleWatch, StopsBeforeABoxAndGoesOnWhenItIsGone) {
     ASSERT_GE(run.first_blocked, 0) << "seed " << seed;
     EXPECT_GE(run.clearance_at_block, 0.3) << "seed " << seed;
     EXPECT_GT(run.cleared_frame, 200) << "seed " << seed;  // after the box left (20 s)
+  }
+}
+
+TEST(ObstacleWatch, ABoxBesideTheWayIsNotAnObstacle) {
+  // The box's near side 0.4 m to the left of the robot's centre line: 0.2 m beside its footprint,
+  // outside the strip the robot drives over (+-0.27 m). The first region, a rectangle of columns
+  // reaching 4.6 m ahead, took such a box in.
+  for (std::uint64_t seed : Seeds()) {
+    const WatchRun run = DriveAt(3.0, 100.0, 22.0, seed, {}, 0.65);
+    EXPECT_EQ(run.first_blocked, -1) << "seed " << seed;
+    EXPECT_GT(run.observed, 100) << "seed " << seed;
   }
 }
 
