@@ -265,7 +265,7 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
     cv::Mat grey = image;
     if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
     // The obstacle watch first: a blocked robot does not look for its keyframe.
-    // The features that matched the route on the previous frame are the taught scene.
+    // The taught scene: the features whose descriptors matched the route on the previous frame.
     const ObstacleCheck obstacle = watch_.Update(grey, t_ns, last_command_.v_mps * dt,
                                                  last_command_.omega_radps * dt, scene_px_);
     if (obstacle.blocked) {
