@@ -208,7 +208,7 @@ void AddEvalCommand(CLI::App* app) {
     std::string end = "scale";
     int redetect_every = navigation::RepeatOptions{}.redetect_every_frames;
     int recover_keyframes = navigation::RepeatOptions{}.recovery_keyframes;
-    std::string on_obstacle;  // default: stop on the obstacles suite, off on the others
+    std::string on_obstacle;  // default: stop
     std::string report;
   };
   auto args = std::make_shared<Args>();
@@ -251,8 +251,8 @@ void AddEvalCommand(CLI::App* app) {
       ->capture_default_str()
       ->check(CLI::Range(0, 20));
   cmd->add_option("--on-obstacle", args->on_obstacle,
-                  "table1, funnel-scenarios, obstacles: the obstacle watch, stop or off (default: "
-                  "stop on obstacles, off on the others, as in `repeat`)")
+                  "table1, funnel-scenarios, obstacles: the obstacle watch, stop (default, as in "
+                  "`repeat`) or off (the paper's repeat)")
       ->check(CLI::IsMember({"stop", "off"}));
   cmd->add_option("--report", args->report,
                   "Write an HTML report (index.html: the results, each scenario from above with "
@@ -285,7 +285,7 @@ void AddEvalCommand(CLI::App* app) {
     base.repeat.end_by_local_scale = ParseEndByLocalScale(args->end);
     base.repeat.redetect_every_frames = args->redetect_every;
     base.repeat.recovery_keyframes = args->recover_keyframes;
-    if (args->on_obstacle.empty()) args->on_obstacle = args->suite == "obstacles" ? "stop" : "off";
+    if (args->on_obstacle.empty()) args->on_obstacle = "stop";
     base.repeat.obstacle.enabled = args->on_obstacle == "stop";
     if (args->suite == "potential") {
       RunPotentialSuite(args->runs, args->seed, args->json, args->jobs, args->only, args->report);

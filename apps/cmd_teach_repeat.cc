@@ -137,8 +137,8 @@ void AddTeachRepeatCommands(CLI::App* app) {
       ->add_option("--on-obstacle", r->on_obstacle,
                    "Obstacle watch: stop (halt before something new on the route, status "
                    "blocked, go on when it is gone) or off (the paper's repeat). Default: the "
-                   "robot file's obstacles.on_obstacle, else off (for now; "
-                   "docs/teach_and_repeat.md#obstacle-watch)")
+                   "robot file's obstacles.on_obstacle, else stop "
+                   "(docs/teach_and_repeat.md#obstacle-watch)")
       ->check(CLI::IsMember({"stop", "off"}));
   repeat->add_option("--log", r->log,
                      "Per-frame decisions as JSON lines to this file (default: stdout; on a robot: "

@@ -92,7 +92,7 @@ struct RepeatOptions {
   double guided_release_s = 1.0;
   CameraCheckOptions camera;  // camera faults: the robot waits, the session carries on after
   // Obstacle watch (not in the paper; obstacle_watch.h): something on the route ahead stops the
-  // robot (status "blocked") until it is gone. enabled = false: the paper's repeat.
+  // robot (status "blocked") until it is gone. On by default; enabled = false: the paper's repeat.
   ObstacleWatchOptions obstacle;
   // At the last keyframe of an incomplete route: false, the repeat ends there (an interrupted
   // teach read from disk); true, the robot waits for the leader that is still teaching it (fleet:

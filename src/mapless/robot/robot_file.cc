@@ -158,7 +158,7 @@ RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
       const io::YamlMap o = map.GetMap("obstacles");
       o.CheckKnownKeys({"on_obstacle", "region_top", "region_width", "horizon", "baseline_m",
                         "min_blocked_fraction"});
-      const std::string on = o.GetString("on_obstacle", "off");
+      const std::string on = o.GetString("on_obstacle", "stop");
       if (on != "stop" && on != "off") o.Fail("on_obstacle", "'" + on + "' is not stop or off");
       r.obstacle.enabled = on == "stop";
       const auto fraction = [&](const std::string& key, double fallback, double lo, double hi) {

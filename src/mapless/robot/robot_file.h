@@ -46,7 +46,7 @@ struct RobotFile {
   double max_frame_age_s = 0.5;
   // No frame for this long: the run ends (exit 1). 0: the robot waits stopped for ever.
   double give_up_without_frames_s = 30.0;
-  // The obstacle watch of `repeat` (section `obstacles`): on_obstacle off (default) or stop, and
+  // The obstacle watch of `repeat` (section `obstacles`): on_obstacle stop (default) or off, and
   // the image region the robot drives through next, for this robot's camera.
   navigation::ObstacleWatchOptions obstacle;
   bool use_sim_time = false;        // ROS `use_sim_time`: the clock comes from /clock

@@ -62,7 +62,8 @@ TEST(RobotFile, ObstacleWatchSettings) {
   EXPECT_DOUBLE_EQ(r.obstacle.region_top, 0.8);
   EXPECT_DOUBLE_EQ(r.obstacle.region_width, 0.3);
   EXPECT_DOUBLE_EQ(r.obstacle.horizon, 0.4);
-  EXPECT_FALSE(ParseRobotFile("{}\n", "robot.yaml").obstacle.enabled);  // off unless asked for
+  EXPECT_TRUE(ParseRobotFile("{}\n", "robot.yaml").obstacle.enabled);  // stop unless told off
+  EXPECT_FALSE(ParseRobotFile("obstacles: {on_obstacle: off}\n", "robot.yaml").obstacle.enabled);
 }
 
 }  // namespace
