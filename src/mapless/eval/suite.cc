@@ -63,7 +63,8 @@ std::vector<SuiteEntry> SuiteEntries(const std::string& suite) {
   } else if (suite == "obstacles") {
     return {{"obstacle_box_table1", navigation::Controller::kSloped},
             {"obstacle_box_corridor", navigation::Controller::kSloped},
-            {"obstacle_cylinder_outdoor", navigation::Controller::kSloped}};
+            {"obstacle_cylinder_outdoor", navigation::Controller::kSloped},
+            {"keyframe_car_gone", navigation::Controller::kSloped}};
   } else {
     throw InputError("unknown suite '" + suite + "' (known: table1, funnel-scenarios, obstacles)");
   }

@@ -19,7 +19,8 @@ struct SuiteEntry {
 // "funnel-scenarios": the six scenarios of Section VII-A, the 30 m and 70 m paths, and the
 // rotation in place, both controllers.
 // "obstacles" (issue 21, not in the paper): routes with something new on them at repeat time,
-// the sloped controller.
+// and one whose keyframes in a turn saw mostly a car that is gone at repeat time (keyframe
+// recovery); the sloped controller.
 std::vector<std::string> SuiteNames();
 std::vector<SuiteEntry> SuiteEntries(const std::string& suite);  // throws InputError if unknown
 
