@@ -168,8 +168,9 @@ void RunEigenspaceSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
   });
   nlohmann::json j = SuiteJson("eigenspace", runs, seed);
   FILE* table = json_out ? stderr : stdout;
-  std::fprintf(table, "%-16s %-16s %9s %5s %10s %11s %11s %9s %9s\n", "scenario", "experiment",
-               "success", "coll", "final rms", "lateral rms", "lateral max", "loc +-1", "nn +-1");
+  std::fprintf(table, "%-19s %-16s %9s %5s %10s %11s %11s %9s %9s %6s %7s %9s\n", "scenario",
+               "experiment", "success", "coll", "final rms", "lateral rms", "lateral max",
+               "loc +-1", "nn +-1", "stops", "at obj", "clearance");
   for (const auto& r : results) {
     nlohmann::json e = EntryJson(r);
     e["experiment"] = r.experiment;
@@ -178,10 +179,13 @@ void RunEigenspaceSuite(int runs, std::uint64_t seed, bool json_out, int jobs,
     e["nearest_within_one"] = r.nearest_within_one;
     e["stop_frames"] = r.stops;
     j["results"].push_back(e);
-    std::fprintf(table, "%-16s %-16s %4d/%-4d %5d %9.3fm %10.3fm %10.3fm %9.3f %9.3f\n",
+    const std::string clearance =
+        std::isfinite(r.min_clearance_m) ? Fixed(r.min_clearance_m, 2) + "m" : "-";
+    std::fprintf(table, "%-19s %-16s %4d/%-4d %5d %9.3fm %10.3fm %10.3fm %9.3f %9.3f %6d %7d %9s\n",
                  r.scenario.c_str(), r.experiment.c_str(), r.successes, r.runs, r.collisions,
                  r.final_error_m_rms, r.lateral_rms_m, r.lateral_rms_m_max,
-                 r.localization_within_one, r.nearest_within_one);
+                 r.localization_within_one, r.nearest_within_one, r.obstacle_stops,
+                 r.stops_at_added_object, clearance.c_str());
   }
   if (json_out) std::cout << j.dump() << "\n";
   if (!report_dir.empty()) {

@@ -79,6 +79,7 @@ void AddFollowCommand(CLI::App* app) {
     std::string log;
     std::uint64_t seed = 1;
     double motion_noise = 0.1;
+    std::string on_obstacle;  // empty: the robot file's, else stop
     FollowConnectArgs fleet;
     RecordArgs record;
     recording::PlaybackOptions playback;
@@ -108,6 +109,7 @@ void AddFollowCommand(CLI::App* app) {
   AddRecordOptions(cmd, &a->record);
   cmd->add_option("--robot", a->robot, "Drive a robot: its robot file (YAML)")->excludes(source);
   cmd->add_option("--log", a->log, "Per-frame decisions as JSON lines (- for stdout)");
+  AddOnObstacleOption(cmd, &a->on_obstacle);
   cmd->add_option("--seed", a->seed, "Simulator: seed of the motion noise")
       ->capture_default_str()
       ->check(SeedCheck());
@@ -123,6 +125,7 @@ void AddFollowCommand(CLI::App* app) {
       f.log = a->log;
       f.seed = a->seed;
       f.motion_noise = a->motion_noise;
+      f.on_obstacle = a->on_obstacle;
       RefuseOutputOverInputs(f.log, "--log", {SourceInput(f.source), f.robot});
       FollowConnected(f);
       return;
@@ -134,7 +137,8 @@ void AddFollowCommand(CLI::App* app) {
                            {a->route, SourceInput(a->source), a->robot});
     cv::Size size;
     const std::shared_ptr<const route::AppearanceRoute> route = RebuildRoute(a->route, &size);
-    const navigation::AppearanceFollowerOptions follower;
+    navigation::AppearanceFollowerOptions follower;
+    follower.obstacle = ObstacleWatchFor(a->robot, a->on_obstacle, follower.obstacle);
     robot::FollowMethod method([route] { return route; }, follower, size);
     if (!a->robot.empty()) {
       const auto recorder = OpenRecorder(a->record);

@@ -133,13 +133,7 @@ void AddTeachRepeatCommands(CLI::App* app) {
                    "docs/teach_and_repeat.md#keyframe-recovery)")
       ->capture_default_str()
       ->check(CLI::Range(0, 20));
-  repeat
-      ->add_option("--on-obstacle", r->on_obstacle,
-                   "Obstacle watch: stop (halt before something new on the route, status "
-                   "blocked, go on when it is gone) or off (the paper's repeat). Default: the "
-                   "robot file's obstacles.on_obstacle, else stop "
-                   "(docs/teach_and_repeat.md#obstacle-watch)")
-      ->check(CLI::IsMember({"stop", "off"}));
+  AddOnObstacleOption(repeat, &r->on_obstacle);
   repeat->add_option("--log", r->log,
                      "Per-frame decisions as JSON lines to this file (default: stdout; on a robot: "
                      "none, - for stdout)");
@@ -177,12 +171,8 @@ void AddTeachRepeatCommands(CLI::App* app) {
     options.redetect_every_frames = r->redetect_every;
     options.recovery_keyframes = r->recover_keyframes;
     options.features.type = features::ParseDetectorType(route->detector);
-    if (!r->on_obstacle.empty()) options.obstacle.enabled = r->on_obstacle == "stop";
+    options.obstacle = ObstacleWatchFor(r->robot, r->on_obstacle, options.obstacle);
     if (!r->robot.empty()) {
-      const robot::RobotFile file = robot::LoadRobotFile(r->robot);
-      const bool enabled = options.obstacle.enabled;
-      options.obstacle = file.obstacle;
-      if (!r->on_obstacle.empty()) options.obstacle.enabled = enabled;
       options.sloped.max_speed_mps = r->speed;
       options.standard.forward_speed_mps = r->speed;
       robot::RepeatMethod method(route, options);

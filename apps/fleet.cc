@@ -325,6 +325,7 @@ void FollowConnected(const FollowConnectArgs& a) {
   if (header.kind == fleet::RouteKind::kFunnel) {
     navigation::RepeatOptions repeat;
     repeat.features.type = features::ParseDetectorType(header.detector);
+    repeat.obstacle = ObstacleWatchFor(a.robot, a.on_obstacle, repeat.obstacle);
     if (scenario) {
       const double speed =
           eval::RepeatSpeedFor(*scenario, eval::RepeatRunOptions{}.max_repeat_speed_mps);
@@ -334,8 +335,10 @@ void FollowConnected(const FollowConnectArgs& a) {
     method =
         std::make_unique<robot::RepeatMethod>([&copy] { return copy.FunnelRoute(); }, repeat, size);
   } else {
+    navigation::AppearanceFollowerOptions follower;
+    follower.obstacle = ObstacleWatchFor(a.robot, a.on_obstacle, follower.obstacle);
     method = std::make_unique<robot::FollowMethod>([&copy] { return copy.AppearanceRoute(); },
-                                                   navigation::AppearanceFollowerOptions{}, size);
+                                                   follower, size);
   }
   spdlog::info("follow: a {} route from {}", fleet::RouteKindName(header.kind), a.connect);
   if (!scenario) {

@@ -22,6 +22,7 @@ struct FollowConnectArgs {
   double rate = 1.0;  // simulator: simulated seconds per wall-clock second
   std::uint64_t seed = 1;
   double motion_noise = 0.1;
+  std::string on_obstacle;  // the obstacle watch: stop, off, or empty (the robot file's, else stop)
 };
 void FollowConnected(const FollowConnectArgs& a);
 

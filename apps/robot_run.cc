@@ -50,6 +50,28 @@ std::unique_ptr<robot::RobotLink> OpenRobotLink(const robot::RobotFile& robot, c
                    " is not available in this build");
 }
 
+navigation::ObstacleWatchOptions ObstacleWatchFor(const std::string& robot_path,
+                                                  const std::string& on_obstacle,
+                                                  const navigation::ObstacleWatchOptions& defaults) {
+  navigation::ObstacleWatchOptions o = defaults;
+  if (!robot_path.empty()) {
+    const robot::RobotFile file = robot::LoadRobotFile(robot_path);
+    o = file.obstacle;
+    if (!file.obstacle_baseline_given) o.baseline_m = defaults.baseline_m;
+  }
+  if (!on_obstacle.empty()) o.enabled = on_obstacle == "stop";
+  return o;
+}
+
+void AddOnObstacleOption(CLI::App* cmd, std::string* on_obstacle) {
+  cmd->add_option("--on-obstacle", *on_obstacle,
+                  "Obstacle watch: stop (halt before something new on the way ahead, status "
+                  "blocked or stopped with the reason, go on when it is gone) or off (the "
+                  "paper's method). Default: the robot file's obstacles.on_obstacle, else stop "
+                  "(docs/teach_and_repeat.md#obstacle-watch)")
+      ->check(CLI::IsMember({"stop", "off"}));
+}
+
 void RunOnRobot(robot::Method& method, const std::string& robot_path, const std::string& log_path,
                 recording::RunRecorder* recorder) {
   const robot::RobotFile file = robot::LoadRobotFile(robot_path);

@@ -24,6 +24,16 @@ std::unique_ptr<robot::RobotLink> OpenRobotLink(const robot::RobotFile& robot, c
 // Throws RunFailed when the method failed or gave up, Interrupted on SIGINT/SIGTERM (after the
 // robot was stopped).
 // With a recorder, the run is recorded (recording/recording_link.h).
+// The obstacle watch of `repeat` and `follow`: the method's `defaults` with the robot file's
+// section `obstacles` when a robot file is given (its baseline_m only when the file has one: the
+// methods' defaults differ with their speeds), and `on_obstacle` ("stop" or "off"; empty: as
+// there).
+navigation::ObstacleWatchOptions ObstacleWatchFor(const std::string& robot_path,
+                                                  const std::string& on_obstacle,
+                                                  const navigation::ObstacleWatchOptions& defaults);
+// `--on-obstacle` of `repeat` and `follow`.
+void AddOnObstacleOption(CLI::App* cmd, std::string* on_obstacle);
+
 void RunOnRobot(robot::Method& method, const std::string& robot_path, const std::string& log_path,
                 recording::RunRecorder* recorder = nullptr);
 

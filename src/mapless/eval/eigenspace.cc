@@ -44,6 +44,8 @@ struct FollowerMetrics {
   int nearest_within_one = 0;
   double lateral_sq = 0.0;
   int stops = 0;
+  int obstacle_stops = 0;  // times the obstacle watch stopped the follower
+  bool was_blocked = false;
   bool converged = false;
   double converged_at_m = -1.0;
 
@@ -54,6 +56,8 @@ struct FollowerMetrics {
     have_last = true;
     last = truth;
     if (step.state == navigation::FollowerState::kStopped) ++stops;
+    if (step.obstacle.blocked && !was_blocked) ++obstacle_stops;
+    was_blocked = step.obstacle.blocked;
     const double lateral = SignedDistanceToPath(leader_path, truth.x_m, truth.y_m);
     if (!converged && travelled_m >= options.convergence_m &&
         std::abs(lateral) <= options.converged_lateral_m) {
@@ -92,6 +96,7 @@ void Finalize(const EigenspaceRunOptions& options, const FollowerMetrics& metric
   run->frames_after_convergence = metrics.frames;
   run->convergence_distance_m = metrics.converged_at_m;
   run->stops = metrics.stops;
+  run->obstacle_stops = metrics.obstacle_stops;
   if (metrics.frames > 0) {
     run->lateral_rms_m = std::sqrt(metrics.lateral_sq / metrics.frames);
     run->localization_within_one = static_cast<double>(metrics.within_one) / metrics.frames;
@@ -119,7 +124,8 @@ bool FollowerFrame(sim::Simulation* sim, int robot, navigation::AppearanceFollow
   const Pose2 truth = sim->robot(robot).pose();
   run->follower_path.push_back(truth);
   const navigation::FollowerStep step = follower->Update(
-      camera->Apply(image, ToSeconds(sim->now_ns())), sim->robot(robot).odometry(), route);
+      camera->Apply(image, ToSeconds(sim->now_ns())), sim->robot(robot).odometry(), route,
+      sim->now_ns());
   metrics->Add(truth, step, image, route, image_truth, run->leader_path, options);
   if (observer) observer(step, truth);
   if (step.state == navigation::FollowerState::kArrived) return true;
@@ -131,7 +137,8 @@ bool FollowerFrame(sim::Simulation* sim, int robot, navigation::AppearanceFollow
 
 SimSetup FollowSimSetup(const sim::Scenario& scenario, const EigenspaceRunOptions& options) {
   SimSetup setup;
-  setup.world = scenario.world;
+  // What has changed since the teach (objects added or removed), as for a repeat.
+  setup.world = sim::ApplyVariant(scenario.world, scenario.repeat_variant);
   setup.camera = scenario.camera;
   setup.robot = FollowerRobot(scenario, options);
   setup.start = StartPose(scenario, options);
@@ -183,11 +190,29 @@ EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario,
     link_options.camera_faults = options.camera_faults;
     link_options.fault_seed = options.seed;
     robot::SimLink link(sim, robot, link_options);
+    // The objects added at follow time, for the obstacle watch's figures.
+    sim::World added;
+    added.objects = scenario.repeat_variant.add;
+    for (auto& o : added.objects) {
+      const auto leaves = scenario.repeat_variant.leave_s.find(o.tag);
+      if (!o.tag.empty() && leaves != scenario.repeat_variant.leave_s.end())
+        o.leaves_s = leaves->second;
+    }
+    bool was_blocked = false;
     const robot::LoopResult result = robot::RunLoop(
         method, link, robot::LoopOptions{},
         [&](const robot::Observation& obs, const robot::Decision& decision) {
           const auto& step = std::get<navigation::FollowerStep>(decision.detail);
           const Pose2 truth = link.truth();
+          const sim::World now = sim::WorldAt(added, ToSeconds(obs.t_ns));
+          if (step.obstacle.blocked && !was_blocked && !now.objects.empty())
+            ++run.stops_at_added_object;
+          was_blocked = step.obstacle.blocked;
+          if (!now.objects.empty()) {
+            run.min_clearance_m =
+                std::min(run.min_clearance_m, sim::ClearanceTo(now, truth.x_m, truth.y_m) -
+                                                  scenario.robot.radius_m);
+          }
           run.follower_path.push_back(truth);
           metrics.Add(truth, step, obs.image, *route, image_truth, run.leader_path, options);
           if (observer) observer(step, truth);
@@ -252,6 +277,7 @@ std::vector<EigenspaceEntry> EigenspaceSuiteEntries() {
       entries.push_back({scenario, experiment});
     }
   }
+  entries.push_back({"obstacle_box_office", "on-route"});
   return entries;
 }
 
@@ -310,6 +336,9 @@ EigenspaceEntryResult RunEigenspaceEntry(const EigenspaceEntry& entry, int runs,
     result.localization_within_one += run.localization_within_one / runs;
     result.nearest_within_one += run.nearest_within_one / runs;
     result.stops += run.stops;
+    if (run.obstacle_stops > 0) ++result.obstacle_stops;
+    if (run.stops_at_added_object > 0) ++result.stops_at_added_object;
+    result.min_clearance_m = std::min(result.min_clearance_m, run.min_clearance_m);
   }
   result.final_error_m_rms = std::sqrt(final_sq / runs);
   result.lateral_rms_m = std::sqrt(lateral_sq / runs);

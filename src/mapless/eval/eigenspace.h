@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,12 @@ struct EigenspaceRun {
   int frames_after_convergence = 0;
   double convergence_distance_m = -1.0;  // driven before convergence (-1: never)
   int stops = 0;                         // frames in which the follower stood still and said why
+  // The obstacle watch: times it stopped the follower, how many of those while an object added
+  // at follow time (the scenario's repeat variant) stood in the world, and the smallest clearance
+  // between the follower's footprint and such an object while it stood (+inf without one).
+  int obstacle_stops = 0;
+  int stops_at_added_object = 0;
+  double min_clearance_m = std::numeric_limits<double>::infinity();
   std::vector<Pose2> leader_path;        // ground truth
   std::vector<Pose2> follower_path;      // ground truth
 };
@@ -68,7 +75,8 @@ EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario,
                                   const EigenspaceRunOptions& options,
                                   const EigenspaceObserver& observer = {});
 
-// One line of `mapless eval eigenspace`.
+// One line of `mapless eval eigenspace` (also obstacle_box_office, on-route: the obstacle watch
+// in the follower, issue 21).
 struct EigenspaceEntry {
   std::string scenario;
   std::string experiment;  // on-route, off-route-left, off-route-right, batch-pca, no-markov,

@@ -41,9 +41,25 @@ TEST(EigenspaceFollow, RejectsBatchPcaWhileTheLeaderTeaches) {
   EXPECT_THROW(RunEigenspaceFollow(sim::LoadScenario("office_aliasing"), options), InputError);
 }
 
-TEST(EigenspaceSuite, HasTwoRoutesAndSixExperimentsEach) {
+// Issue 21: a box on the office route when the follower comes (gone after 40 s). The obstacle
+// watch stops the follower before it and lets it go on; without the watch it drives into the box.
+TEST(EigenspaceFollow, StopsBeforeABoxOnTheRouteAndGoesOnWhenItIsGone) {
+  const sim::Scenario scenario = sim::LoadScenario("obstacle_box_office");
+  EigenspaceRunOptions options = EigenspaceEntryOptions({"obstacle_box_office", "on-route"}, 1);
+  const EigenspaceRun run = RunEigenspaceFollow(scenario, options);
+  EXPECT_TRUE(run.success) << run.status;
+  EXPECT_FALSE(run.collided);
+  EXPECT_GE(run.stops_at_added_object, 1);
+  EXPECT_GE(run.min_clearance_m, 0.2);
+  options.follower.obstacle.enabled = false;  // the paper's follower
+  const EigenspaceRun blind = RunEigenspaceFollow(scenario, options);
+  EXPECT_TRUE(blind.collided) << blind.status;
+  EXPECT_EQ(blind.obstacle_stops, 0);
+}
+
+TEST(EigenspaceSuite, HasTwoRoutesAndSixExperimentsEachAndTheFollowersObstacle) {
   const auto entries = EigenspaceSuiteEntries();
-  EXPECT_EQ(entries.size(), 12U);
+  EXPECT_EQ(entries.size(), 13U);
   EXPECT_THROW(EigenspaceEntryOptions({"office_aliasing", "sideways"}, 1), InputError);
 }
 

@@ -24,6 +24,7 @@
 #include "mapless/localization/initial.h"
 #include "mapless/localization/markov.h"
 #include "mapless/navigation/camera_check.h"
+#include "mapless/navigation/obstacle_watch.h"
 #include "mapless/route/appearance_route.h"
 
 namespace mapless::navigation {
@@ -76,7 +77,7 @@ class AppearanceLeader {
 
 struct AppearanceFollowerOptions {
   AppearanceFollowerOptions();  // sets markov.uniform_mixing = 0.01 (used only with
-                                // uniform_mixing_for_m > 0)
+                                // uniform_mixing_for_m > 0) and obstacle.baseline_m = 0.12
   bool use_markov = true;       // false: nearest projection every frame (Section 3 alone)
   appearance::AppearanceImageOptions image;
   appearance::SubWindowOptions windows;
@@ -131,6 +132,11 @@ struct AppearanceFollowerOptions {
   int arrive_within_images = 1;  // arrived at the end of a complete route within this many
   int wait_within_images = 2;    // wait for a leader this close to the end it has taught so far
   CameraCheckOptions camera;     // camera faults: stop until the images are usable again
+  // Obstacle watch (not in the paper; obstacle_watch.h), as in the repeat: something on the way
+  // ahead stops the follower (kStopped, the reason says so) until it is gone. On by default;
+  // enabled = false: the paper's follower. The route has no features, so everything off the
+  // ground in the region counts; the region is the robot-wide strip of ground ahead.
+  ObstacleWatchOptions obstacle;
   void Validate() const;
 };
 
@@ -146,6 +152,7 @@ struct FollowerStep {
   std::string reason;        // why the robot is stopped (kStopped, kWaitingForLeader)
   control::SubWindowSteering steering;
   std::vector<float> belief;  // Markov: the belief over the route images after this frame
+  ObstacleCheck obstacle;     // the obstacle watch on this frame (blocked: stopped for it)
 };
 
 class AppearanceFollower {
@@ -154,8 +161,9 @@ class AppearanceFollower {
   // One control period: the current image, the odometry and the latest route snapshot. A camera
   // fault stops the robot (kStopped, or kInitializing while it localizes) with the fault as the
   // reason; the frame is otherwise ignored, so localization resumes where it was.
+  // t_ns: the frame's time (the obstacle watch compares frames at most max_age_s apart).
   FollowerStep Update(const cv::Mat& image, const Pose2& odometry,
-                      const route::AppearanceRoute& route);
+                      const route::AppearanceRoute& route, Timestamp t_ns);
 
  private:
   FollowerStep Decide(const cv::Mat& image, const Pose2& odometry,
@@ -167,6 +175,9 @@ class AppearanceFollower {
 
   AppearanceFollowerOptions options_;
   CameraMonitor camera_;
+  ObstacleWatch watch_;
+  bool have_watch_odometry_ = false;
+  Pose2 watch_odometry_;  // the odometry at the previous frame the watch saw
   Twist2 last_command_;
   localization::MarkovLocalizer markov_;
   bool initializing_ = true;

@@ -99,7 +99,7 @@ TEST(AppearanceFollower, WaitsWhileTheRouteHasFewerThanTwoImages) {
   AppearanceLeader leader;
   leader.Update(SmoothImage(1), Pose2{});
   AppearanceFollower follower;
-  const FollowerStep step = follower.Update(SmoothImage(2), Pose2{}, *leader.Snapshot());
+  const FollowerStep step = follower.Update(SmoothImage(2), Pose2{}, *leader.Snapshot(), 0);
   EXPECT_EQ(step.state, FollowerState::kWaitingForLeader);
   EXPECT_EQ(step.command.v_mps, 0.0);
   EXPECT_FALSE(step.reason.empty());
@@ -115,26 +115,26 @@ TEST(AppearanceFollower, LocalizesWithSmallTurnsThenStopsOnABlackCameraAndSaysWh
   bool turned_left = false;
   bool turned_right = false;
   for (int i = 0; i < 200 && step.state == FollowerState::kInitializing; ++i) {
-    step = follower.Update(sim.Render(robot), sim.robot(robot).odometry(), *route);
+    step = follower.Update(sim.Render(robot), sim.robot(robot).odometry(), *route, sim.now_ns());
     turned_left |= step.command.omega_radps > 0.0;
     turned_right |= step.command.omega_radps < 0.0;
     sim.SetCommand(robot, step.command);
     sim.Advance(0.1);
   }
   EXPECT_TRUE(turned_left && turned_right);
-  step = follower.Update(sim.Render(robot), sim.robot(robot).odometry(), *route);
+  step = follower.Update(sim.Render(robot), sim.robot(robot).odometry(), *route, sim.now_ns());
   ASSERT_EQ(step.state, FollowerState::kFollowing) << step.reason;
   EXPECT_LE(step.index, 3);
   EXPECT_GT(step.command.v_mps, 0.0);
   // The camera goes black: the robot stops within this control period and says why.
   const cv::Mat black = cv::Mat::zeros(240, 320, CV_8UC1);
-  step = follower.Update(black, sim.robot(robot).odometry(), *route);
+  step = follower.Update(black, sim.robot(robot).odometry(), *route, sim.now_ns());
   EXPECT_EQ(step.state, FollowerState::kStopped);
   EXPECT_EQ(step.command.v_mps, 0.0);
   EXPECT_EQ(step.command.omega_radps, 0.0);
   EXPECT_NE(step.reason.find("camera fault: black frame"), std::string::npos) << step.reason;
   // Images return: it follows again.
-  step = follower.Update(sim.Render(robot), sim.robot(robot).odometry(), *route);
+  step = follower.Update(sim.Render(robot), sim.robot(robot).odometry(), *route, sim.now_ns());
   EXPECT_EQ(step.state, FollowerState::kFollowing) << step.reason;
 }
 

@@ -141,7 +141,7 @@ Decision FollowMethod::Step(const Observation& observation) {
     return Make(MethodState::kStopped, {}, "waiting", "no route image yet: waiting for the leader");
   }
   navigation::FollowerStep step =
-      follower_.Update(observation.image, *observation.odometry, *route);
+      follower_.Update(observation.image, *observation.odometry, *route, observation.t_ns);
   MethodState state = MethodState::kDriving;
   switch (step.state) {
     case navigation::FollowerState::kInitializing:

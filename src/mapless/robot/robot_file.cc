@@ -175,6 +175,7 @@ RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
       if (r.obstacle.horizon >= r.obstacle.region_top)
         o.Fail("horizon", "must be above region_top (a smaller fraction)");
       r.obstacle.baseline_m = fraction("baseline_m", r.obstacle.baseline_m, 0.01, 1.0);
+      r.obstacle_baseline_given = o.Has("baseline_m");
       r.obstacle.min_blocked_fraction =
           fraction("min_blocked_fraction", r.obstacle.min_blocked_fraction, 0.01, 0.99);
     }

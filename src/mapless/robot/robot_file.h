@@ -49,6 +49,7 @@ struct RobotFile {
   // The obstacle watch of `repeat` (section `obstacles`): on_obstacle stop (default) or off, and
   // the image region the robot drives through next, for this robot's camera.
   navigation::ObstacleWatchOptions obstacle;
+  bool obstacle_baseline_given = false;  // obstacles.baseline_m is in the file (else each method's)
   bool use_sim_time = false;        // ROS `use_sim_time`: the clock comes from /clock
   double connect_timeout_s = 10.0;  // waiting for the master / the first subscriber
   // The full name of a topic: absolute topics stay, relative ones get the namespace.

@@ -63,6 +63,10 @@ TEST(RobotFile, ObstacleWatchSettings) {
   EXPECT_DOUBLE_EQ(r.obstacle.region_width, 0.3);
   EXPECT_DOUBLE_EQ(r.obstacle.horizon, 0.4);
   EXPECT_TRUE(ParseRobotFile("{}\n", "robot.yaml").obstacle.enabled);  // stop unless told off
+  EXPECT_FALSE(ParseRobotFile("{}\n", "robot.yaml").obstacle_baseline_given);
+  const RobotFile b = ParseRobotFile("obstacles: {baseline_m: 0.2}\n", "robot.yaml");
+  EXPECT_TRUE(b.obstacle_baseline_given);
+  EXPECT_DOUBLE_EQ(b.obstacle.baseline_m, 0.2);
   EXPECT_FALSE(ParseRobotFile("obstacles: {on_obstacle: off}\n", "robot.yaml").obstacle.enabled);
 }
 

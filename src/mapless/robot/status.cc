@@ -29,6 +29,7 @@ void FollowerFields(const navigation::FollowerStep& s, nlohmann::json* j) {
     (*j)["shift_px"] = s.steering.shift_px;
     (*j)["confidence"] = s.steering.confidence;
   }
+  if (s.obstacle.observed) (*j)["obstacle_fraction"] = s.obstacle.blocked_fraction;
 }
 
 std::string Fixed(double v, int digits) {
