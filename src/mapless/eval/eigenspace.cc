@@ -191,13 +191,7 @@ EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario,
     link_options.fault_seed = options.seed;
     robot::SimLink link(sim, robot, link_options);
     // The objects added at follow time, for the obstacle watch's figures.
-    sim::World added;
-    added.objects = scenario.repeat_variant.add;
-    for (auto& o : added.objects) {
-      const auto leaves = scenario.repeat_variant.leave_s.find(o.tag);
-      if (!o.tag.empty() && leaves != scenario.repeat_variant.leave_s.end())
-        o.leaves_s = leaves->second;
-    }
+    const sim::World added = ObjectsAddedAtRepeat(scenario);
     bool was_blocked = false;
     const robot::LoopResult result = robot::RunLoop(
         method, link, robot::LoopOptions{},

@@ -16,13 +16,7 @@ struct ObstacleStops {
 
 ObstacleStops CountObstacleStops(const sim::Scenario& scenario, const RepeatRun& run) {
   ObstacleStops out;
-  sim::World added;
-  added.objects = scenario.repeat_variant.add;
-  for (auto& o : added.objects) {
-    const auto leaves = scenario.repeat_variant.leave_s.find(o.tag);
-    if (!o.tag.empty() && leaves != scenario.repeat_variant.leave_s.end())
-      o.leaves_s = leaves->second;
-  }
+  const sim::World added = ObjectsAddedAtRepeat(scenario);
   const double period = 1.0 / scenario.camera.rate_hz;
   bool was_blocked = false;
   for (std::size_t i = 0; i < run.steps.size() && i < run.path.size(); ++i) {
@@ -43,6 +37,17 @@ ObstacleStops CountObstacleStops(const sim::Scenario& scenario, const RepeatRun&
 }
 
 }  // namespace
+
+sim::World ObjectsAddedAtRepeat(const sim::Scenario& scenario) {
+  sim::World added;
+  added.objects = scenario.repeat_variant.add;
+  for (auto& o : added.objects) {
+    const auto leaves = scenario.repeat_variant.leave_s.find(o.tag);
+    if (!o.tag.empty() && leaves != scenario.repeat_variant.leave_s.end())
+      o.leaves_s = leaves->second;
+  }
+  return added;
+}
 
 std::vector<std::string> SuiteNames() { return {"table1", "funnel-scenarios", "obstacles"}; }
 

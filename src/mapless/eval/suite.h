@@ -22,6 +22,9 @@ struct SuiteEntry {
 // and one whose keyframes in a turn saw mostly a car that is gone at repeat time (keyframe
 // recovery); the sloped controller.
 std::vector<std::string> SuiteNames();
+// The objects a scenario's repeat adds (its variant), with the times they leave at: for the
+// obstacle figures (stops while one stood there, clearance to it).
+sim::World ObjectsAddedAtRepeat(const sim::Scenario& scenario);
 std::vector<SuiteEntry> SuiteEntries(const std::string& suite);  // throws InputError if unknown
 
 struct EntryResult {
