@@ -9,6 +9,15 @@
 #include "mapless/localization/nearest.h"
 
 namespace mapless::navigation {
+namespace {
+
+// Signed distance from `from` to `to` along `from`'s heading (odometry between two frames).
+double AdvanceAlong(const Pose2& from, const Pose2& to) {
+  return (to.x_m - from.x_m) * std::cos(from.theta_rad) +
+         (to.y_m - from.y_m) * std::sin(from.theta_rad);
+}
+
+}  // namespace
 
 // ---- Leader ------------------------------------------------------------------------------------
 
@@ -292,8 +301,7 @@ FollowerStep AppearanceFollower::Update(const cv::Mat& image, const Pose2& odome
       double forward_m = 0.0;
       double turned_rad = 0.0;
       if (have_watch_odometry_) {
-        forward_m = (odometry.x_m - watch_odometry_.x_m) * std::cos(watch_odometry_.theta_rad) +
-                    (odometry.y_m - watch_odometry_.y_m) * std::sin(watch_odometry_.theta_rad);
+        forward_m = AdvanceAlong(watch_odometry_, odometry);
         turned_rad = std::abs(WrapAngle(odometry.theta_rad - watch_odometry_.theta_rad));
       }
       obstacle = watch_.Update(grey, t_ns, forward_m, turned_rad);
@@ -317,8 +325,7 @@ FollowerStep AppearanceFollower::Decide(const cv::Mat& image, const Pose2& odome
   double advance_m = 0.0;
   if (have_odometry_) {
     // Signed distance along the previous heading.
-    advance_m = (odometry.x_m - last_odometry_.x_m) * std::cos(last_odometry_.theta_rad) +
-                (odometry.y_m - last_odometry_.y_m) * std::sin(last_odometry_.theta_rad);
+    advance_m = AdvanceAlong(last_odometry_, odometry);
   }
   have_odometry_ = true;
   last_odometry_ = odometry;
