@@ -248,7 +248,7 @@ void AddTeachRepeatCommands(CLI::App* app) {
             std::to_string(frame.image.rows) + ", the route " + r->route + " was taught at " +
             std::to_string(route->image_width) + "x" + std::to_string(route->image_height));
       }
-      last = session.Update(frame.image, frame.t_ns);
+      last = session.Update(frame.image, frame.t_ns, frame.odometry);
       nlohmann::json j = StepJson(frame_index++, frame.t_ns, last);
       j["image"] = frame.name;
       log.Write(j);

@@ -148,7 +148,7 @@ class LeaderTeacher {
       Serve(fleet::HeaderRecord(h));
     }
     if (kind_ == fleet::RouteKind::kFunnel) {
-      Keep(session_->Update(image, t_ns));
+      Keep(session_->Update(image, t_ns, odometry));
       return;
     }
     if (!odometry)

@@ -54,10 +54,10 @@ class KeyframeTeacher : public Teacher {
     options_.Validate();
     session_ = std::make_unique<navigation::TeachSession>(options_);
   }
-  void Frame(const cv::Mat& image, Timestamp t_ns, const std::optional<Pose2>&) override {
+  void Frame(const cv::Mat& image, Timestamp t_ns, const std::optional<Pose2>& odometry) override {
     if (!writer_)
       writer_ = std::make_unique<route::RouteWriter>(dir_, detector_, image.cols, image.rows);
-    Keep(session_->Update(image, t_ns));
+    Keep(session_->Update(image, t_ns, odometry));
   }
   void Finish() override {
     if (!writer_) return;

@@ -60,7 +60,7 @@ TaughtRoute TeachOnSimulator(const sim::Scenario& scenario, const navigation::Te
   const sim::DriveSummary summary =
       sim::DriveTaughtPath(scenario, drive, [&](const sim::DriveFrame& f) {
         taught.path.push_back(f.truth);
-        keep(teach.Update(f.image, f.t_ns));
+        keep(teach.Update(f.image, f.t_ns, f.odometry));
       });
   keep(teach.Finish());
   MAPLESS_CHECK(summary.completed,

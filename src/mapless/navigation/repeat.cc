@@ -89,6 +89,9 @@ void RepeatOptions::Validate() const {
                 "RepeatOptions.recovery_keyframes = " << recovery_keyframes << "; must be >= 0");
   MAPLESS_CHECK(recovery_time_factor > 0.0,
                 "RepeatOptions.recovery_time_factor = " << recovery_time_factor << "; must be > 0");
+  carry_on.Validate();
+  MAPLESS_CHECK(carry_on_keyframes >= 0,
+                "RepeatOptions.carry_on_keyframes = " << carry_on_keyframes << "; must be >= 0");
   MAPLESS_CHECK(recovery_min_features >= 2, "RepeatOptions.recovery_min_features = "
                                                 << recovery_min_features << "; must be >= 2");
   // recovery_after_s >= abort_after_s is allowed: the repeat then aborts before it recovers.
@@ -202,41 +205,6 @@ void RepeatSession::DetectAndMatch(const cv::Mat& grey, RepeatStep* step) {
   frames_since_detect_ = 0;
 }
 
-bool RepeatSession::Recover(RepeatStep* step) {
-  if (options_.recovery_keyframes <= 0 || !step->redetected) return false;
-  const auto& kfs = route_->keyframes;
-  const int known = static_cast<int>(kfs.size());
-  const auto taught_at = [&](int k) { return ToSeconds(kfs[static_cast<std::size_t>(k)].t_ns); };
-  for (int k = destination_ + 1; k <= destination_ + options_.recovery_keyframes && k < known;
-       ++k) {
-    // Keyframe k as the destination puts the robot past keyframe k - 1: the keyframe after the
-    // unmatched one always qualifies (the robot is somewhere before the unmatched keyframe, the
-    // next one is the next place it can head for), those farther only as far as the robot may
-    // have driven since the last switch.
-    const double taught_s = taught_at(k - 1) - taught_at(destination_);
-    if (taught_s > options_.recovery_time_factor * driven_since_switch_s_) break;
-    std::vector<cv::Point2f> cur, dst, scene;
-    MatchKeyframe(k, &cur, &dst, &scene);
-    if (static_cast<int>(cur.size()) <
-        std::max(options_.recovery_min_features, options_.min_features)) {
-      continue;
-    }
-    step->recovered_from = destination_;
-    step->switched = true;
-    destination_ = k;
-    step->destination = k;
-    current_px_ = std::move(cur);
-    destination_px_ = std::move(dst);
-    scene_px_ = std::move(scene);
-    last_matches_ = static_cast<int>(current_px_.size());
-    mse_.Reset();
-    switch_votes_ = 0;
-    driven_since_switch_s_ = 0.0;
-    return true;
-  }
-  return false;
-}
-
 RepeatStep RepeatSession::Stop(RepeatStep step, RepeatStatus status, const std::string& reason) {
   step.status = status;
   step.reason = reason;
@@ -246,24 +214,28 @@ RepeatStep RepeatSession::Stop(RepeatStep step, RepeatStatus status, const std::
   return step;
 }
 
-RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
+RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns,
+                                 const std::optional<Pose2>& odometry) {
+  odometry_ = odometry;
+  // At the start the robot stands at keyframe 0, where the first segment begins.
+  if (!have_last_t_ && destination_ == 1) switch_odometry_ = odometry;
   RepeatStep step;
   step.destination = destination_;
   if (finished())
     return Stop(step, status_, status_ == RepeatStatus::kCompleted ? "route completed" : "aborted");
   const double dt = have_last_t_ ? std::max(0.0, ToSeconds(t_ns - last_t_ns_)) : 0.0;
   // Keyframe recovery's measure of progress: the time spent with a moving command.
-  if (last_command_.v_mps != 0.0 || last_command_.omega_radps != 0.0)
-    driven_since_switch_s_ += dt;
+  if (last_command_.v_mps != 0.0 || last_command_.omega_radps != 0.0) driven_since_switch_s_ += dt;
   last_t_ns_ = t_ns;
   have_last_t_ = true;
-  const CameraCheck camera = camera_.Check(image, last_command_);
+  // Grey once: the camera check, the watch and the method all read the grey frame.
+  cv::Mat grey = image;
+  if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  const CameraCheck camera = camera_.Check(grey, last_command_);
   if (!camera.usable()) {
     step.matches = last_matches_;
     step = Stop(step, RepeatStatus::kWaiting, camera.reason);
   } else {
-    cv::Mat grey = image;
-    if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
     // The obstacle watch first: a blocked robot does not look for its keyframe.
     // The taught scene: the features whose descriptors matched the route on the previous frame.
     const ObstacleCheck obstacle = watch_.Update(grey, t_ns, last_command_.v_mps * dt,
@@ -274,6 +246,7 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns) {
     } else {
       // The time spent blocked is not time spent looking for features.
       if (obstacle.cleared && waiting_) waiting_since_ns_ = t_ns;
+      if (obstacle.cleared && short_since_ns_) short_since_ns_ = t_ns;
       step = Decide(grey, t_ns);
       step.current_px = current_px_;
       step.destination_px = destination_px_;
@@ -309,7 +282,7 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
     }
     // The leader taught the next keyframe: switch to it as at any segment switch.
     waiting_for_route_ = false;
-    driven_since_switch_s_ = 0.0;
+    MarkSwitch();
     ++destination_;
     step.switched = true;
     step.destination = destination_;
@@ -322,8 +295,9 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
   // Periodic refresh (an option; see RepeatOptions::redetect_every_frames): no point tracking
   // features that are about to be replaced.
   ++frames_since_detect_;
-  const bool refresh =
-      options_.redetect_every_frames > 0 && frames_since_detect_ >= options_.redetect_every_frames;
+  // Carrying on matches every frame afresh.
+  const bool refresh = carry_active_ || (options_.redetect_every_frames > 0 &&
+                                         frames_since_detect_ >= options_.redetect_every_frames);
   // Algorithm 1, lines 16-18: track the matched features inside the segment.
   if (!refresh && !previous_.empty() && !current_px_.empty()) {
     const features::KltResult tracked =
@@ -344,13 +318,35 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
     DetectAndMatch(grey, &step);
   step.matches = last_matches_;
   step.tracked = static_cast<int>(current_px_.size());
-  // Keyframe recovery, once the destination has stayed unmatched for recovery_after_s (a
-  // shortage that passes by itself is waited out, not skipped).
-  if (step.tracked < options_.min_features && waiting_ &&
-      ToSeconds(t_ns - waiting_since_ns_) >= options_.recovery_after_s && Recover(&step)) {
+  // The destination is short of features from a frame with fewer than min_features until one
+  // matches it as well as a recovered keyframe must: a few matches that come and go (the
+  // landmarks' surroundings, the robot creeping a frame at a time) do not end the shortage.
+  const int found = std::max(options_.recovery_min_features, options_.min_features);
+  if (step.tracked < options_.min_features && !short_since_ns_) short_since_ns_ = t_ns;
+  if (step.tracked >= found) short_since_ns_.reset();
+  // Keyframe recovery, once the destination has been short for recovery_after_s (a shortage
+  // that passes by itself is waited out, not skipped).
+  const bool short_long = step.tracked < options_.min_features && short_since_ns_ &&
+                          ToSeconds(t_ns - *short_since_ns_) >= options_.recovery_after_s;
+  if (short_long && Recover(&step)) {
     step.matches = last_matches_;
     step.tracked = static_cast<int>(current_px_.size());
   }
+  // Carrying on through keyframes that recovery could not find (RepeatOptions::carry_on), until
+  // the destination or a following keyframe matches as well as a recovered keyframe must.
+  const bool carry = carry_active_ ? step.tracked < found : short_long && !step.switched;
+  if (carry) {
+    if (const std::optional<Twist2> command = CarryOn(t_ns, &step)) {
+      step.command = *command;
+      step.status = RepeatStatus::kDriving;
+      return step;
+    }
+    step.matches = last_matches_;
+    step.tracked = static_cast<int>(current_px_.size());
+  }
+  // The destination matches again: the funnel lane drives; carrying on resumes where it was
+  // if the destination is lost again.
+  if (step.tracked >= found) carry_active_ = false;
   if (step.tracked < options_.min_features) {
     // Stop while features are insufficient; abort if that lasts too long.
     if (!waiting_) {
@@ -402,7 +398,7 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
       options_.switching != Switching::kMse || by_scale ? switch_votes_ >= confirm : mse_says;
   if (switch_now) {
     step.switched = true;
-    driven_since_switch_s_ = 0.0;
+    MarkSwitch();
     ++destination_;
     mse_.Reset();
     switch_votes_ = 0;

@@ -15,10 +15,12 @@
 
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "mapless/control/funnel_lane.h"
+#include "mapless/control/taught_path.h"
 #include "mapless/features/features.h"
 #include "mapless/features/klt.h"
 #include "mapless/navigation/camera_check.h"
@@ -83,6 +85,15 @@ struct RepeatOptions {
   double recovery_after_s = 2.0;
   double recovery_time_factor = 1.5;
   int recovery_min_features = 20;
+  // Carrying on (not in the paper): when recovery finds no keyframe and the route has the
+  // taught odometry (route::Keyframe::odometry; a teach with odometry) and the frames have the
+  // robot's, the robot drives the taught path by odometry (control/taught_path.h) through the
+  // unmatched keyframe and up to carry_on_keyframes after it, matching each of them every
+  // frame; the first that matches becomes the destination and the funnel lane takes over. It
+  // gives up after carry_on.max_distance_m (then waits and aborts as before). The obstacle watch
+  // guards the way as always. max_distance_m = 0: off.
+  control::TaughtPathOptions carry_on;
+  int carry_on_keyframes = 6;
   // Guided matching (not in the paper): matches must lie within this many pixels of the
   // horizontal displacement predicted from the previous frame (at a segment switch: the previous
   // displacement minus the teach-time shift between the two keyframes). A repeating texture then
@@ -108,14 +119,15 @@ const char* RepeatStatusName(RepeatStatus s);
 // What one frame decided (logged as JSON lines by the apps).
 struct RepeatStep {
   RepeatStatus status = RepeatStatus::kDriving;
-  std::string reason;       // why the robot is waiting, stopped or aborted
-  int destination = 1;      // destination keyframe of the current segment
-  int matches = 0;          // matches at the last detection
-  int tracked = 0;          // features in use this frame
-  bool redetected = false;  // features were detected and matched this frame
-  bool switched = false;    // the segment switched this frame
-  int recovered_from = -1;  // the switch skipped this keyframe, which could not be matched
-  ObstacleCheck obstacle;   // the obstacle watch on this frame
+  std::string reason;        // why the robot is waiting, stopped or aborted
+  int destination = 1;       // destination keyframe of the current segment
+  int matches = 0;           // matches at the last detection
+  int tracked = 0;           // features in use this frame
+  bool redetected = false;   // features were detected and matched this frame
+  bool switched = false;     // the segment switched this frame
+  int recovered_from = -1;   // the switch skipped this keyframe, which could not be matched
+  bool carrying_on = false;  // driving the taught path by odometry (RepeatOptions::carry_on)
+  ObstacleCheck obstacle;    // the obstacle watch on this frame
   control::SwitchDecision switching;
   control::LocalScale local_scale;  // measured on the last segment only (end_by_local_scale)
   control::SlopedFunnelLaneResult sloped;
@@ -133,7 +145,9 @@ class RepeatSession {
 
   // One control period. A camera fault (see camera_check.h) gives kWaiting with the fault as the
   // reason and a zero command; it does not count towards abort_after_s.
-  RepeatStep Update(const cv::Mat& image, Timestamp t_ns);
+  // `odometry`: the robot's odometry pose at the frame, if it has one (only carrying on uses it).
+  RepeatStep Update(const cv::Mat& image, Timestamp t_ns,
+                    const std::optional<Pose2>& odometry = std::nullopt);
   // A longer snapshot of a route a leader is still teaching (fleet/): the same keyframes and
   // more, or the same ones now complete. At the last keyframe of an incomplete route the robot
   // stops (waiting for the leader) instead of completing, and goes on when the next keyframe
@@ -157,6 +171,14 @@ class RepeatSession {
   // Keyframe recovery (RepeatOptions::recovery_keyframes): the nearest following keyframe the
   // robot may have reached that the current frame matches, switched to; false when none does.
   bool Recover(RepeatStep* step);
+  // Switches to the nearest keyframe in [first, last] that the current frame matches with at
+  // least recovery_min_features (and min_features); false when none does. `taught_reach_s`
+  // >= 0: only keyframes k whose k - 1 was taught at most that long after the destination.
+  bool SwitchToMatching(int first, int last, double taught_reach_s, RepeatStep* step);
+  // Carrying on (RepeatOptions::carry_on): starts it if it can; the command of this frame, or
+  // nullopt when it cannot start or has given up.
+  std::optional<Twist2> CarryOn(Timestamp t_ns, RepeatStep* step);
+  void MarkSwitch();  // a new destination: the recovery and carrying-on bookkeeping restart
   std::vector<control::FeaturePair> Pairs() const;
   RepeatStep Stop(RepeatStep step, RepeatStatus status, const std::string& reason);
 
@@ -191,6 +213,12 @@ class RepeatSession {
   double driven_since_switch_s_ = 0.0;  // time with a moving command since the last switch
   bool waiting_ = false;
   Timestamp waiting_since_ns_ = 0;
+  std::optional<Timestamp> short_since_ns_;  // the destination short of features since
+  std::optional<Pose2> odometry_;            // this frame's
+  std::optional<Pose2> switch_odometry_;     // at the last switch (the robot at keyframe dest - 1)
+  std::optional<control::TaughtPathPursuit> carrying_;
+  bool carry_active_ = false;              // driving by carrying_ (paused while matched)
+  bool carried_this_destination_ = false;  // gave up on this destination: no second try
 };
 
 }  // namespace mapless::navigation

@@ -30,7 +30,8 @@ double TeachSession::tracked_fraction() const {
              : static_cast<double>(current_.size()) / static_cast<double>(initial_count_);
 }
 
-std::optional<route::Keyframe> TeachSession::MakeKeyframe(const cv::Mat& grey, Timestamp t_ns) {
+std::optional<route::Keyframe> TeachSession::MakeKeyframe(const cv::Mat& grey, Timestamp t_ns,
+                                                          const std::optional<Pose2>& odometry) {
   // A keyframe without enough features could not be matched in the repeat: the keyframe is
   // deferred to the next frame that has them, and the deferral counted.
   const features::Features f = extractor_.Extract(grey);
@@ -41,6 +42,7 @@ std::optional<route::Keyframe> TeachSession::MakeKeyframe(const cv::Mat& grey, T
   route::Keyframe kf;
   kf.index = next_index_++;
   kf.t_ns = t_ns;
+  kf.odometry = odometry;
   const double scale = static_cast<double>(options_.thumbnail_width_px) / grey.cols;
   cv::resize(grey, kf.thumbnail, cv::Size(), scale, scale, cv::INTER_AREA);
   kf.keypoints = f.keypoints;
@@ -55,13 +57,14 @@ std::optional<route::Keyframe> TeachSession::MakeKeyframe(const cv::Mat& grey, T
   return kf;
 }
 
-std::optional<route::Keyframe> TeachSession::Update(const cv::Mat& image, Timestamp t_ns) {
+std::optional<route::Keyframe> TeachSession::Update(const cv::Mat& image, Timestamp t_ns,
+                                                    const std::optional<Pose2>& odometry) {
   MAPLESS_CHECK(!image.empty(), "TeachSession: empty frame");
   cv::Mat grey = image;
   if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
   std::optional<route::Keyframe> out;
   if (next_index_ == 0) {
-    out = MakeKeyframe(grey, t_ns);  // the first keyframe: the first frame with features
+    out = MakeKeyframe(grey, t_ns, odometry);  // the first keyframe: the first frame with features
   } else {
     MAPLESS_CHECK(grey.size() == previous_.size(), "TeachSession: frame size changed from "
                                                        << previous_.cols << "x" << previous_.rows
@@ -87,18 +90,19 @@ std::optional<route::Keyframe> TeachSession::Update(const cv::Mat& image, Timest
       spread_grew = s0 > 1e-9 && control::StdDev(xs1) / s0 > options_.max_spread_growth;
     }
     if (tracked_fraction() < options_.keyframe_tracked_fraction || spread_grew) {
-      out = MakeKeyframe(grey, t_ns);
+      out = MakeKeyframe(grey, t_ns, odometry);
     }
   }
   previous_is_keyframe_ = out.has_value();
   previous_ = grey.clone();
   previous_t_ns_ = t_ns;
+  previous_odometry_ = odometry;
   return out;
 }
 
 std::optional<route::Keyframe> TeachSession::Finish() {
   if (previous_.empty() || previous_is_keyframe_) return std::nullopt;
-  std::optional<route::Keyframe> last = MakeKeyframe(previous_, previous_t_ns_);
+  std::optional<route::Keyframe> last = MakeKeyframe(previous_, previous_t_ns_, previous_odometry_);
   previous_is_keyframe_ = last.has_value();
   return last;
 }

@@ -39,8 +39,10 @@ class TeachSession {
  public:
   explicit TeachSession(TeachOptions options);
 
-  // Feeds one frame; returns the keyframe this frame became, if it did.
-  std::optional<route::Keyframe> Update(const cv::Mat& image, Timestamp t_ns);
+  // Feeds one frame; returns the keyframe this frame became, if it did. With the robot's
+  // odometry pose at the frame, the keyframe keeps it (route::Keyframe::odometry).
+  std::optional<route::Keyframe> Update(const cv::Mat& image, Timestamp t_ns,
+                                        const std::optional<Pose2>& odometry = std::nullopt);
   // Ends the teach: the last frame becomes the final keyframe unless it already is one or has too
   // few features. Like every keyframe, the first is the first frame with enough features.
   std::optional<route::Keyframe> Finish();
@@ -53,13 +55,15 @@ class TeachSession {
 
  private:
   // The keyframe `grey` becomes, or nullopt (counted as deferred) with too few features.
-  std::optional<route::Keyframe> MakeKeyframe(const cv::Mat& grey, Timestamp t_ns);
+  std::optional<route::Keyframe> MakeKeyframe(const cv::Mat& grey, Timestamp t_ns,
+                                              const std::optional<Pose2>& odometry);
 
   TeachOptions options_;
   features::FeatureExtractor extractor_;
   int next_index_ = 0;
   cv::Mat previous_;
   Timestamp previous_t_ns_ = 0;
+  std::optional<Pose2> previous_odometry_;
   bool previous_is_keyframe_ = false;
   std::vector<cv::Point2f> start_;    // tracked features at the segment's first keyframe
   std::vector<cv::Point2f> current_;  // ... where they are now

@@ -68,7 +68,8 @@ Decision RepeatMethod::Step(const Observation& observation) {
       return Make(MethodState::kStopped, Twist2{}, "waiting",
                   "waiting for the leader: the route has fewer than 2 keyframes yet");
   }
-  navigation::RepeatStep step = session_->Update(observation.image, observation.t_ns);
+  navigation::RepeatStep step =
+      session_->Update(observation.image, observation.t_ns, observation.odometry);
   MethodState state = MethodState::kDriving;
   switch (step.status) {
     case navigation::RepeatStatus::kDriving:

@@ -47,6 +47,7 @@ void RepeatFields(const navigation::RepeatStep& s, nlohmann::json* j) {
   (*j)["tracked"] = s.tracked;
   (*j)["switched"] = s.switched;
   if (s.recovered_from >= 0) (*j)["recovered_from"] = s.recovered_from;
+  if (s.carrying_on) (*j)["carrying_on"] = true;
   (*j)["std_ratio"] = s.switching.std_ratio;
   (*j)["ed_px"] = s.switching.ed_px;
   if (s.local_scale.ok) (*j)["local_scale"] = s.local_scale.ratio;

@@ -194,6 +194,11 @@ std::optional<Keyframe> ParseCanonicalKeyframe(const std::string& text) {
     }
   }
   in.SkipSpace();
+  if (in.Literal("odometry: ")) {
+    if (!in.FlowList(3, &values) || values.size() != 3) return std::nullopt;
+    kf.odometry = Pose2{values[0], values[1], values[2]};
+    in.SkipSpace();
+  }
   if (!in.Literal("end: 1") || !in.AtEnd()) return std::nullopt;
   return kf;
 }
@@ -211,6 +216,10 @@ std::string SerializeKeyframe(const Keyframe& kf) {
   fs << "descriptors" << kf.descriptors;
   fs << "segment_start_px" << kf.segment_start_px;
   fs << "segment_end_px" << kf.segment_end_px;
+  if (kf.odometry) {
+    fs << "odometry"
+       << std::vector<double>{kf.odometry->x_m, kf.odometry->y_m, kf.odometry->theta_rad};
+  }
   fs << "end" << 1;  // last field: a truncated file lacks it
   return fs.releaseAndGetString();
 }
@@ -300,6 +309,12 @@ Keyframe ParseKeyframe(const std::string& text, const std::string& name) {
     };
     kf.segment_start_px = points("segment_start_px");
     kf.segment_end_px = points("segment_end_px");
+    if (root.Has("odometry")) {
+      const std::vector<double> v = root.GetDoubles("odometry", 3);  // x, y, yaw
+      for (const double x : v)
+        if (!std::isfinite(x)) root.Fail("odometry", "a value is not finite");
+      kf.odometry = Pose2{v[0], v[1], v[2]};
+    }
     if (static_cast<std::size_t>(kf.descriptors.rows) != kf.keypoints.size()) {
       throw InputError(name + ": corrupt keyframe file (" + std::to_string(kf.keypoints.size()) +
                        " keypoints but " + std::to_string(kf.descriptors.rows) + " descriptors)");

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,9 @@ struct Keyframe {
   // Features tracked from the previous keyframe to this one (empty for the first keyframe).
   std::vector<cv::Point2f> segment_start_px;
   std::vector<cv::Point2f> segment_end_px;
+  // The robot's odometry pose (REP-105 odom frame) when the keyframe was taught, when the teach
+  // had odometry: lets the repeat carry on through keyframes whose landmarks are gone.
+  std::optional<Pose2> odometry;
 };
 
 struct Route {

@@ -39,6 +39,8 @@ Keyframe MakeKeyframe(int index) {
     kf.segment_start_px = {{10, 20}, {30, 40}};
     kf.segment_end_px = {{12, 21}, {35, 41}};
   }
+  // A teach with odometry stores the pose (odd indices here), one without does not.
+  if (index % 2 == 1) kf.odometry = Pose2{0.5 * index, -0.25 * index, 0.1 * index + 0.0123456789};
   return kf;
 }
 
@@ -62,6 +64,12 @@ TEST(RouteStore, RoundTripsEveryField) {
     EXPECT_EQ(cv::norm(got.descriptors, expected.descriptors, cv::NORM_INF), 0.0);
     EXPECT_EQ(got.segment_end_px, expected.segment_end_px);
     EXPECT_EQ(cv::norm(got.thumbnail, expected.thumbnail, cv::NORM_INF), 0.0);
+    ASSERT_EQ(got.odometry.has_value(), expected.odometry.has_value()) << i;
+    if (got.odometry) {
+      EXPECT_NEAR(got.odometry->x_m, expected.odometry->x_m, 1e-12);
+      EXPECT_NEAR(got.odometry->y_m, expected.odometry->y_m, 1e-12);
+      EXPECT_NEAR(got.odometry->theta_rad, expected.odometry->theta_rad, 1e-12);
+    }
   }
 }
 
@@ -217,9 +225,31 @@ TEST(RouteStore, TheFastKeyframeReaderAgreesWithYamlCpp) {
     EXPECT_EQ(fast.descriptors.type(), general.descriptors.type());
     EXPECT_EQ(fast.segment_start_px, general.segment_start_px);
     EXPECT_EQ(fast.segment_end_px, general.segment_end_px);
+    ASSERT_EQ(fast.odometry.has_value(), index % 2 == 1);
+    ASSERT_EQ(general.odometry.has_value(), index % 2 == 1);
+    if (fast.odometry) {
+      EXPECT_DOUBLE_EQ(fast.odometry->x_m, general.odometry->x_m);
+      EXPECT_DOUBLE_EQ(fast.odometry->theta_rad, general.odometry->theta_rad);
+    }
     // Cut anywhere, the file is refused (by one reader or the other), never half read.
     for (std::size_t n = 0; n + 1 < text.size(); n += 97)
       EXPECT_THROW(ParseKeyframe(text.substr(0, n), "cut"), InputError) << n;
+  }
+}
+
+TEST(RouteStore, ABadOdometryFieldIsNamed) {
+  const std::string text = SerializeKeyframe(MakeKeyframe(1));
+  const std::size_t at = text.find("odometry: ");
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t line_end = text.find(']', at) + 1;  // OpenCV may wrap the list
+  for (const char* bad : {"odometry: [ 1., 2. ]", "odometry: [ 1., .nan, 3. ]", "odometry: x"}) {
+    const std::string broken = text.substr(0, at) + bad + text.substr(line_end);
+    try {
+      ParseKeyframe(broken, "kf.yml");
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("odometry"), std::string::npos) << e.what();
+    }
   }
 }
 

@@ -1,0 +1,102 @@
+// RepeatSession when its destination keyframe cannot be matched (issue 21; not in the paper):
+// keyframe recovery (the following keyframes, within reach) and carrying on along the taught
+// odometry. The rest of the session is in repeat.cc.
+#include <algorithm>
+#include <string>
+
+#include "mapless/navigation/repeat.h"
+
+namespace mapless::navigation {
+
+void RepeatSession::MarkSwitch() {
+  driven_since_switch_s_ = 0.0;
+  switch_odometry_ = odometry_;
+  carrying_.reset();
+  carry_active_ = false;
+  carried_this_destination_ = false;
+  short_since_ns_.reset();
+}
+
+bool RepeatSession::SwitchToMatching(int first, int last, double taught_reach_s, RepeatStep* step) {
+  const auto& kfs = route_->keyframes;
+  const auto taught_at = [&](int k) { return ToSeconds(kfs[static_cast<std::size_t>(k)].t_ns); };
+  last = std::min(last, static_cast<int>(kfs.size()) - 1);
+  for (int k = first; k <= last; ++k) {
+    if (taught_reach_s >= 0.0 && taught_at(k - 1) - taught_at(destination_) > taught_reach_s) break;
+    std::vector<cv::Point2f> cur, dst, scene;
+    MatchKeyframe(k, &cur, &dst, &scene);
+    if (static_cast<int>(cur.size()) <
+        std::max(options_.recovery_min_features, options_.min_features)) {
+      continue;
+    }
+    step->recovered_from = destination_;
+    step->switched = true;
+    destination_ = k;
+    step->destination = k;
+    current_px_ = std::move(cur);
+    destination_px_ = std::move(dst);
+    scene_px_ = std::move(scene);
+    last_matches_ = static_cast<int>(current_px_.size());
+    mse_.Reset();
+    switch_votes_ = 0;
+    MarkSwitch();
+    return true;
+  }
+  return false;
+}
+
+bool RepeatSession::Recover(RepeatStep* step) {
+  if (options_.recovery_keyframes <= 0 || !step->redetected) return false;
+  // Keyframe k as the destination puts the robot past keyframe k - 1: the keyframe after the
+  // unmatched one always qualifies (the robot is somewhere before the unmatched keyframe, the
+  // next one is the next place it can head for), those farther only as far as the robot may
+  // have driven since the last switch.
+  return SwitchToMatching(destination_ + 1, destination_ + options_.recovery_keyframes,
+                          options_.recovery_time_factor * driven_since_switch_s_, step);
+}
+
+std::optional<Twist2> RepeatSession::CarryOn(Timestamp t_ns, RepeatStep* step) {
+  if (options_.carry_on.max_distance_m <= 0.0 || !odometry_ || !step->redetected) return {};
+  const auto& kfs = route_->keyframes;
+  const int last =
+      std::min(destination_ + options_.carry_on_keyframes, static_cast<int>(kfs.size()) - 1);
+  if (!carrying_) {
+    // From the place of the last switch (keyframe destination - 1), through the taught poses of
+    // the unmatched keyframe and those after it; not again once given up at this destination.
+    const auto& from = kfs[static_cast<std::size_t>(destination_ - 1)];
+    if (carried_this_destination_ || !switch_odometry_ || !from.odometry) return {};
+    std::vector<Pose2> taught;
+    for (int k = destination_; k <= last; ++k) {
+      const auto& kf = kfs[static_cast<std::size_t>(k)];
+      if (!kf.odometry) break;
+      taught.push_back(*kf.odometry);
+    }
+    if (taught.empty()) return {};
+    carrying_.emplace(std::move(taught), *from.odometry, *switch_odometry_, options_.carry_on);
+  }
+  carry_active_ = true;
+  // A following keyframe that matches ends it: the funnel lane takes over.
+  if (SwitchToMatching(destination_ + 1, last, -1.0, step)) return {};
+  const double speed = options_.controller == Controller::kSloped
+                           ? options_.sloped.max_speed_mps
+                           : options_.standard.forward_speed_mps;
+  const std::optional<Twist2> command = carrying_->Command(*odometry_, speed);
+  if (!command) {
+    // Given up: the robot stops and the abort countdown starts afresh; no second try at this
+    // destination.
+    carrying_.reset();
+    carry_active_ = false;
+    carried_this_destination_ = true;
+    waiting_since_ns_ = t_ns;
+    return {};
+  }
+  step->carrying_on = true;
+  step->reason = "carrying on: keyframe " + std::to_string(destination_) +
+                 " does not match; driving the taught path by odometry (" +
+                 std::to_string(static_cast<int>(100.0 * carrying_->driven_m())) + " cm of " +
+                 std::to_string(static_cast<int>(100.0 * options_.carry_on.max_distance_m)) +
+                 " cm)";
+  return command;
+}
+
+}  // namespace mapless::navigation
