@@ -71,8 +71,8 @@ nlohmann::json EntryJson(const eval::EntryResult& r) {
           {"collisions", r.collisions},
           {"obstacle_stops", r.obstacle_stops},
           {"stops_at_added_object", r.stops_at_added_object},
-          {"min_clearance_m", std::isfinite(r.min_clearance_m) ? nlohmann::json(r.min_clearance_m)
-                                                               : nlohmann::json()},
+          {"min_clearance_m",
+           std::isfinite(r.min_clearance_m) ? nlohmann::json(r.min_clearance_m) : nlohmann::json()},
           {"failures", r.failures}};
 }
 
@@ -212,6 +212,7 @@ void AddEvalCommand(CLI::App* app) {
     std::string end = "scale";
     int redetect_every = navigation::RepeatOptions{}.redetect_every_frames;
     int recover_keyframes = navigation::RepeatOptions{}.recovery_keyframes;
+    double carry_on_m = navigation::RepeatOptions{}.carry_on.max_distance_m;
     std::string on_obstacle;  // default: stop
     std::string report;
   };
@@ -254,6 +255,11 @@ void AddEvalCommand(CLI::App* app) {
                   "off)")
       ->capture_default_str()
       ->check(CLI::Range(0, 20));
+  cmd->add_option("--carry-on-m", args->carry_on_m,
+                  "table1, funnel-scenarios, obstacles: carrying on along the taught odometry, "
+                  "at most this many metres (0: off)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0));
   cmd->add_option("--on-obstacle", args->on_obstacle,
                   "table1, funnel-scenarios, obstacles: the obstacle watch, stop (default, as in "
                   "`repeat`) or off (the paper's repeat)")
@@ -276,19 +282,21 @@ void AddEvalCommand(CLI::App* app) {
     }
     const bool teach_repeat = args->suite != "potential" && args->suite != "eigenspace";
     const navigation::RepeatOptions defaults;
-    if (!teach_repeat && (args->switching != "stdratio" || args->end != "scale" ||
-                          args->redetect_every != defaults.redetect_every_frames ||
-                          args->recover_keyframes != defaults.recovery_keyframes ||
-                          !args->on_obstacle.empty()))
+    if (!teach_repeat &&
+        (args->switching != "stdratio" || args->end != "scale" ||
+         args->redetect_every != defaults.redetect_every_frames ||
+         args->recover_keyframes != defaults.recovery_keyframes ||
+         args->carry_on_m != defaults.carry_on.max_distance_m || !args->on_obstacle.empty()))
       throw InputError(
-          "--switching, --end, --redetect-every, --recover-keyframes and --on-obstacle apply to "
-          "table1, funnel-scenarios and obstacles, not " +
+          "--switching, --end, --redetect-every, --recover-keyframes, --carry-on-m and "
+          "--on-obstacle apply to table1, funnel-scenarios and obstacles, not " +
           args->suite);
     eval::RepeatRunOptions base;
     base.repeat.switching = navigation::ParseSwitching(args->switching);
     base.repeat.end_by_local_scale = ParseEndByLocalScale(args->end);
     base.repeat.redetect_every_frames = args->redetect_every;
     base.repeat.recovery_keyframes = args->recover_keyframes;
+    base.repeat.carry_on.max_distance_m = args->carry_on_m;
     if (args->on_obstacle.empty()) args->on_obstacle = "stop";
     base.repeat.obstacle.enabled = args->on_obstacle == "stop";
     if (args->suite == "potential") {
@@ -340,9 +348,9 @@ void AddEvalCommand(CLI::App* app) {
     j["on_obstacle"] = args->on_obstacle;
     j["end"] = args->end;
     FILE* table = args->json ? stderr : stdout;
-    std::fprintf(table, "%-30s %-9s %9s %10s %10s %10s %5s %6s %7s %9s\n", "scenario",
-                 "control", "success", "final rms", "final std", "lateral", "coll", "stops",
-                 "at obj", "clearance");
+    std::fprintf(table, "%-30s %-9s %9s %10s %10s %10s %5s %6s %7s %9s\n", "scenario", "control",
+                 "success", "final rms", "final std", "lateral", "coll", "stops", "at obj",
+                 "clearance");
     for (const auto& r : results) {
       j["results"].push_back(EntryJson(r));
       const std::string clearance =

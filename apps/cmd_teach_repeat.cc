@@ -81,6 +81,7 @@ void AddTeachRepeatCommands(CLI::App* app) {
     std::string end = "scale";
     int redetect_every = navigation::RepeatOptions{}.redetect_every_frames;
     int recover_keyframes = navigation::RepeatOptions{}.recovery_keyframes;
+    double carry_on_m = navigation::RepeatOptions{}.carry_on.max_distance_m;
     std::string on_obstacle;  // empty: the robot file's, else stop
     std::string log;
     std::uint64_t seed = 1;
@@ -133,6 +134,15 @@ void AddTeachRepeatCommands(CLI::App* app) {
                    "docs/teach_and_repeat.md#keyframe-recovery)")
       ->capture_default_str()
       ->check(CLI::Range(0, 20));
+  repeat
+      ->add_option(
+          "--carry-on-m", r->carry_on_m,
+          "When no keyframe matches and recovery finds none: drive the taught path by "
+          "odometry for at most this many metres, matching the following keyframes "
+          "(needs a route taught with odometry; 0: off; "
+          "docs/teach_and_repeat.md#carrying-on-along-the-taught-odometry-keyframe_car_gone)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0));
   AddOnObstacleOption(repeat, &r->on_obstacle);
   repeat->add_option("--log", r->log,
                      "Per-frame decisions as JSON lines to this file (default: stdout; on a robot: "
@@ -170,6 +180,7 @@ void AddTeachRepeatCommands(CLI::App* app) {
     options.end_by_local_scale = ParseEndByLocalScale(r->end);
     options.redetect_every_frames = r->redetect_every;
     options.recovery_keyframes = r->recover_keyframes;
+    options.carry_on.max_distance_m = r->carry_on_m;
     options.features.type = features::ParseDetectorType(route->detector);
     options.obstacle = ObstacleWatchFor(r->robot, r->on_obstacle, options.obstacle);
     if (!r->robot.empty()) {

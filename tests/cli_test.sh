@@ -177,6 +177,12 @@ grep -q "not both" "$TMP/err"; check "ground says F0 F1 or --source" $?
 expect_exit "teach on the simulator" 0 "$MAPLESS" teach --source sim:rotation_in_place --out "$TMP/simroute"
 expect_exit "repeat with the paper's end rule" 0 "$MAPLESS" repeat --route "$TMP/simroute" --source sim:rotation_in_place --end switching --log "$TMP/rep2.jsonl"
 tail -1 "$TMP/rep2.jsonl" | grep -q '"status":"completed"' && ! grep -q '"local_scale":' "$TMP/rep2.jsonl"; check "--end switching completes without the local scale" $?
+# A teach with odometry (the simulator) stores each keyframe's pose; one from a folder without
+# poses does not (carrying on needs it).
+grep -q "^odometry: " "$TMP/simroute/keyframes/000001.yml" && ! grep -q "^odometry: " "$TMP/route/keyframes/000001.yml"; check "keyframes keep the teach's odometry when it had any" $?
+expect_exit "a negative --carry-on-m exits 2" 2 "$MAPLESS" repeat --route "$TMP/route" --source "$TMP/d1/frames" --carry-on-m -1
+grep -q -- "--carry-on-m" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "a bad --carry-on-m is named in one line" $?
+expect_exit "eval potential refuses --carry-on-m" 2 "$MAPLESS" eval potential --runs 1 --carry-on-m 2
 expect_exit "unknown --end exits 2" 2 "$MAPLESS" repeat --route "$TMP/route" --source "$TMP/d1/frames" --end sideways
 grep -q "\-\-end 'sideways'" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "unknown --end names the value in one line" $?
 

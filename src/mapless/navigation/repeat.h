@@ -77,8 +77,10 @@ struct RepeatOptions {
   // unmatched keyframe (the funnel lane has no odometry; the time with a moving command is its
   // measure). The nearest one with at least recovery_min_features matches becomes the
   // destination; with none the robot stops and aborts as before. 0 keyframes: off (the paper).
-  // Recovery starts once the robot has waited recovery_after_s for its destination: a shortage
-  // that passes by itself (a few frames of blur) is waited out, not skipped. 3 by default: with
+  // Recovery starts once the destination has been short of features for recovery_after_s: a
+  // shortage that passes by itself (a few frames of blur) is waited out, not skipped. The
+  // shortage begins at a frame with fewer than min_features matches and ends only at one with
+  // recovery_min_features (a few matches that come and go do not end it). 3 by default: with
   // it every row of table1 and funnel-scenarios is as without it, indoor_30m standard 9/10
   // instead of 8/10 (docs/teach_and_repeat.md#keyframe-recovery).
   int recovery_keyframes = 3;

@@ -217,8 +217,13 @@ std::string SerializeKeyframe(const Keyframe& kf) {
   fs << "segment_start_px" << kf.segment_start_px;
   fs << "segment_end_px" << kf.segment_end_px;
   if (kf.odometry) {
+    // To the micrometre and the nanoradian: odometry recorded as a quaternion (nav_msgs/Odometry)
+    // gives back the yaw within a few units of the last bit, and a route taught from the
+    // recording must be the route taught live, file for file.
+    const auto round = [](double v, double unit) { return std::round(v / unit) * unit; };
     fs << "odometry"
-       << std::vector<double>{kf.odometry->x_m, kf.odometry->y_m, kf.odometry->theta_rad};
+       << std::vector<double>{round(kf.odometry->x_m, 1e-6), round(kf.odometry->y_m, 1e-6),
+                              round(kf.odometry->theta_rad, 1e-9)};
   }
   fs << "end" << 1;  // last field: a truncated file lacks it
   return fs.releaseAndGetString();

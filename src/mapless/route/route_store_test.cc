@@ -66,9 +66,11 @@ TEST(RouteStore, RoundTripsEveryField) {
     EXPECT_EQ(cv::norm(got.thumbnail, expected.thumbnail, cv::NORM_INF), 0.0);
     ASSERT_EQ(got.odometry.has_value(), expected.odometry.has_value()) << i;
     if (got.odometry) {
-      EXPECT_NEAR(got.odometry->x_m, expected.odometry->x_m, 1e-12);
-      EXPECT_NEAR(got.odometry->y_m, expected.odometry->y_m, 1e-12);
-      EXPECT_NEAR(got.odometry->theta_rad, expected.odometry->theta_rad, 1e-12);
+      // Stored to the micrometre and the nanoradian.
+      EXPECT_NEAR(got.odometry->x_m, expected.odometry->x_m, 0.5e-6);
+      EXPECT_NEAR(got.odometry->y_m, expected.odometry->y_m, 0.5e-6);
+      EXPECT_NEAR(got.odometry->theta_rad, expected.odometry->theta_rad, 0.5e-9);
+      EXPECT_NE(got.odometry->theta_rad, expected.odometry->theta_rad);  // 0.1123456789 rounded
     }
   }
 }
