@@ -328,7 +328,8 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
   // that passes by itself is waited out, not skipped).
   const bool short_long = step.tracked < options_.min_features && short_since_ns_ &&
                           ToSeconds(t_ns - *short_since_ns_) >= options_.recovery_after_s;
-  if (short_long && Recover(&step)) {
+  // While carrying on, CarryOn tries every keyframe recovery would (and farther): not twice.
+  if (short_long && !carrying_ && Recover(&step)) {
     step.matches = last_matches_;
     step.tracked = static_cast<int>(current_px_.size());
   }
