@@ -138,7 +138,7 @@ void AddFollowCommand(CLI::App* app) {
     cv::Size size;
     const std::shared_ptr<const route::AppearanceRoute> route = RebuildRoute(a->route, &size);
     navigation::AppearanceFollowerOptions follower;
-    follower.obstacle = ObstacleWatchFor(a->robot, a->on_obstacle, follower.obstacle);
+    follower.obstacle = ObstacleWatchFor(a->robot, a->on_obstacle, follower.obstacle, false);
     robot::FollowMethod method([route] { return route; }, follower, size);
     if (!a->robot.empty()) {
       const auto recorder = OpenRecorder(a->record);

@@ -182,7 +182,7 @@ void AddTeachRepeatCommands(CLI::App* app) {
     options.recovery_keyframes = r->recover_keyframes;
     options.carry_on.max_distance_m = r->carry_on_m;
     options.features.type = features::ParseDetectorType(route->detector);
-    options.obstacle = ObstacleWatchFor(r->robot, r->on_obstacle, options.obstacle);
+    options.obstacle = ObstacleWatchFor(r->robot, r->on_obstacle, options.obstacle, true);
     if (!r->robot.empty()) {
       options.sloped.max_speed_mps = r->speed;
       options.standard.forward_speed_mps = r->speed;

@@ -325,7 +325,7 @@ void FollowConnected(const FollowConnectArgs& a) {
   if (header.kind == fleet::RouteKind::kFunnel) {
     navigation::RepeatOptions repeat;
     repeat.features.type = features::ParseDetectorType(header.detector);
-    repeat.obstacle = ObstacleWatchFor(a.robot, a.on_obstacle, repeat.obstacle);
+    repeat.obstacle = ObstacleWatchFor(a.robot, a.on_obstacle, repeat.obstacle, true);
     if (scenario) {
       const double speed =
           eval::RepeatSpeedFor(*scenario, eval::RepeatRunOptions{}.max_repeat_speed_mps);
@@ -336,7 +336,7 @@ void FollowConnected(const FollowConnectArgs& a) {
         std::make_unique<robot::RepeatMethod>([&copy] { return copy.FunnelRoute(); }, repeat, size);
   } else {
     navigation::AppearanceFollowerOptions follower;
-    follower.obstacle = ObstacleWatchFor(a.robot, a.on_obstacle, follower.obstacle);
+    follower.obstacle = ObstacleWatchFor(a.robot, a.on_obstacle, follower.obstacle, false);
     method = std::make_unique<robot::FollowMethod>([&copy] { return copy.AppearanceRoute(); },
                                                    follower, size);
   }

@@ -52,24 +52,37 @@ std::unique_ptr<robot::RobotLink> OpenRobotLink(const robot::RobotFile& robot, c
 
 navigation::ObstacleWatchOptions ObstacleWatchFor(const std::string& robot_path,
                                                   const std::string& on_obstacle,
-                                                  const navigation::ObstacleWatchOptions& defaults) {
+                                                  const navigation::ObstacleWatchOptions& defaults,
+                                                  bool can_avoid) {
   navigation::ObstacleWatchOptions o = defaults;
+  std::string from = "--on-obstacle";
   if (!robot_path.empty()) {
     const robot::RobotFile file = robot::LoadRobotFile(robot_path);
     o = file.obstacle;
     if (!file.obstacle_baseline_given) o.baseline_m = defaults.baseline_m;
+    from = robot_path + ": obstacles.on_obstacle";
   }
-  if (!on_obstacle.empty()) o.enabled = on_obstacle == "stop";
+  if (!on_obstacle.empty()) {
+    o.enabled = on_obstacle != "off";
+    o.avoid = on_obstacle == "avoid";
+    from = "--on-obstacle";
+  }
+  if (o.enabled && o.avoid && !can_avoid)
+    throw InputError(from +
+                     ": avoid is built for teach & repeat only; the appearance follower stops "
+                     "(stop or off)");
   return o;
 }
 
 void AddOnObstacleOption(CLI::App* cmd, std::string* on_obstacle) {
   cmd->add_option("--on-obstacle", *on_obstacle,
                   "Obstacle watch: stop (halt before something new on the way ahead, status "
-                  "blocked or stopped with the reason, go on when it is gone) or off (the "
-                  "paper's method). Default: the robot file's obstacles.on_obstacle, else stop "
+                  "blocked or stopped with the reason, go on when it is gone), avoid (teach & "
+                  "repeat: go round it by odometry and rejoin the route; "
+                  "docs/teach_and_repeat.md#avoid) or off (the paper's method). Default: the "
+                  "robot file's obstacles.on_obstacle, else stop "
                   "(docs/teach_and_repeat.md#obstacle-watch)")
-      ->check(CLI::IsMember({"stop", "off"}));
+      ->check(CLI::IsMember({"stop", "avoid", "off"}));
 }
 
 void RunOnRobot(robot::Method& method, const std::string& robot_path, const std::string& log_path,

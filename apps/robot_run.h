@@ -27,11 +27,12 @@ std::unique_ptr<robot::RobotLink> OpenRobotLink(const robot::RobotFile& robot, c
 // The obstacle watch of `repeat` and `follow`: the method's `defaults` with the robot file's
 // section `obstacles` when a robot file is given (its baseline_m only when the file has one: the
 // methods' defaults differ with their speeds), and `on_obstacle` ("stop" or "off"; empty: as
-// there).
+// there; "avoid": go round, teach & repeat only: `can_avoid` false refuses it with one line).
 navigation::ObstacleWatchOptions ObstacleWatchFor(const std::string& robot_path,
                                                   const std::string& on_obstacle,
-                                                  const navigation::ObstacleWatchOptions& defaults);
-// `--on-obstacle` of `repeat` and `follow`.
+                                                  const navigation::ObstacleWatchOptions& defaults,
+                                                  bool can_avoid);
+// `--on-obstacle` of `repeat` and `follow` (stop, avoid, off).
 void AddOnObstacleOption(CLI::App* cmd, std::string* on_obstacle);
 
 void RunOnRobot(robot::Method& method, const std::string& robot_path, const std::string& log_path,

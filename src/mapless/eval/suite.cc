@@ -49,6 +49,12 @@ sim::World ObjectsAddedAtRepeat(const sim::Scenario& scenario) {
   return added;
 }
 
+sim::WorldVariant ObjectsStay(sim::WorldVariant variant) {
+  for (auto& o : variant.add) o.leaves_s = std::numeric_limits<double>::infinity();
+  variant.leave_s.clear();
+  return variant;
+}
+
 std::vector<std::string> SuiteNames() { return {"table1", "funnel-scenarios", "obstacles"}; }
 
 std::vector<SuiteEntry> SuiteEntries(const std::string& suite) {

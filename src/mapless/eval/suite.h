@@ -25,6 +25,9 @@ std::vector<std::string> SuiteNames();
 // The objects a scenario's repeat adds (its variant), with the times they leave at: for the
 // obstacle figures (stops while one stood there, clearance to it).
 sim::World ObjectsAddedAtRepeat(const sim::Scenario& scenario);
+// The variant with every object it adds staying for the whole run (no leaves_s, no leave_s):
+// `eval --on-obstacle avoid`.
+sim::WorldVariant ObjectsStay(sim::WorldVariant variant);
 std::vector<SuiteEntry> SuiteEntries(const std::string& suite);  // throws InputError if unknown
 
 struct EntryResult {

@@ -75,6 +75,8 @@ void ObstacleWatchOptions::Validate() const {
                 "ObstacleWatchOptions.region_top = " << region_top << "; must be in [0, 1)");
   MAPLESS_CHECK(region_width > 0.0 && region_width <= 1.0,
                 "ObstacleWatchOptions.region_width = " << region_width << "; must be in (0, 1]");
+  MAPLESS_CHECK(region_half_width_m > 0.0, "ObstacleWatchOptions.region_half_width_m = "
+                                                << region_half_width_m << "; must be > 0");
   MAPLESS_CHECK(horizon >= 0.0 && horizon < region_top,
                 "ObstacleWatchOptions.horizon = " << horizon << "; must be in [0, region_top = "
                                                   << region_top << ")");
@@ -165,6 +167,13 @@ ObstacleCheck ObstacleWatch::Update(const cv::Mat& grey, Timestamp t_ns, double 
     }
   }
   return check;
+}
+
+void ObstacleWatch::Resume() {
+  blocked_ = false;
+  votes_ = 0;
+  free_votes_ = 0;
+  history_.clear();
 }
 
 cv::Mat ObstacleWatch::FitGround(const std::vector<cv::Point2f>& here,
@@ -306,16 +315,10 @@ ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, const std::vector<cv::Mat
   const cv::Mat h = FitGround(here, there, draw);
   if (h.empty()) return check;
   check.plane_found = true;
-  // The region's points off the plane (and not next to the taught scene) are the candidates.
-  std::vector<std::size_t> in_region;
-  std::vector<cv::Point2f> region_here, predicted;
-  for (std::size_t i = 0; i < here.size(); ++i) {
-    if (!InRegion(here[i], size)) continue;
-    in_region.push_back(i);
-    region_here.push_back(here[i]);
-  }
-  if (region_here.empty()) return check;
-  cv::perspectiveTransform(region_here, predicted, h);
+  // The region's points off the plane (and not next to the taught scene) are the candidates;
+  // with avoid, also every other point below fit_top off the plane (the obstacle's extent).
+  std::vector<cv::Point2f> predicted;
+  cv::perspectiveTransform(here, predicted, h);
   const double r2 = options_.known_radius_px * options_.known_radius_px;
   const auto known = [&](const cv::Point2f& p) {
     return std::any_of(known_px.begin(), known_px.end(), [&](const cv::Point2f& k) {
@@ -323,19 +326,25 @@ ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, const std::vector<cv::Mat
       return dx * dx + dy * dy <= r2;
     });
   };
+  int region_points = 0;
   std::vector<cv::Point2f> candidates, candidates_there;
-  for (std::size_t r = 0; r < in_region.size(); ++r) {
-    const std::size_t i = in_region[r];
+  std::vector<char> candidate_in_region;
+  for (std::size_t i = 0; i < here.size(); ++i) {
+    const bool in_region = InRegion(here[i], size);
+    region_points += in_region ? 1 : 0;
+    if (!in_region && !options_.avoid) continue;
     const double flow = cv::norm(there[i] - here[i]);
-    const double off = cv::norm(there[i] - predicted[r]);
-    if (off > options_.tolerance_px + options_.tolerance_relative * flow && !known(here[i])) {
+    const double off = cv::norm(there[i] - predicted[i]);
+    if (off > options_.tolerance_px + options_.tolerance_relative * flow &&
+        !(in_region && known(here[i]))) {
       candidates.push_back(here[i]);
       candidates_there.push_back(there[i]);
+      candidate_in_region.push_back(in_region ? 1 : 0);
     }
   }
+  if (region_points == 0) return check;
   // A candidate counts when its track is right: tracked back, it returns to where it started.
   // One that does not is a wrong track, neither obstacle nor ground: out of the count.
-  int region_points = static_cast<int>(in_region.size());
   int obstacle_points = 0;
   if (!candidates.empty()) {
     std::vector<cv::Point2f> back;
@@ -343,7 +352,10 @@ ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, const std::vector<cv::Mat
     cv::calcOpticalFlowPyrLK(earlier->pyramid, pyramid, candidates_there, back, ok_back, err,
                              window, options_.levels, stop, 0, options_.min_eigen);
     for (std::size_t c = 0; c < candidates.size(); ++c) {
-      if (ok_back[c] && cv::norm(back[c] - candidates[c]) <= options_.max_round_trip_px) {
+      const bool right = ok_back[c] && cv::norm(back[c] - candidates[c]) <= options_.max_round_trip_px;
+      if (right) check.off_plane_px.push_back(candidates[c]);
+      if (!candidate_in_region[c]) continue;
+      if (right) {
         ++obstacle_points;
         check.obstacle_px.push_back(candidates[c]);
       } else {

@@ -50,6 +50,13 @@ struct ObstacleWatchOptions {
   // On by default (issue 21: `--on-obstacle stop` is the default); false: the paper's repeat.
   // False alarms measured on table1 and funnel-scenarios: docs/teach_and_repeat.md#obstacle-watch.
   bool enabled = true;
+  // `--on-obstacle avoid` (repeat only): go round the obstacle instead of waiting for it to be
+  // taken away (control/detour.h; needs the robot's odometry, without it the robot stops).
+  bool avoid = false;
+  // The strip's half-width on the ground (the robot's half-width and the margin region_width
+  // stands for; 0.27 m for the simulator's robot and camera, see above): with avoid, how far
+  // aside to step, from the obstacle's extent in the image (control::LateralExtent).
+  double region_half_width_m = 0.27;
   double baseline_m = 0.08;       // commanded forward motion between the two frames compared
   double max_baseline_rad = 0.1;  // ... and at most this much commanded turning
   double max_age_s = 2.0;         // older frames are not used as the earlier frame
@@ -100,6 +107,9 @@ struct ObstacleCheck {
   bool cleared = false;           // this frame the obstacle was seen to be gone
   std::string reason;             // why blocked (empty when free)
   std::vector<cv::Point2f> obstacle_px;  // the obstacle points (debug pictures)
+  // With avoid: every point below fit_top off the ground's plane (the region's obstacle points
+  // and those beside it: the obstacle's extent, walls), for going round.
+  std::vector<cv::Point2f> off_plane_px;
 };
 
 class ObstacleWatch {
@@ -112,6 +122,9 @@ class ObstacleWatch {
   ObstacleCheck Update(const cv::Mat& grey, Timestamp t_ns, double forward_m, double turned_rad,
                        const std::vector<cv::Point2f>& known_px = {});
   bool blocked() const { return blocked_; }
+  // Drops a confirmed obstacle and the frames seen so far: the robot is going round it (avoid),
+  // and the next check needs a new baseline.
+  void Resume();
   const ObstacleWatchOptions& options() const { return options_; }
 
  private:

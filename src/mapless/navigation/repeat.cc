@@ -97,6 +97,9 @@ void RepeatOptions::Validate() const {
   // recovery_after_s >= abort_after_s is allowed: the repeat then aborts before it recovers.
   MAPLESS_CHECK(recovery_after_s >= 0.0,
                 "RepeatOptions.recovery_after_s = " << recovery_after_s << "; must be >= 0");
+  detour.Validate();
+  MAPLESS_CHECK(max_detours >= 0,
+                "RepeatOptions.max_detours = " << max_detours << "; must be >= 0");
   MAPLESS_CHECK(mse_rising_frames >= 1,
                 "RepeatOptions.mse_rising_frames = " << mse_rising_frames << "; must be >= 1");
 }
@@ -238,9 +241,16 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns,
   } else {
     // The obstacle watch first: a blocked robot does not look for its keyframe.
     // The taught scene: the features whose descriptors matched the route on the previous frame.
-    const ObstacleCheck obstacle = watch_.Update(grey, t_ns, last_command_.v_mps * dt,
-                                                 last_command_.omega_radps * dt, scene_px_);
-    if (obstacle.blocked) {
+    // Going round an obstacle, the last frame's match with the route is stale: no known scene.
+    const ObstacleCheck obstacle =
+        watch_.Update(grey, t_ns, last_command_.v_mps * dt, last_command_.omega_radps * dt,
+                      detour_ ? std::vector<cv::Point2f>{} : scene_px_);
+    const bool started = !detour_ && obstacle.blocked && StartDetour(obstacle, grey.size());
+    if (detour_) {
+      // Going round it (--on-obstacle avoid) until back on the route; the obstacle that started
+      // the detour is not news to it.
+      step = Detouring(step, started ? ObstacleCheck{} : obstacle);
+    } else if (obstacle.blocked) {
       step.matches = last_matches_;
       step = Stop(step, RepeatStatus::kBlocked, obstacle.reason);
     } else {
@@ -324,6 +334,17 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
   const int found = std::max(options_.recovery_min_features, options_.min_features);
   if (step.tracked < options_.min_features && !short_since_ns_) short_since_ns_ = t_ns;
   if (step.tracked >= found) short_since_ns_.reset();
+  // Back on the route after a detour: the destination, or the nearest following keyframe that
+  // matches as a recovered one must (the detour may have taken the robot past the destination).
+  if (reacquire_) {
+    reacquire_ = false;
+    if (step.tracked < found &&
+        SwitchToMatching(destination_ + 1, destination_ + options_.carry_on_keyframes, -1.0,
+                         &step)) {
+      step.matches = last_matches_;
+      step.tracked = static_cast<int>(current_px_.size());
+    }
+  }
   // Keyframe recovery, once the destination has been short for recovery_after_s (a shortage
   // that passes by itself is waited out, not skipped).
   const bool short_long = step.tracked < options_.min_features && short_since_ns_ &&

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "mapless/control/detour.h"
 #include "mapless/control/funnel_lane.h"
 #include "mapless/control/taught_path.h"
 #include "mapless/features/features.h"
@@ -106,7 +107,14 @@ struct RepeatOptions {
   CameraCheckOptions camera;  // camera faults: the robot waits, the session carries on after
   // Obstacle watch (not in the paper; obstacle_watch.h): something on the route ahead stops the
   // robot (status "blocked") until it is gone. On by default; enabled = false: the paper's repeat.
+  // With obstacle.avoid the robot goes round it instead (control/detour.h, by odometry: a frame
+  // without odometry stops as without avoid), at most max_detours times per destination keyframe
+  // (then it stops and waits as without avoid), and re-acquires the destination or, when that
+  // no longer matches with recovery_min_features, the nearest following keyframe within
+  // carry_on_keyframes that does.
   ObstacleWatchOptions obstacle;
+  control::DetourOptions detour;
+  int max_detours = 3;
   // At the last keyframe of an incomplete route: false, the repeat ends there (an interrupted
   // teach read from disk); true, the robot waits for the leader that is still teaching it (fleet:
   // see Extend()).
@@ -129,6 +137,7 @@ struct RepeatStep {
   bool switched = false;     // the segment switched this frame
   int recovered_from = -1;   // the switch skipped this keyframe, which could not be matched
   bool carrying_on = false;  // driving the taught path by odometry (RepeatOptions::carry_on)
+  bool avoiding = false;     // going round an obstacle (obstacle.avoid; reason: the phase)
   ObstacleCheck obstacle;    // the obstacle watch on this frame
   control::SwitchDecision switching;
   control::LocalScale local_scale;  // measured on the last segment only (end_by_local_scale)
@@ -181,6 +190,12 @@ class RepeatSession {
   // nullopt when it cannot start or has given up.
   std::optional<Twist2> CarryOn(Timestamp t_ns, RepeatStep* step);
   void MarkSwitch();  // a new destination: the recovery and carrying-on bookkeeping restart
+  // Avoid (RepeatOptions::obstacle.avoid; repeat_avoid.cc): starts a detour round the obstacle
+  // the watch has just confirmed; false when it cannot (no odometry, too many detours).
+  bool StartDetour(const ObstacleCheck& obstacle, cv::Size image);
+  // This frame of the detour under way, the watch's check of the frame.
+  RepeatStep Detouring(RepeatStep step, const ObstacleCheck& obstacle);
+  double RouteSpeed() const;
   std::vector<control::FeaturePair> Pairs() const;
   RepeatStep Stop(RepeatStep step, RepeatStatus status, const std::string& reason);
 
@@ -221,6 +236,9 @@ class RepeatSession {
   std::optional<control::TaughtPathPursuit> carrying_;
   bool carry_active_ = false;              // driving by carrying_ (paused while matched)
   bool carried_this_destination_ = false;  // gave up on this destination: no second try
+  std::optional<control::Detour> detour_;  // going round an obstacle
+  int detours_ = 0;                        // detours started for this destination
+  bool reacquire_ = false;                 // a detour ended: find the route's keyframe again
 };
 
 }  // namespace mapless::navigation

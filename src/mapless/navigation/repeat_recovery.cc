@@ -15,6 +15,7 @@ void RepeatSession::MarkSwitch() {
   carry_active_ = false;
   carried_this_destination_ = false;
   short_since_ns_.reset();
+  detours_ = 0;
 }
 
 bool RepeatSession::SwitchToMatching(int first, int last, double taught_reach_s, RepeatStep* step) {
@@ -43,6 +44,11 @@ bool RepeatSession::SwitchToMatching(int first, int last, double taught_reach_s,
     return true;
   }
   return false;
+}
+
+double RepeatSession::RouteSpeed() const {
+  return options_.controller == Controller::kSloped ? options_.sloped.max_speed_mps
+                                                    : options_.standard.forward_speed_mps;
 }
 
 bool RepeatSession::Recover(RepeatStep* step) {
@@ -77,10 +83,7 @@ std::optional<Twist2> RepeatSession::CarryOn(Timestamp t_ns, RepeatStep* step) {
   carry_active_ = true;
   // A following keyframe that matches ends it: the funnel lane takes over.
   if (SwitchToMatching(destination_ + 1, last, -1.0, step)) return {};
-  const double speed = options_.controller == Controller::kSloped
-                           ? options_.sloped.max_speed_mps
-                           : options_.standard.forward_speed_mps;
-  const std::optional<Twist2> command = carrying_->Command(*odometry_, speed);
+  const std::optional<Twist2> command = carrying_->Command(*odometry_, RouteSpeed());
   if (!command) {
     // Given up: the robot stops and the abort countdown starts afresh; no second try at this
     // destination.

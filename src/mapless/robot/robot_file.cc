@@ -159,8 +159,10 @@ RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
       o.CheckKnownKeys({"on_obstacle", "region_top", "region_width", "horizon", "baseline_m",
                         "min_blocked_fraction"});
       const std::string on = o.GetString("on_obstacle", "stop");
-      if (on != "stop" && on != "off") o.Fail("on_obstacle", "'" + on + "' is not stop or off");
-      r.obstacle.enabled = on == "stop";
+      if (on != "stop" && on != "avoid" && on != "off")
+        o.Fail("on_obstacle", "'" + on + "' is not stop, avoid or off");
+      r.obstacle.enabled = on != "off";
+      r.obstacle.avoid = on == "avoid";
       const auto fraction = [&](const std::string& key, double fallback, double lo, double hi) {
         const double v = o.GetDouble(key, fallback);
         if (!std::isfinite(v) || v < lo || v > hi)

@@ -48,6 +48,7 @@ void RepeatFields(const navigation::RepeatStep& s, nlohmann::json* j) {
   (*j)["switched"] = s.switched;
   if (s.recovered_from >= 0) (*j)["recovered_from"] = s.recovered_from;
   if (s.carrying_on) (*j)["carrying_on"] = true;
+  if (s.avoiding) (*j)["avoiding"] = true;
   (*j)["std_ratio"] = s.switching.std_ratio;
   (*j)["ed_px"] = s.switching.ed_px;
   if (s.local_scale.ok) (*j)["local_scale"] = s.local_scale.ratio;

@@ -1,0 +1,165 @@
+#include "mapless/control/detour.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "mapless/core/check.h"
+
+namespace mapless::control {
+namespace {
+
+constexpr double kRobotRadius = 0.2;
+
+// A stand-in for the obstacle watch: a disc on the ground is seen when it overlaps the strip
+// +-0.27 m wide from 0.9 m to 2.1 m ahead of the robot, and only after the robot has driven 8 cm
+// straight (the watch's baseline).
+struct FakeWatch {
+  double ox, oy, r;
+  double straight_m = 0.0;
+  AheadView Look(const Pose2& pose, const Twist2& last, double dt) {
+    straight_m = last.omega_radps == 0.0 && last.v_mps > 0.0 ? straight_m + last.v_mps * dt : 0.0;
+    if (straight_m < 0.08) return AheadView::kUnknown;
+    double x = 0.0, y = 0.0;
+    pose.Inverse().Apply(ox, oy, &x, &y);
+    const bool in = x + r > 0.9 && x - r < 2.1 && std::abs(y) < 0.27 + r;
+    return in ? AheadView::kBlocked : AheadView::kFree;
+  }
+};
+
+TEST(Detour, GoesRoundABoxOnTheLineAndRejoinsItBeyond) {
+  for (const double oy : {-0.1, 0.0, 0.12}) {
+    FakeWatch watch{1.1, oy, 0.25};
+    // The side: away from the box's offset (left of the line: round by the right).
+    const double side_theta = oy > 0.0 ? -0.5 : 0.5;
+    // The box's extent as the image would give it (a little wider: the safe side).
+    ObstacleExtent extent;
+    extent.found = true;
+    extent.left_m = oy + 0.3;
+    extent.right_m = oy - 0.3;
+    Detour detour({0.0, 0.0, 0.0}, side_theta, extent, 0.27, DetourOptions{});
+    Pose2 pose;
+    Twist2 last;
+    double closest = 1e9;
+    int steps = 0;
+    for (; steps < 2000 && !detour.finished(); ++steps) {
+      const AheadView view = watch.Look(pose, last, 0.1);
+      last = detour.Command(pose, view, 0.3);
+      pose = IntegrateTwist(pose, last, 0.1);
+      closest = std::min(closest, std::hypot(pose.x_m - 1.1, pose.y_m - oy) - 0.25);
+    }
+    EXPECT_EQ(detour.phase(), DetourPhase::kDone) << "box at y = " << oy;
+    EXPECT_GT(closest, kRobotRadius + 0.05) << "box at y = " << oy;
+    EXPECT_GT(pose.x_m, 1.35 + 0.3);           // beyond the box
+    EXPECT_LT(std::abs(pose.y_m), 0.1 + 0.01);  // back on the line
+    EXPECT_EQ(detour.side() < 0.0, oy > 0.0);
+  }
+}
+
+TEST(Detour, FailsWhenTheWayStaysBlockedBeyondTheLargestOffset) {
+  DetourOptions o;
+  o.max_offset_m = 0.6;
+  Detour detour({0.0, 0.0, 0.0}, 0.3, ObstacleExtent{}, 0.27, o);
+  Pose2 pose;
+  Twist2 last;
+  for (int i = 0; i < 3000 && !detour.finished(); ++i) {
+    // A wall across the way: every look is blocked.
+    const AheadView view = last.omega_radps == 0.0 && last.v_mps > 0.0
+                               ? AheadView::kSuspect
+                               : AheadView::kUnknown;
+    last = detour.Command(pose, view, 0.3);
+    pose = IntegrateTwist(pose, last, 0.1);
+  }
+  EXPECT_EQ(detour.phase(), DetourPhase::kFailed);
+  EXPECT_LT(pose.y_m, 0.6 + 0.15);  // it stopped stepping aside
+  EXPECT_EQ(detour.Command(pose, AheadView::kFree, 0.3).v_mps, 0.0);
+}
+
+// Eq. 8-16 on the watch's map: obstacle points left of the image's centre push to the right
+// (theta < 0), right of it to the left; nothing in the way and the destination ahead: theta 0.
+TEST(DetourAngle, TurnsAwayFromTheObstaclesSide) {
+  std::vector<cv::Point2f> left, right;
+  for (int y = 150; y < 200; y += 10) {
+    for (int x = 100; x < 150; x += 10) {
+      left.emplace_back(static_cast<float>(x), static_cast<float>(y));
+      right.emplace_back(static_cast<float>(320 - x), static_cast<float>(y));
+    }
+  }
+  VisualPotentialOptions o;
+  o.repulsion_gain = 2.0;
+  // Only the sign is used (the turn-out angle is clamped): a sigma of half the image makes the
+  // force's side component small.
+  EXPECT_LT(DetourAngle(left, {320, 240}, 0.55, 10.0, 0.0, o), -0.005);
+  EXPECT_GT(DetourAngle(right, {320, 240}, 0.55, 10.0, 0.0, o), 0.005);
+  EXPECT_NEAR(DetourAngle({}, {320, 240}, 0.55, 10.0, 0.0, o), 0.0, 1e-6);
+  // A destination to the left pulls the free view's force to the left.
+  EXPECT_GT(DetourAngle({}, {320, 240}, 0.55, 10.0, 0.5, o), 0.1);
+}
+
+// Without an extent (nothing measured) the first step is first_step_m; with one wider than
+// max_offset_m allows, the detour fails at once (the robot stops instead).
+TEST(Detour, AnObstacleTooWideToStepPastFailsAtOnce) {
+  ObstacleExtent wide;
+  wide.found = true;
+  wide.left_m = 2.0;
+  wide.right_m = -2.0;
+  Detour detour({0.0, 0.0, 0.0}, 0.2, wide, 0.27, DetourOptions{});
+  EXPECT_EQ(detour.phase(), DetourPhase::kFailed);
+  Detour plain({0.0, 0.0, 0.0}, 0.2, ObstacleExtent{}, 0.27, DetourOptions{});
+  EXPECT_NEAR(plain.offset_m(), 0.27 + DetourOptions{}.margin_m, 1e-9);
+}
+
+// The force points left, but a wall 0.8 m to the left leaves no room past a box reaching 0.3 m
+// left: round by the right, where the wall is 1.5 m away.
+TEST(Detour, TakesTheOtherSideWhenTheForcesSideHasNoRoom) {
+  ObstacleExtent e;
+  e.found = true;
+  e.left_m = 0.3;
+  e.right_m = -0.1;
+  e.room_left_m = 0.8;
+  e.room_right_m = -1.5;
+  const Detour detour({0.0, 0.0, 0.0}, 0.4, e, 0.27, DetourOptions{});
+  EXPECT_LT(detour.side(), 0.0);
+  EXPECT_NEAR(detour.offset_m(), 0.1 + 0.27 + DetourOptions{}.margin_m, 1e-9);
+  e.room_right_m = -0.5;  // and no room on the right either: failed, the robot stops
+  EXPECT_EQ(Detour({0.0, 0.0, 0.0}, 0.4, e, 0.27, DetourOptions{}).phase(), DetourPhase::kFailed);
+}
+
+// Ground points at known lateral positions (the strip's geometry: +-0.27 m is +-80 px at the
+// bottom row of a 320x240 image, meeting at the horizon, row 120): the extent is the region's
+// points grown over the off-plane points next to them, not over a wall 0.8 m farther.
+TEST(MeasureObstacleExtent, GrowsOverNeighboursButNotOverAFarWall) {
+  const cv::Size image(320, 240);
+  const auto at = [](double lateral_m, double row) {
+    const double per_row = 80.0 / 120.0;
+    return cv::Point2f(static_cast<float>(160.0 - lateral_m / 0.27 * (row - 120.0) * per_row),
+                       static_cast<float>(row));
+  };
+  std::vector<cv::Point2f> region{at(-0.1, 200), at(0.0, 210), at(0.2, 190)};
+  std::vector<cv::Point2f> off = region;
+  for (double l = 0.25; l <= 0.45; l += 0.1) off.push_back(at(l, 180));  // the box beyond
+  off.push_back(at(-0.2, 205));
+  off.push_back(at(1.3, 150));   // a wall on the left
+  off.push_back(at(-1.0, 150));  // and one on the right
+  const ObstacleExtent e = MeasureObstacleExtent(region, off, image, 0.5, 0.5, 0.27);
+  ASSERT_TRUE(e.found);
+  EXPECT_NEAR(e.left_m, 0.45, 1e-3);
+  EXPECT_NEAR(e.right_m, -0.2, 1e-3);
+  EXPECT_NEAR(e.room_left_m, 1.3, 1e-3);
+  EXPECT_NEAR(e.room_right_m, -1.0, 1e-3);
+  EXPECT_FALSE(MeasureObstacleExtent({}, off, image, 0.5, 0.5, 0.27).found);
+}
+
+TEST(DetourOptions, ABadFieldIsNamed) {
+  DetourOptions o;
+  o.turn_out_max_rad = 2.0;
+  try {
+    o.Validate();
+    FAIL() << "accepted turn_out_max_rad = 2";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("turn_out_max_rad"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace mapless::control
