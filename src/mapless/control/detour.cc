@@ -83,54 +83,37 @@ double DetourAngle(const std::vector<cv::Point2f>& obstacle_px, cv::Size image,
 
 ObstacleExtent MeasureObstacleExtent(const std::vector<cv::Point2f>& region_px,
                                      const std::vector<cv::Point2f>& off_plane_px, cv::Size image,
-                                     double horizon_fraction, double region_width_fraction,
-                                     double half_width_m, double column_px, double gap_m) {
+                                     double region_width_fraction,
+                                     double region_top_fraction, double half_width_m,
+                                     double gap_m) {
   const double cx = 0.5 * image.width;
-  const double yh = horizon_fraction * image.height;
-  // The strip's half-width in pixels per row below the horizon.
-  const double per_row = 0.5 * region_width_fraction * image.width / (image.height - yh);
-  // A point's lateral position at the row of the lowest off-plane point of its column (nearest
-  // to the obstacle's foot, which may be below the image).
-  const auto lateral = [&](const cv::Point2f& p, double* out) {
-    double foot = p.y;
-    for (const cv::Point2f& q : off_plane_px) {
-      if (std::abs(q.x - p.x) <= column_px) foot = std::max(foot, static_cast<double>(q.y));
-    }
-    if (foot <= yh + 1.0) return false;
-    *out = -(p.x - cx) / ((foot - yh) * per_row) * half_width_m;
-    return true;
-  };
-  ObstacleExtent e;
-  double v = 0.0;
-  for (const cv::Point2f& p : region_px) {
-    if (!lateral(p, &v)) continue;
-    e.left_m = e.found ? std::max(e.left_m, v) : v;
-    e.right_m = e.found ? std::min(e.right_m, v) : v;
-    e.found = true;
-  }
-  if (!e.found) return e;
-  std::vector<double> others;
+  // The strip's half-width in pixels at the bottom row.
+  const double half_px = 0.5 * region_width_fraction * image.width;
+  const auto lateral = [&](const cv::Point2f& p) { return -(p.x - cx) / half_px * half_width_m; };
+  // Lateral positions of the points in the region's rows, sorted, split where neighbours are
+  // more than gap_m apart: the clusters holding region points are the obstacle.
+  std::vector<std::pair<double, bool>> points;  // lateral, from the region
+  const double top = region_top_fraction * image.height;
+    for (const cv::Point2f& p : region_px) points.emplace_back(lateral(p), true);
   for (const cv::Point2f& p : off_plane_px) {
-    if (lateral(p, &v)) others.push_back(v);
+    if (p.y >= top) points.emplace_back(lateral(p), false);
   }
-  std::sort(others.begin(), others.end());
-  // Outwards to the left (ascending), then to the right; the first point beyond a gap is the
-  // nearest thing on that side (a wall, another object): the room there.
-  for (double o : others) {
-    if (o <= e.left_m) continue;
-    if (o > e.left_m + gap_m) {
-      e.room_left_m = o;
-      break;
+  std::sort(points.begin(), points.end());
+  ObstacleExtent e;
+  std::size_t i = 0;
+  while (i < points.size()) {
+    std::size_t j = i;
+    bool region = points[i].second;
+    while (j + 1 < points.size() && points[j + 1].first <= points[j].first + gap_m) {
+      ++j;
+      region = region || points[j].second;
     }
-    e.left_m = o;
-  }
-  for (auto it = others.rbegin(); it != others.rend(); ++it) {
-    if (*it >= e.right_m) continue;
-    if (*it < e.right_m - gap_m) {
-      e.room_right_m = *it;
-      break;
+    if (region) {
+      e.right_m = e.found ? std::min(e.right_m, points[i].first) : points[i].first;
+      e.left_m = e.found ? std::max(e.left_m, points[j].first) : points[j].first;
+      e.found = true;
     }
-    e.right_m = *it;
+    i = j + 1;
   }
   return e;
 }
@@ -143,21 +126,12 @@ Detour::Detour(const Pose2& stopped_at, double theta_rad, const ObstacleExtent& 
   turn_out_rad_ = std::clamp(std::abs(theta_rad), options_.turn_out_min_rad,
                              options_.turn_out_max_rad);
   // Clear of the obstacle's side by the strip's half-width (the robot's and its margin) and a
-  // margin; the side the force points to if there is room for that, else the other one.
-  const double clear = half_width_m + options_.margin_m;
-  const auto offset = [&](double side) {
-    const double beyond =
-        extent.found ? std::max(0.0, side > 0.0 ? extent.left_m : -extent.right_m) : 0.0;
-    return std::max(options_.first_step_m, beyond + clear);
-  };
-  const auto room = [&](double side) {
-    const double wall = side > 0.0 ? extent.room_left_m : -extent.room_right_m;
-    return std::min(options_.max_offset_m, wall - clear) >= offset(side);
-  };
+  // margin, on the side the force points to.
   side_ = theta_rad >= 0.0 ? 1.0 : -1.0;
-  if (!room(side_) && room(-side_)) side_ = -side_;
-  offset_m_ = offset(side_);
-  if (!room(side_)) phase_ = DetourPhase::kFailed;
+  const double beyond =
+      extent.found ? std::max(0.0, side_ > 0.0 ? extent.left_m : -extent.right_m) : 0.0;
+  offset_m_ = std::max(options_.first_step_m, beyond + half_width_m + options_.margin_m);
+  if (offset_m_ > options_.max_offset_m) phase_ = DetourPhase::kFailed;
 }
 
 Twist2 Detour::TurnTo(double heading_rad, double now_rad) const {

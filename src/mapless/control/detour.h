@@ -28,7 +28,6 @@
 // level camera spent most frames without a ground plane. docs/teach_and_repeat.md#avoid.
 #pragma once
 
-#include <limits>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -79,35 +78,31 @@ double DetourAngle(const std::vector<cv::Point2f>& obstacle_px, cv::Size image,
 
 // The obstacle's lateral extent (metres, positive to the left of the robot's centre line) from
 // image points, without calibration: the watch's strip is half_width_m on either side of the
-// centre line on the ground and region_width_fraction of the image width at the bottom row, its
-// sides meeting at the horizon row, so a ground point's lateral position is its column offset
-// over the strip's half-width at its row, times half_width_m. A point on the obstacle above the
-// ground sits higher in the image than its foot, where the strip is narrower: each point is
-// placed at the row of the lowest off-plane point within column_px of it (its foot, or the
-// lowest visible part; still the safe side when the foot is below the image). The extent
-// starts from the region's obstacle points and grows outwards over the other off-plane points
-// while they continue it with gaps below gap_m; the first point beyond such a gap on each side
-// (a wall, another object) is the room there.
+// centre line on the ground and region_width_fraction of the image width at the bottom row, so
+// a point at the bottom row lies (column offset / strip half-width in pixels) * half_width_m
+// aside. Every point is measured so: an obstacle that stopped the robot stands about as near as
+// the nearest ground in view (the camera sees the ground from about 0.9 m; the lowest rows of
+// a face that near move almost like the ground and its foot is not found), and a farther
+// obstacle comes out narrower than it is (the detour's look ahead then steps further). The
+// off-plane points in the region's rows (from region_top_fraction down; a wall farther off is
+// above them) fall into clusters wherever neighbours are more than gap_m apart; the clusters
+// holding region points are the obstacle.
 struct ObstacleExtent {
   bool found = false;
   double left_m = 0.0;   // the obstacle's leftmost lateral position
   double right_m = 0.0;  // its rightmost (smallest)
-  double room_left_m = std::numeric_limits<double>::infinity();    // the next thing to the left
-  double room_right_m = -std::numeric_limits<double>::infinity();  // ... and to the right
 };
 ObstacleExtent MeasureObstacleExtent(const std::vector<cv::Point2f>& region_px,
                                      const std::vector<cv::Point2f>& off_plane_px, cv::Size image,
-                                     double horizon_fraction, double region_width_fraction,
-                                     double half_width_m, double column_px = 10.0,
+                                     double region_width_fraction,
+                                     double region_top_fraction, double half_width_m,
                                      double gap_m = 0.15);
 
 class Detour {
  public:
   // `stopped_at`: the odometry pose where the watch stopped the robot; `theta_rad`: DetourAngle's
-  // (its sign is the side, unless only the other side has room: the step aside must keep
-  // half_width_m and margin_m from the next thing there, and stay within max_offset_m; with room
-  // on neither side the detour has failed at once); `extent` and `half_width_m`: how far aside to
-  // step first (see above).
+  // (its sign is the side); `extent` and `half_width_m`: how far aside to step first, the
+  // obstacle's side plus half_width_m and margin_m (beyond max_offset_m: failed at once).
   Detour(const Pose2& stopped_at, double theta_rad, const ObstacleExtent& extent,
          double half_width_m, DetourOptions options);
   // The command at odometry pose `now`, the watch's view of this frame; `speed_mps`: the route's.

@@ -109,45 +109,26 @@ TEST(Detour, AnObstacleTooWideToStepPastFailsAtOnce) {
   EXPECT_NEAR(plain.offset_m(), 0.27 + DetourOptions{}.margin_m, 1e-9);
 }
 
-// The force points left, but a wall 0.8 m to the left leaves no room past a box reaching 0.3 m
-// left: round by the right, where the wall is 1.5 m away.
-TEST(Detour, TakesTheOtherSideWhenTheForcesSideHasNoRoom) {
-  ObstacleExtent e;
-  e.found = true;
-  e.left_m = 0.3;
-  e.right_m = -0.1;
-  e.room_left_m = 0.8;
-  e.room_right_m = -1.5;
-  const Detour detour({0.0, 0.0, 0.0}, 0.4, e, 0.27, DetourOptions{});
-  EXPECT_LT(detour.side(), 0.0);
-  EXPECT_NEAR(detour.offset_m(), 0.1 + 0.27 + DetourOptions{}.margin_m, 1e-9);
-  e.room_right_m = -0.5;  // and no room on the right either: failed, the robot stops
-  EXPECT_EQ(Detour({0.0, 0.0, 0.0}, 0.4, e, 0.27, DetourOptions{}).phase(), DetourPhase::kFailed);
-}
-
-// Ground points at known lateral positions (the strip's geometry: +-0.27 m is +-80 px at the
-// bottom row of a 320x240 image, meeting at the horizon, row 120): the extent is the region's
-// points grown over the off-plane points next to them, not over a wall 0.8 m farther.
+// The strip's geometry: +-0.27 m is +-80 px at the bottom row of a 320x240 image. The extent
+// is measured at the bottom row, over the off-plane points of the region's rows next to the
+// region's own, not over a wall farther aside nor over points above the region's rows.
 TEST(MeasureObstacleExtent, GrowsOverNeighboursButNotOverAFarWall) {
   const cv::Size image(320, 240);
   const auto at = [](double lateral_m, double row) {
-    const double per_row = 80.0 / 120.0;
-    return cv::Point2f(static_cast<float>(160.0 - lateral_m / 0.27 * (row - 120.0) * per_row),
+    return cv::Point2f(static_cast<float>(160.0 - lateral_m / 0.27 * 80.0),
                        static_cast<float>(row));
   };
-  std::vector<cv::Point2f> region{at(-0.1, 200), at(0.0, 210), at(0.2, 190)};
+  std::vector<cv::Point2f> region{at(-0.1, 200), at(0.0, 190), at(0.2, 200)};
   std::vector<cv::Point2f> off = region;
-  for (double l = 0.25; l <= 0.45; l += 0.1) off.push_back(at(l, 180));  // the box beyond
-  off.push_back(at(-0.2, 205));
-  off.push_back(at(1.3, 150));   // a wall on the left
-  off.push_back(at(-1.0, 150));  // and one on the right
-  const ObstacleExtent e = MeasureObstacleExtent(region, off, image, 0.5, 0.5, 0.27);
+  for (double l = 0.25; l <= 0.46; l += 0.1) off.push_back(at(l, 180));  // the obstacle beyond
+  off.push_back(at(-0.2, 200));
+  off.push_back(at(0.8, 200));   // a wall on the left, beyond a gap
+  off.push_back(at(-0.3, 150));  // above the region's rows (row 173 down): not counted
+  const ObstacleExtent e = MeasureObstacleExtent(region, off, image, 0.5, 0.72, 0.27);
   ASSERT_TRUE(e.found);
   EXPECT_NEAR(e.left_m, 0.45, 1e-3);
   EXPECT_NEAR(e.right_m, -0.2, 1e-3);
-  EXPECT_NEAR(e.room_left_m, 1.3, 1e-3);
-  EXPECT_NEAR(e.room_right_m, -1.0, 1e-3);
-  EXPECT_FALSE(MeasureObstacleExtent({}, off, image, 0.5, 0.5, 0.27).found);
+  EXPECT_FALSE(MeasureObstacleExtent({}, off, image, 0.5, 0.72, 0.27).found);
 }
 
 TEST(DetourOptions, ABadFieldIsNamed) {

@@ -313,7 +313,10 @@ ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, const std::vector<cv::Mat
   }
   if (draw.size() < 8) return check;  // a plain floor: nothing to measure
   const cv::Mat h = FitGround(here, there, draw);
-  if (h.empty()) return check;
+  if (h.empty()) {
+    check.no_ground = true;
+    return check;
+  }
   check.plane_found = true;
   // The region's points off the plane (and not next to the taught scene) are the candidates;
   // with avoid, also every other point below fit_top off the plane (the obstacle's extent).

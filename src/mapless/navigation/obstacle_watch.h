@@ -101,6 +101,9 @@ struct ObstacleWatchOptions {
 struct ObstacleCheck {
   bool observed = false;          // two frames far enough apart were compared this frame
   bool plane_found = false;       // the ground's homography was fitted (observed frames only)
+  // Two frames were compared, with tracked points in the bottom rows, but they fit no ground
+  // plane: a wall or a large object fills the view (not observed: the region is not measured).
+  bool no_ground = false;
   int region_points = 0;          // tracked points in the region (observed frames only)
   double blocked_fraction = 0.0;  // obstacle points among them
   bool blocked = false;           // the watch holds the robot (an obstacle confirmed, not gone)

@@ -306,7 +306,7 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
   // features that are about to be replaced.
   ++frames_since_detect_;
   // Carrying on matches every frame afresh.
-  const bool refresh = carry_active_ || (options_.redetect_every_frames > 0 &&
+  const bool refresh = carry_active_ || reacquire_ || (options_.redetect_every_frames > 0 &&
                                          frames_since_detect_ >= options_.redetect_every_frames);
   // Algorithm 1, lines 16-18: track the matched features inside the segment.
   if (!refresh && !previous_.empty() && !current_px_.empty()) {
@@ -334,16 +334,13 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
   const int found = std::max(options_.recovery_min_features, options_.min_features);
   if (step.tracked < options_.min_features && !short_since_ns_) short_since_ns_ = t_ns;
   if (step.tracked >= found) short_since_ns_.reset();
-  // Back on the route after a detour: the destination, or the nearest following keyframe that
-  // matches as a recovered one must (the detour may have taken the robot past the destination).
+  // Back on the route after a detour: the keyframe that matches best (the detour may have taken
+  // the robot past the destination and more).
   if (reacquire_) {
     reacquire_ = false;
-    if (step.tracked < found &&
-        SwitchToMatching(destination_ + 1, destination_ + options_.carry_on_keyframes, -1.0,
-                         &step)) {
-      step.matches = last_matches_;
-      step.tracked = static_cast<int>(current_px_.size());
-    }
+    Reacquire(&step);
+    step.matches = last_matches_;
+    step.tracked = static_cast<int>(current_px_.size());
   }
   // Keyframe recovery, once the destination has been short for recovery_after_s (a shortage
   // that passes by itself is waited out, not skipped).

@@ -189,6 +189,12 @@ class RepeatSession {
   // Carrying on (RepeatOptions::carry_on): starts it if it can; the command of this frame, or
   // nullopt when it cannot start or has given up.
   std::optional<Twist2> CarryOn(Timestamp t_ns, RepeatStep* step);
+  // Keyframe k becomes the destination with these matches (recovery, carrying on, avoid).
+  void SwitchTo(int k, std::vector<cv::Point2f> current_px, std::vector<cv::Point2f> keyframe_px,
+                std::vector<cv::Point2f> scene_px, RepeatStep* step);
+  // After a detour: the keyframe in [destination, destination + carry_on_keyframes] that the
+  // current frame matches best (at least recovery_min_features) becomes the destination.
+  void Reacquire(RepeatStep* step);
   void MarkSwitch();  // a new destination: the recovery and carrying-on bookkeeping restart
   // Avoid (RepeatOptions::obstacle.avoid; repeat_avoid.cc): starts a detour round the obstacle
   // the watch has just confirmed; false when it cannot (no odometry, too many detours).
@@ -238,6 +244,7 @@ class RepeatSession {
   bool carried_this_destination_ = false;  // gave up on this destination: no second try
   std::optional<control::Detour> detour_;  // going round an obstacle
   int detours_ = 0;                        // detours started for this destination
+  int no_ground_frames_ = 0;               // successive frames without the ground ahead
   bool reacquire_ = false;                 // a detour ended: find the route's keyframe again
 };
 

@@ -2,6 +2,7 @@
 // the paper): the obstacle watch confirms something new ahead, the visual potential on its map
 // picks the side, control::Detour drives round by odometry with the watch looking ahead, and the
 // repeat then re-acquires its keyframe. The rest of the session is in repeat.cc.
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -22,7 +23,8 @@ bool RepeatSession::StartDetour(const ObstacleCheck& obstacle, cv::Size image) {
                                             0.0, potential);
   const control::ObstacleExtent extent =
       control::MeasureObstacleExtent(obstacle.obstacle_px, obstacle.off_plane_px, image,
-                                     w.horizon, w.region_width, w.region_half_width_m, w.grid_px);
+                                     w.region_width, w.region_top, w.region_half_width_m);
+  no_ground_frames_ = 0;
   detour_.emplace(*odometry_, theta, extent, w.region_half_width_m, options_.detour);
   ++detours_;
   watch_.Resume();  // the watch goes on looking ahead while the robot goes round
@@ -38,7 +40,10 @@ RepeatStep RepeatSession::Detouring(RepeatStep step, const ObstacleCheck& obstac
                 "going round an obstacle: no odometry on this frame: stopped");
   }
   control::AheadView ahead = control::AheadView::kUnknown;
-  if (obstacle.blocked) {
+  // The ground ahead not found on two compared frames in a row: a wall or something large
+  // fills the view (the watch cannot measure it, the detour must not drive into it).
+  no_ground_frames_ = obstacle.no_ground ? no_ground_frames_ + 1 : 0;
+  if (obstacle.blocked || no_ground_frames_ >= 2) {
     ahead = control::AheadView::kBlocked;
     watch_.Resume();
   } else if (obstacle.observed) {
@@ -68,6 +73,27 @@ RepeatStep RepeatSession::Detouring(RepeatStep step, const ObstacleCheck& obstac
     short_since_ns_.reset();
   }
   return step;
+}
+
+void RepeatSession::Reacquire(RepeatStep* step) {
+  const int last = std::min(destination_ + options_.carry_on_keyframes,
+                            static_cast<int>(route_->keyframes.size()) - 1);
+  int best = destination_;
+  std::vector<cv::Point2f> best_cur = current_px_, best_dst = destination_px_,
+                           best_scene = scene_px_;
+  for (int k = destination_ + 1; k <= last; ++k) {
+    std::vector<cv::Point2f> cur, dst, scene;
+    MatchKeyframe(k, &cur, &dst, &scene);
+    if (cur.size() > best_cur.size()) {
+      best = k;
+      best_cur = std::move(cur);
+      best_dst = std::move(dst);
+      best_scene = std::move(scene);
+    }
+  }
+  const int found = std::max(options_.recovery_min_features, options_.min_features);
+  if (best != destination_ && static_cast<int>(best_cur.size()) >= found)
+    SwitchTo(best, std::move(best_cur), std::move(best_dst), std::move(best_scene), step);
 }
 
 }  // namespace mapless::navigation

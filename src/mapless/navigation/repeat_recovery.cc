@@ -30,20 +30,26 @@ bool RepeatSession::SwitchToMatching(int first, int last, double taught_reach_s,
         std::max(options_.recovery_min_features, options_.min_features)) {
       continue;
     }
-    step->recovered_from = destination_;
-    step->switched = true;
-    destination_ = k;
-    step->destination = k;
-    current_px_ = std::move(cur);
-    destination_px_ = std::move(dst);
-    scene_px_ = std::move(scene);
-    last_matches_ = static_cast<int>(current_px_.size());
-    mse_.Reset();
-    switch_votes_ = 0;
-    MarkSwitch();
+    SwitchTo(k, std::move(cur), std::move(dst), std::move(scene), step);
     return true;
   }
   return false;
+}
+
+void RepeatSession::SwitchTo(int k, std::vector<cv::Point2f> current_px,
+                             std::vector<cv::Point2f> keyframe_px,
+                             std::vector<cv::Point2f> scene_px, RepeatStep* step) {
+  step->recovered_from = destination_;
+  step->switched = true;
+  destination_ = k;
+  step->destination = k;
+  current_px_ = std::move(current_px);
+  destination_px_ = std::move(keyframe_px);
+  scene_px_ = std::move(scene_px);
+  last_matches_ = static_cast<int>(current_px_.size());
+  mse_.Reset();
+  switch_votes_ = 0;
+  MarkSwitch();
 }
 
 double RepeatSession::RouteSpeed() const {
