@@ -1,6 +1,6 @@
 // `mapless eval SUITE`: reproduce a paper's experiments on the simulator; one JSON object
 // {"suite", "results": [{"scenario", "controller", "runs", "successes", "final_error_m_rms",
-// "final_error_m_std", "lateral_rms_m", "collisions"}]} and a readable table.
+// "final_error_m_std", "final_error_m_max", "lateral_rms_m", "collisions", ...}]} and a readable table.
 #include <spdlog/spdlog.h>
 
 #include <cmath>
@@ -67,9 +67,11 @@ nlohmann::json EntryJson(const eval::EntryResult& r) {
           {"successes", r.successes},
           {"final_error_m_rms", r.final_error_m_rms},
           {"final_error_m_std", r.final_error_m_std},
+          {"final_error_m_max", r.final_error_m_max},
           {"lateral_rms_m", r.lateral_rms_m},
           {"collisions", r.collisions},
           {"obstacle_stops", r.obstacle_stops},
+          {"went_round", r.went_round},
           {"stops_at_added_object", r.stops_at_added_object},
           {"min_clearance_m",
            std::isfinite(r.min_clearance_m) ? nlohmann::json(r.min_clearance_m) : nlohmann::json()},
@@ -352,17 +354,18 @@ void AddEvalCommand(CLI::App* app) {
     j["on_obstacle"] = args->on_obstacle;
     j["end"] = args->end;
     FILE* table = args->json ? stderr : stdout;
-    std::fprintf(table, "%-30s %-9s %9s %10s %10s %10s %5s %6s %7s %9s\n", "scenario", "control",
-                 "success", "final rms", "final std", "lateral", "coll", "stops", "at obj",
-                 "clearance");
+    std::fprintf(table, "%-30s %-9s %9s %10s %10s %10s %10s %5s %6s %7s %9s %6s\n", "scenario",
+                 "control", "success", "final rms", "final std", "final max", "lateral", "coll",
+                 "stops", "at obj", "clearance", "round");
     for (const auto& r : results) {
       j["results"].push_back(EntryJson(r));
       const std::string clearance =
           std::isfinite(r.min_clearance_m) ? Fixed(r.min_clearance_m, 2) + "m" : "-";
-      std::fprintf(table, "%-30s %-9s %4d/%-4d %9.2fm %9.2fm %9.2fm %5d %6d %7d %9s\n",
+      std::fprintf(table, "%-30s %-9s %4d/%-4d %9.2fm %9.2fm %9.2fm %9.2fm %5d %6d %7d %9s %6d\n",
                    r.scenario.c_str(), r.controller.c_str(), r.successes, r.runs,
-                   r.final_error_m_rms, r.final_error_m_std, r.lateral_rms_m, r.collisions,
-                   r.obstacle_stops, r.stops_at_added_object, clearance.c_str());
+                   r.final_error_m_rms, r.final_error_m_std, r.final_error_m_max, r.lateral_rms_m,
+                   r.collisions, r.obstacle_stops, r.stops_at_added_object, clearance.c_str(),
+                   r.went_round);
     }
     if (args->json) std::cout << j.dump() << "\n";
     if (!args->report.empty()) {

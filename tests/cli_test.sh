@@ -183,6 +183,12 @@ grep -q "^odometry: " "$TMP/simroute/keyframes/000001.yml" && ! grep -q "^odomet
 expect_exit "a negative --carry-on-m exits 2" 2 "$MAPLESS" repeat --route "$TMP/route" --source "$TMP/d1/frames" --carry-on-m -1
 grep -q -- "--carry-on-m" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "a bad --carry-on-m is named in one line" $?
 expect_exit "eval potential refuses --carry-on-m" 2 "$MAPLESS" eval potential --runs 1 --carry-on-m 2
+# --on-obstacle avoid: teach & repeat only; the follower refuses it in one line.
+expect_exit "follow refuses --on-obstacle avoid" 2 "$MAPLESS" follow --route "$TMP/eroute" --source "$TMP/d1/frames" --poses "$TMP/d1/odometry.tum" --on-obstacle avoid
+grep -q "avoid is built for teach & repeat only" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "follow names --on-obstacle avoid in one line" $?
+expect_exit "an unknown --on-obstacle exits 2" 2 "$MAPLESS" repeat --route "$TMP/route" --source "$TMP/d1/frames" --on-obstacle swerve
+expect_exit "repeat with --on-obstacle avoid and nothing in the way" 0 "$MAPLESS" repeat --route "$TMP/simroute" --source sim:rotation_in_place --on-obstacle avoid --log "$TMP/rep3.jsonl"
+tail -1 "$TMP/rep3.jsonl" | grep -q '"status":"completed"' && ! grep -q '"avoiding":' "$TMP/rep3.jsonl"; check "avoid with nothing in the way: completed, never went round" $?
 expect_exit "unknown --end exits 2" 2 "$MAPLESS" repeat --route "$TMP/route" --source "$TMP/d1/frames" --end sideways
 grep -q "\-\-end 'sideways'" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "unknown --end names the value in one line" $?
 

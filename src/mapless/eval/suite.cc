@@ -125,6 +125,11 @@ EntryResult RunEntry(const sim::Scenario& scenario, const TaughtRoute& taught,
                                       " m from the taught end"
                                 : ""));
     if (run.collided) ++r.collisions;
+    if (run.completed && !run.collided)
+      r.final_error_m_max = std::max(r.final_error_m_max, run.final_error_m);
+    if (std::any_of(run.steps.begin(), run.steps.end(),
+                    [](const navigation::RepeatStep& s) { return s.avoiding; }))
+      ++r.went_round;
     const ObstacleStops stops = CountObstacleStops(scenario, run);
     if (stops.stops > 0) ++r.obstacle_stops;
     if (stops.at_added_object) ++r.stops_at_added_object;

@@ -37,6 +37,7 @@ struct EntryResult {
   int successes = 0;
   double final_error_m_rms = 0.0;  // RMS over runs of the final distance to the taught end
   double final_error_m_std = 0.0;  // standard deviation of that distance over runs
+  double final_error_m_max = 0.0;  // the largest (of runs that completed without collision)
   double lateral_rms_m = 0.0;      // RMS over all repeated poses of the distance to the taught path
   int collisions = 0;
   // The obstacle watch (navigation/obstacle_watch.h): runs in which it stopped the robot at
@@ -46,6 +47,7 @@ struct EntryResult {
   // object while it stood there (over all runs; +inf without added objects).
   int obstacle_stops = 0;
   int stops_at_added_object = 0;
+  int went_round = 0;  // runs that went round an obstacle at least once (--on-obstacle avoid)
   double min_clearance_m = std::numeric_limits<double>::infinity();
   std::vector<std::string> failures;  // one status line per failed run
   // Ground truth for reports: the reference path (taught, or the leader's) and each run's path.

@@ -156,8 +156,8 @@ RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
     }
     if (map.Has("obstacles")) {
       const io::YamlMap o = map.GetMap("obstacles");
-      o.CheckKnownKeys({"on_obstacle", "region_top", "region_width", "horizon", "baseline_m",
-                        "min_blocked_fraction"});
+      o.CheckKnownKeys({"on_obstacle", "region_top", "region_width", "region_half_width_m",
+                        "horizon", "baseline_m", "min_blocked_fraction"});
       const std::string on = o.GetString("on_obstacle", "stop");
       if (on != "stop" && on != "avoid" && on != "off")
         o.Fail("on_obstacle", "'" + on + "' is not stop, avoid or off");
@@ -173,6 +173,8 @@ RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
       r.obstacle.region_top = fraction("region_top", r.obstacle.region_top, 0.0, 0.95);
       r.obstacle.fit_top = std::min(r.obstacle.fit_top, r.obstacle.region_top);
       r.obstacle.region_width = fraction("region_width", r.obstacle.region_width, 0.05, 1.0);
+      r.obstacle.region_half_width_m =
+          fraction("region_half_width_m", r.obstacle.region_half_width_m, 0.05, 2.0);
       r.obstacle.horizon = fraction("horizon", r.obstacle.horizon, 0.0, 0.94);
       if (r.obstacle.horizon >= r.obstacle.region_top)
         o.Fail("horizon", "must be above region_top (a smaller fraction)");

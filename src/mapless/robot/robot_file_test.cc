@@ -68,6 +68,13 @@ TEST(RobotFile, ObstacleWatchSettings) {
   EXPECT_TRUE(b.obstacle_baseline_given);
   EXPECT_DOUBLE_EQ(b.obstacle.baseline_m, 0.2);
   EXPECT_FALSE(ParseRobotFile("obstacles: {on_obstacle: off}\n", "robot.yaml").obstacle.enabled);
+  EXPECT_FALSE(ParseRobotFile("{}\n", "robot.yaml").obstacle.avoid);
+  const RobotFile a =
+      ParseRobotFile("obstacles: {on_obstacle: avoid, region_half_width_m: 0.35}\n", "robot.yaml");
+  EXPECT_TRUE(a.obstacle.enabled);
+  EXPECT_TRUE(a.obstacle.avoid);
+  EXPECT_DOUBLE_EQ(a.obstacle.region_half_width_m, 0.35);
+  ExpectError("obstacles: {region_half_width_m: 0}\n", "region_half_width_m");
 }
 
 }  // namespace
