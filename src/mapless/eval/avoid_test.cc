@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "mapless/eval/suite.h"
+#include "mapless/eval/taught_once.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/sim/scenario.h"
 #include "mapless/sim/world.h"
@@ -37,27 +38,8 @@ class NoOdometry : public robot::RobotLink {
   robot::RobotLink& inner_;
 };
 
-class Avoid : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    sim::Scenario s = sim::LoadScenario("obstacle_box_table1");
-    s.repeat_variant = ObjectsStay(s.repeat_variant);
-    scenario_ = new sim::Scenario(s);
-    taught_ = new TaughtRoute(TeachOnSimulator(*scenario_, navigation::TeachOptions{}));
-  }
-  static void TearDownTestSuite() {
-    delete taught_;
-    delete scenario_;
-  }
-  static const sim::Scenario* scenario_;
-  static const TaughtRoute* taught_;
-};
-const sim::Scenario* Avoid::scenario_ = nullptr;
-const TaughtRoute* Avoid::taught_ = nullptr;
-
-TEST_F(Avoid, ARepeatGoesRoundABoxOnTheRouteAndCompletesIt) {
-  const sim::Scenario& scenario = *scenario_;
-  const TaughtRoute& taught = *taught_;
+TEST(Avoid, ARepeatGoesRoundABoxOnTheRouteAndCompletesIt) {
+  const auto& [scenario, taught] = TaughtOnce("obstacle_box_table1", true);
   RepeatRunOptions o;
   o.seed = 2;
   o.repeat.obstacle.avoid = true;
@@ -86,9 +68,8 @@ TEST_F(Avoid, ARepeatGoesRoundABoxOnTheRouteAndCompletesIt) {
 
 // Without odometry (a camera-only robot) avoid cannot measure its way round: it stops as with
 // stop. Shown on the session directly: the watch's first confirmed obstacle gives kBlocked.
-TEST_F(Avoid, WithoutOdometryTheRobotStopsAsWithStop) {
-  const sim::Scenario& scenario = *scenario_;
-  const TaughtRoute& taught = *taught_;
+TEST(Avoid, WithoutOdometryTheRobotStopsAsWithStop) {
+  const auto& [scenario, taught] = TaughtOnce("obstacle_box_table1", true);
   RepeatRunOptions o;
   o.seed = 2;
   o.repeat.obstacle.avoid = true;

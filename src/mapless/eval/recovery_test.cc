@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <opencv2/core.hpp>
 
+#include "mapless/eval/taught_once.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/sim/scenario.h"
 
@@ -26,25 +27,8 @@ TaughtRoute WithKeyframesGone(const TaughtRoute& taught, int first, int count = 
   return out;
 }
 
-class KeyframeRecovery : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    scenario_ = new sim::Scenario(sim::LoadScenario("table1_almost_straight"));
-    taught_ = new TaughtRoute(TeachOnSimulator(*scenario_, navigation::TeachOptions{}));
-  }
-  static void TearDownTestSuite() {
-    delete taught_;
-    delete scenario_;
-  }
-  static const sim::Scenario* scenario_;
-  static const TaughtRoute* taught_;
-};
-const sim::Scenario* KeyframeRecovery::scenario_ = nullptr;
-const TaughtRoute* KeyframeRecovery::taught_ = nullptr;
-
-TEST_F(KeyframeRecovery, ARepeatSkipsAKeyframeWhoseLandmarksAreGone) {
-  const sim::Scenario& scenario = *scenario_;
-  const TaughtRoute& taught = *taught_;
+TEST(KeyframeRecovery, ARepeatSkipsAKeyframeWhoseLandmarksAreGone) {
+  const auto& [scenario, taught] = TaughtOnce("table1_almost_straight");
   const int n = static_cast<int>(taught.route->keyframes.size());
   ASSERT_GE(n, 5);
   const int gone = n / 2;
@@ -77,15 +61,16 @@ TEST_F(KeyframeRecovery, ARepeatSkipsAKeyframeWhoseLandmarksAreGone) {
 // Three keyframes in a row gone, more than recovery reaches from where the robot stops: the
 // repeat carries on along the taught odometry (the simulator's, with its noise) and the funnel
 // lane takes over at the first keyframe that matches again.
-TEST_F(KeyframeRecovery, ARepeatCarriesOnByOdometryThroughThreeKeyframesGone) {
-  const int n = static_cast<int>(taught_->route->keyframes.size());
+TEST(KeyframeRecovery, ARepeatCarriesOnByOdometryThroughThreeKeyframesGone) {
+  const auto& [scenario, taught] = TaughtOnce("table1_almost_straight");
+  const int n = static_cast<int>(taught.route->keyframes.size());
   ASSERT_GE(n, 7);
-  for (const auto& kf : taught_->route->keyframes) ASSERT_TRUE(kf.odometry.has_value());
+  for (const auto& kf : taught.route->keyframes) ASSERT_TRUE(kf.odometry.has_value());
   const int gone = n / 2 - 1;
-  const TaughtRoute broken = WithKeyframesGone(*taught_, gone, 3);
+  const TaughtRoute broken = WithKeyframesGone(taught, gone, 3);
   RepeatRunOptions options;
   options.seed = 3;
-  const RepeatRun run = RepeatOnSimulator(*scenario_, broken, options);
+  const RepeatRun run = RepeatOnSimulator(scenario, broken, options);
   EXPECT_TRUE(run.success) << run.status << ", final error " << run.final_error_m;
   int carrying = 0;
   int resumed_at = -1;
@@ -104,10 +89,11 @@ TEST_F(KeyframeRecovery, ARepeatCarriesOnByOdometryThroughThreeKeyframesGone) {
 // On an intact route the repeat passes the keyframes in order, one at a time: neither recovery
 // nor carrying on steps in. (Until 2026-11-26 this test ran on a route that the test above had
 // broken by accident, the descriptors being shared: it then allowed one recovery.)
-TEST_F(KeyframeRecovery, AnIntactRouteIsRepeatedInOrder) {
+TEST(KeyframeRecovery, AnIntactRouteIsRepeatedInOrder) {
+  const auto& [scenario, taught] = TaughtOnce("table1_almost_straight");
   RepeatRunOptions options;
   options.seed = 3;
-  const RepeatRun run = RepeatOnSimulator(*scenario_, *taught_, options);
+  const RepeatRun run = RepeatOnSimulator(scenario, taught, options);
   EXPECT_TRUE(run.success) << run.status;
   int last = 1;
   for (const auto& step : run.steps) {
