@@ -142,7 +142,9 @@ ObstacleCheck ObstacleWatch::Update(const cv::Mat& grey, Timestamp t_ns, double 
   ObstacleCheck check;
   if (!options_.enabled) return check;
   forward_m_ += std::max(0.0, forward_m);
-  turned_rad_ += std::abs(turned_rad);
+  // The heading, not the turning's total: the standard funnel lane turns +-R every frame, and
+  // the sum of |turning| ruled out every pair of frames 8 cm apart (it never looked).
+  turned_rad_ += turned_rad;
   if (blocked_) {
     check = WatchBlocked(grey);
   } else {
@@ -273,7 +275,7 @@ ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, const std::vector<cv::Mat
   const Frame* earlier = nullptr;
   for (auto it = history_.rbegin(); it != history_.rend(); ++it) {
     if (forward_m_ - it->forward_m < options_.baseline_m) continue;
-    if (turned_rad_ - it->turned_rad <= options_.max_baseline_rad &&
+    if (std::abs(turned_rad_ - it->turned_rad) <= options_.max_baseline_rad &&
         ToSeconds(t_ns - it->t_ns) <= options_.max_age_s &&
         it->pyramid.front().size() == grey.size()) {
       earlier = &*it;

@@ -58,7 +58,7 @@ struct ObstacleWatchOptions {
   // aside to step, from the obstacle's extent in the image (control::LateralExtent).
   double region_half_width_m = 0.27;
   double baseline_m = 0.08;       // commanded forward motion between the two frames compared
-  double max_baseline_rad = 0.1;  // ... and at most this much commanded turning
+  double max_baseline_rad = 0.1;  // ... and at most this much commanded heading change
   double max_age_s = 2.0;         // older frames are not used as the earlier frame
   // The region ahead: the strip of ground the robot drives over, rows from region_top (fraction
   // of the image height from the top; 0.72: about 2 m ahead, see above) to the bottom. A strip of
@@ -135,7 +135,7 @@ class ObstacleWatch {
     std::vector<cv::Mat> pyramid;  // its Lucas-Kanade pyramid, grey levels (built once per frame)
     Timestamp t_ns = 0;
     double forward_m = 0.0;   // odometer of commanded forward motion when it was taken
-    double turned_rad = 0.0;  // ... and of commanded |turning|
+    double turned_rad = 0.0;  // ... and the commanded heading (the sum of signed turning)
   };
   cv::Rect Region(cv::Size size) const;  // the region's bounding box
   bool InRegion(cv::Point2f p, cv::Size size) const;
