@@ -22,9 +22,11 @@ struct WatchRun {
 
 // Drives straight along +x at `speed` through table1_almost_straight's hall (with a 0.5 m box at
 // (`box_x`, `box_y`) when box_x > 0, taken away at `box_leaves_s`), the watch deciding every
-// frame; stops for good when it blocks (the command is zero while blocked).
+// frame; stops for good when it blocks (the command is zero while blocked). `zigzag_radps`:
+// turning left and right at that rate on alternate frames, as the standard funnel lane does.
 WatchRun DriveAt(double box_x, double box_leaves_s, double drive_s, std::uint64_t seed,
-                 const ObstacleWatchOptions& options = {}, double box_y = 0.0) {
+                 const ObstacleWatchOptions& options = {}, double box_y = 0.0,
+                 double zigzag_radps = 0.0) {
   sim::Scenario s = sim::LoadScenario("table1_almost_straight");
   sim::World world = s.world;
   if (box_x > 0.0) {
@@ -60,8 +62,9 @@ WatchRun DriveAt(double box_x, double box_leaves_s, double drive_s, std::uint64_
     } else {
       grey = image;
     }
-    const ObstacleCheck c =
-        watch.Update(grey, FromSeconds(i * period), command.v_mps * (i > 0 ? period : 0.0), 0.0);
+    const double dt = i > 0 ? period : 0.0;
+    const ObstacleCheck c = watch.Update(grey, FromSeconds(i * period), command.v_mps * dt,
+                                         command.omega_radps * dt);
     if (c.observed) ++out.observed;
     if (c.observed && out.first_blocked < 0)
       out.max_fraction = std::max(out.max_fraction, c.blocked_fraction);
@@ -70,7 +73,8 @@ WatchRun DriveAt(double box_x, double box_leaves_s, double drive_s, std::uint64_
       out.clearance_at_block = box_x - 0.25 - simulation.robot(r).pose().x_m - robot.radius_m;
     }
     if (c.cleared && out.cleared_frame < 0) out.cleared_frame = i;
-    command = watch.blocked() ? Twist2{} : Twist2{0.2, 0.0};
+    const double turn = i % 2 == 0 ? zigzag_radps : -zigzag_radps;
+    command = watch.blocked() ? Twist2{} : Twist2{0.2, turn};
     simulation.SetCommand(r, command);
     simulation.Advance(period);
   }
@@ -105,6 +109,17 @@ TEST(ObstacleWatch, StopsBeforeABoxAndGoesOnWhenItIsGone) {
     ASSERT_GE(run.first_blocked, 0) << "seed " << seed;
     EXPECT_GE(run.clearance_at_block, 0.3) << "seed " << seed;
     EXPECT_GT(run.cleared_frame, 200) << "seed " << seed;  // after the box left (20 s)
+  }
+}
+
+// The standard funnel lane's turning, +-0.3 rad/s on alternate frames: the heading hardly
+// changes, and the watch must look (until 2026-11-26 it summed |turning| and never did).
+TEST(ObstacleWatch, ARobotThatZigzagsIsWatchedToo) {
+  for (std::uint64_t seed : Seeds()) {
+    const WatchRun run = DriveAt(3.0, 1000.0, 20.0, seed, {}, 0.0, 0.3);
+    EXPECT_GT(run.observed, 20) << "seed " << seed;
+    ASSERT_GE(run.first_blocked, 0) << "seed " << seed;
+    EXPECT_GE(run.clearance_at_block, 0.3) << "seed " << seed;
   }
 }
 
