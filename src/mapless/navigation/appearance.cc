@@ -302,7 +302,8 @@ FollowerStep AppearanceFollower::Update(const cv::Mat& image, const Pose2& odome
       double turned_rad = 0.0;
       if (have_watch_odometry_) {
         forward_m = AdvanceAlong(watch_odometry_, odometry);
-        turned_rad = std::abs(WrapAngle(odometry.theta_rad - watch_odometry_.theta_rad));
+        // Signed: the watch compares the heading between two frames (obstacle_watch.cc).
+        turned_rad = WrapAngle(odometry.theta_rad - watch_odometry_.theta_rad);
       }
       obstacle = watch_.Update(grey, t_ns, forward_m, turned_rad);
     }
