@@ -20,8 +20,6 @@ void DetourOptions::Validate() const {
                 "DetourOptions: first_step_m and step_m must be > 0, margin_m >= 0");
   MAPLESS_CHECK(max_offset_m >= first_step_m,
                 "DetourOptions.max_offset_m = " << max_offset_m << "; must be >= first_step_m");
-  MAPLESS_CHECK(suspect_fraction > 0.0 && suspect_fraction < 1.0,
-                "DetourOptions.suspect_fraction = " << suspect_fraction << "; must be in (0, 1)");
   MAPLESS_CHECK(look_max_m > 0.0, "DetourOptions.look_max_m = " << look_max_m << "; must be > 0");
   MAPLESS_CHECK(look_speed_fraction > 0.0 && look_speed_fraction <= 1.0,
                 "DetourOptions.look_speed_fraction = " << look_speed_fraction
@@ -191,28 +189,22 @@ Twist2 Detour::Command(const Pose2& now, AheadView ahead, double speed_mps) {
         if (std::abs(heading) > options_.aligned_rad) return TurnTo(0.0, heading);
         phase_ = look_after_step_ ? DetourPhase::kLook : DetourPhase::kPass;
         look_start_ = now;
-        free_looks_ = 0;
-        suspects_ = 0;
         break;
       case DetourPhase::kLook:
-        // Blocked or suspect on any frame, or not seen free twice within look_max_m (not known
-        // to be free): a step further aside.
+        // Blocked, or not seen within look_max_m (not known to be free): a step further aside.
         if (ahead == AheadView::kBlocked || ahead == AheadView::kSuspect ||
             now.DistanceTo(look_start_) >= options_.look_max_m) {
           StepFurther(options_.step_m);
           break;
         }
-        if (ahead == AheadView::kFree && ++free_looks_ >= 2) {
+        if (ahead == AheadView::kFree) {
           look_after_step_ = false;
           phase_ = DetourPhase::kPass;
           break;
         }
         return {options_.look_speed_fraction * speed_mps, 0.0};
       case DetourPhase::kPass:
-        suspects_ = ahead == AheadView::kSuspect ? suspects_ + 1
-                    : ahead == AheadView::kUnknown ? suspects_
-                                                   : 0;
-        if (ahead == AheadView::kBlocked || suspects_ >= 2) {
+        if (ahead == AheadView::kBlocked) {
           look_after_step_ = true;
           StepFurther(options_.step_m);
           break;

@@ -44,12 +44,7 @@ struct DetourOptions {
   double turn_out_max_rad = 1.4;
   double first_step_m = 0.3;      // the first lateral step off the line at least
   double step_m = 0.2;            // each further step while the way ahead is still blocked
-  double margin_m = 0.15;         // beside the obstacle's extent and the strip's half-width
-  // The share of the strip's points off the ground that makes a look (one frame) or a pass (two
-  // observed frames in a row) step further aside; a look passes after two frames below it. The
-  // watch stops at 0.15 on its own; an empty floor gives 0-0.04, the edge of a box in the strip
-  // 0.03-0.15 on the simulator.
-  double suspect_fraction = 0.05;
+  double margin_m = 0.1;          // beside the obstacle's extent and the strip's half-width
   double max_offset_m = 1.5;      // stepping aside farther than this: the detour fails
   double look_max_m = 0.2;        // creep at most this far for one look ahead
   double look_speed_fraction = 0.5;  // of the speed, while creeping to look
@@ -65,10 +60,7 @@ struct DetourOptions {
 enum class AheadView {
   kUnknown,  // not observed (no baseline yet, a plain floor)
   kFree,     // observed, below the watch's blocked fraction
-  // Observed with some of the strip off the ground (DetourOptions::suspect_fraction): the
-  // obstacle's edge may be in the way. Looking, a step further; passing, on two observed frames
-  // in a row.
-  kSuspect,
+  kSuspect,  // observed, above it on this frame (not yet confirmed)
   kBlocked,  // confirmed by the watch
 };
 
@@ -131,8 +123,7 @@ class Detour {
   double turn_out_rad_ = 0.8;
   double offset_m_ = 0.0;  // lateral target of the current step, towards side_
   bool look_after_step_ = true;
-  int free_looks_ = 0;  // observed frames without anything in the strip, this look
-  int suspects_ = 0;    // observed suspect frames in a row, passing
+  double look_from_m_ = 0.0;
   Pose2 look_start_;
   DetourPhase phase_ = DetourPhase::kBackOff;
 };

@@ -47,7 +47,7 @@ RepeatStep RepeatSession::Detouring(RepeatStep step, const ObstacleCheck& obstac
     ahead = control::AheadView::kBlocked;
     watch_.Resume();
   } else if (obstacle.observed) {
-    ahead = obstacle.blocked_fraction > options_.detour.suspect_fraction
+    ahead = obstacle.blocked_fraction > options_.obstacle.min_blocked_fraction
                 ? control::AheadView::kSuspect
                 : control::AheadView::kFree;
   }
