@@ -272,6 +272,9 @@ std::vector<EigenspaceEntry> EigenspaceSuiteEntries() {
     }
   }
   entries.push_back({"obstacle_box_office", "on-route"});
+  // Issue 21, recovery: route images whose carts are gone, with and without it.
+  entries.push_back({"route_images_gone_office", "on-route"});
+  entries.push_back({"route_images_gone_office", "no-recovery"});
   return entries;
 }
 
@@ -292,7 +295,9 @@ EigenspaceRunOptions EigenspaceEntryOptions(const EigenspaceEntry& entry, std::u
   } else if (e == "no-markov") {
     options.follower.use_markov = false;
   } else if (e == "concurrent") {
-    options.concurrent = true;
+    options.concurrent = true;  } else if (e == "no-recovery") {
+    options.follower.recover_images = 0;
+    options.follower.carry_on.max_distance_m = 0.0;
   } else {
     MAPLESS_CHECK(e == "on-route", "eigenspace suite: unknown experiment '" << e << "'");
   }

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <string>
+
 #include "mapless/core/check.h"
 
 namespace mapless::eval {
@@ -57,9 +60,39 @@ TEST(EigenspaceFollow, StopsBeforeABoxOnTheRouteAndGoesOnWhenItIsGone) {
   EXPECT_EQ(blind.obstacle_stops, 0);
 }
 
+// Issue 21, recovery: carts along both walls filled the leader's view from 5 m to 12 m and are
+// gone when the follower comes. The follower carries on along the leader's odometry where no
+// route image fits and completes the route (without recovery it does not:
+// `mapless eval eigenspace --only route_images_gone_office`, README).
+TEST(EigenspaceFollow, CarriesOnWhereTheRouteImagesNoLongerFitAndArrives) {
+  const sim::Scenario scenario = sim::LoadScenario("route_images_gone_office");
+  const EigenspaceRunOptions options =
+      EigenspaceEntryOptions({"route_images_gone_office", "on-route"}, 1);
+  int carrying = 0;
+  double carried_from_m = 1e9;
+  double carried_to_m = -1e9;
+  const EigenspaceRun run = RunEigenspaceFollow(
+      scenario, options, [&](const navigation::FollowerStep& step, const Pose2& truth) {
+        if (!step.carrying_on) return;
+        ++carrying;
+        EXPECT_EQ(step.state, navigation::FollowerState::kFollowing);
+        EXPECT_NE(step.reason.find("carrying on"), std::string::npos) << step.reason;
+        carried_from_m = std::min(carried_from_m, truth.x_m);
+        carried_to_m = std::max(carried_to_m, truth.x_m);
+      });
+  EXPECT_TRUE(run.success) << run.status;
+  EXPECT_FALSE(run.collided);
+  EXPECT_LT(run.final_error_m, 0.6);
+  EXPECT_GE(carrying, 10);
+  // Where the carts were in view (they stood from 8 m to 12 m).
+  EXPECT_GT(carried_from_m, 2.0);
+  EXPECT_LT(carried_to_m, 12.0);
+  EXPECT_THROW(EigenspaceEntryOptions({"route_images_gone_office", "sideways"}, 1), InputError);
+}
+
 TEST(EigenspaceSuite, HasTwoRoutesAndSixExperimentsEachAndTheFollowersObstacle) {
   const auto entries = EigenspaceSuiteEntries();
-  EXPECT_EQ(entries.size(), 13U);
+  EXPECT_EQ(entries.size(), 15U);
   EXPECT_THROW(EigenspaceEntryOptions({"office_aliasing", "sideways"}, 1), InputError);
 }
 

@@ -105,6 +105,49 @@ void MarkovLocalizer::Predict(double advance_images) {
   }
 }
 
+void MarkovLocalizer::ApplyIndexLimits() {
+  const int n = static_cast<int>(belief_.size());
+  const int lo = std::clamp(min_index_, 0, n - 1);
+  const int hi = max_index_ < 0 ? n - 1 : std::clamp(max_index_, lo, n - 1);
+  if (lo > 0 || hi < n - 1) {
+    const double kept = belief_.segment(lo, hi - lo + 1).sum();
+    if (kept > 0.0) {
+      belief_.head(lo).setZero();
+      belief_.tail(n - 1 - hi).setZero();
+      belief_ /= kept;
+    }
+  }
+}
+
+Localization MarkovLocalizer::Peak() const {
+  Localization result;
+  const int n = static_cast<int>(belief_.size());
+  if (n == 0) return result;
+  Eigen::Index best = 0;
+  belief_.maxCoeff(&best);
+  result.index = static_cast<int>(best);
+  const int w = options_.probability_window;
+  const int from = std::max(0, result.index - w);
+  const int to = std::min(n - 1, result.index + w);
+  result.probability = belief_.segment(from, to - from + 1).sum();
+  result.status = LocalizationStatus::kTracking;
+  return result;
+}
+
+Localization MarkovLocalizer::Predict(int route_images, double advance_images) {
+  MAPLESS_CHECK(std::isfinite(advance_images),
+                "Markov localization: advance = " << advance_images << "; must be finite");
+  if (route_images == 0) return {};
+  if (belief_.size() == 0) ResetUniform(route_images);
+  MAPLESS_CHECK(route_images >= belief_.size(), "Markov localization: the route shrank from "
+                                                    << belief_.size() << " to " << route_images
+                                                    << " images");
+  Grow(route_images);
+  Predict(advance_images);
+  ApplyIndexLimits();
+  return Peak();
+}
+
 Localization MarkovLocalizer::Update(const Eigen::MatrixXf& projections,
                                      const Eigen::VectorXf& query, double advance_images) {
   MAPLESS_CHECK(std::isfinite(advance_images),
@@ -117,16 +160,7 @@ Localization MarkovLocalizer::Update(const Eigen::MatrixXf& projections,
                                          << belief_.size() << " to " << n << " images");
   Grow(n);
   Predict(advance_images);
-  const int lo = std::clamp(min_index_, 0, n - 1);
-  const int hi = max_index_ < 0 ? n - 1 : std::clamp(max_index_, lo, n - 1);
-  if (lo > 0 || hi < n - 1) {
-    const double kept = belief_.segment(lo, hi - lo + 1).sum();
-    if (kept > 0.0) {
-      belief_.head(lo).setZero();
-      belief_.tail(n - 1 - hi).setZero();
-      belief_ /= kept;
-    }
-  }
+  ApplyIndexLimits();
 
   // Eq. (6): p(z|x) = 1/k Σ γ_j exp(-((x - x_j)/σ)²), γ_j = d_1 / d_j in (0, 1].
   result.neighbours = NearestProjections(projections, query, options_.kernels);
@@ -152,13 +186,9 @@ Localization MarkovLocalizer::Update(const Eigen::MatrixXf& projections,
     belief_ /= total;
   }
 
-  Eigen::Index best = 0;
-  belief_.maxCoeff(&best);
-  result.index = static_cast<int>(best);
-  const int w = options_.probability_window;
-  const int from = std::max(0, result.index - w);
-  const int to = std::min(n - 1, result.index + w);
-  result.probability = belief_.segment(from, to - from + 1).sum();
+  const Localization peak = Peak();
+  result.index = peak.index;
+  result.probability = peak.probability;
   const bool doubtful =
       result.probability < options_.lost_probability || result.agreement < options_.min_agreement;
   low_updates_ = doubtful ? low_updates_ + 1 : 0;

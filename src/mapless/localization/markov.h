@@ -63,6 +63,11 @@ class MarkovLocalizer {
   Localization Update(const Eigen::MatrixXf& projections, const Eigen::VectorXf& query,
                       double advance_images);
 
+  // Prediction alone (dead reckoning, not in the paper): the belief moves with the odometry and the
+  // index limits, with no observation (the images are known not to fit, e.g. where something the
+  // route images showed is gone). The status stays kTracking and the lost count is not advanced.
+  Localization Predict(int route_images, double advance_images);
+
   const Eigen::VectorXd& belief() const { return belief_; }
   // Changes MarkovOptions::uniform_mixing from the next prediction on.
   void set_uniform_mixing(double mixing);
@@ -78,6 +83,8 @@ class MarkovLocalizer {
  private:
   void Grow(int route_images);
   void Predict(double advance_images);
+  void ApplyIndexLimits();
+  Localization Peak() const;  // index and probability at the belief's maximum
 
   MarkovOptions options_;
   Eigen::VectorXd belief_;

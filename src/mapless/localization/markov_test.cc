@@ -183,6 +183,39 @@ TEST(MarkovLocalizer, AMinimumIndexKeepsTheBeliefFromFallingBack) {
   ExpectLimitsHold(40.0, 36, -1);
 }
 
+// Dead reckoning (the follower carrying on where the route images no longer fit): the belief
+// moves with the advance alone, spreads, stays within the limits and is never reported lost,
+// while the same images as observations would have pulled it back and declared it lost.
+TEST(MarkovLocalizer, PredictionAloneMovesTheBeliefByTheAdvanceAndNeverLosesIt) {
+  const int n = 100;
+  const Eigen::MatrixXf route = LinearRoute(n);
+  MarkovOptions options;
+  options.lost_after_updates = 3;
+  MarkovLocalizer reckoning(options);
+  MarkovLocalizer observing(options);
+  reckoning.ResetAt(n, 10.0, 1.0);
+  observing.ResetAt(n, 10.0, 1.0);
+  Localization by_advance;
+  Localization by_images;
+  int lost = 0;
+  for (int t = 0; t < 10; ++t) {
+    by_advance = reckoning.Predict(n, 2.0);
+    by_images = observing.Update(route, LooksLike(10.0F), 2.0);  // the view of place 10 stays
+    lost += by_images.status == LocalizationStatus::kLost;
+  }
+  EXPECT_EQ(by_advance.status, LocalizationStatus::kTracking);
+  EXPECT_NEAR(by_advance.index, 30, 1);
+  EXPECT_LT(by_advance.probability, 0.5);  // spread by the motion model
+  EXPECT_LT(by_images.index, by_advance.index - 3);  // held back by the view of place 10
+  EXPECT_GT(lost, 0);
+  // The limits hold too.
+  reckoning.set_index_limits(-1, 32);
+  for (int t = 0; t < 5; ++t) by_advance = reckoning.Predict(n, 2.0);
+  EXPECT_LE(by_advance.index, 32);
+  EXPECT_EQ(reckoning.belief().tail(n - 33).sum(), 0.0);
+  EXPECT_NEAR(reckoning.belief().sum(), 1.0, 1e-9);
+}
+
 TEST(MarkovOptions, RejectsBadValuesNamingTheField) {
   MarkovOptions options;
   options.kernels = 0;

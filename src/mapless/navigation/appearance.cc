@@ -176,6 +176,12 @@ void AppearanceFollowerOptions::Validate() const {
                                                << arrive_within_images << "; must be >= 0");
   MAPLESS_CHECK(wait_within_images >= 0, "AppearanceFollowerOptions.wait_within_images = "
                                              << wait_within_images << "; must be >= 0");
+  MAPLESS_CHECK(carry_on_heading_frames >= 1,
+                "AppearanceFollowerOptions.carry_on_heading_frames = "
+                    << carry_on_heading_frames << "; must be >= 1");
+  MAPLESS_CHECK(recover_images >= 0, "AppearanceFollowerOptions.recover_images = "
+                                         << recover_images << "; must be >= 0");
+  carry_on.Validate();
 }
 
 AppearanceFollowerOptions::AppearanceFollowerOptions() {
@@ -274,6 +280,8 @@ FollowerStep AppearanceFollower::Initialize(const appearance::Vector& projection
   }
   since_localized_m_ = 0.0;
   have_localization_ = false;
+  carrying_.reset();
+  carry_given_up_ = false;
   pending_advance_images_ = 0.0;
   initializing_ = false;
   init_started_ = false;
@@ -380,8 +388,10 @@ FollowerStep AppearanceFollower::Decide(const cv::Mat& image, const Pose2& odome
       markov_.set_uniform_mixing(since_localized_m_ < options_.uniform_mixing_for_m
                                      ? options_.markov.uniform_mixing
                                      : 0.0);
+      // Carrying on: the images are known not to fit here, so the belief moves by odometry alone.
       last_localization_ =
-          markov_.Update(route.space.projections, projection, pending_advance_images_);
+          carrying_ ? markov_.Predict(route.size(), pending_advance_images_)
+                    : markov_.Update(route.space.projections, projection, pending_advance_images_);
       pending_advance_images_ = 0.0;
       have_localization_ = true;
       last_route_size_ = route.size();
@@ -424,22 +434,19 @@ FollowerStep AppearanceFollower::Decide(const cv::Mat& image, const Pose2& odome
     return step;
   }
   // Steer towards the route image lookahead_images ahead; when its sub-windows give no
-  // consistent fit, try its neighbours (the localization is good to about one image).
+  // consistent fit, try its neighbours (the localization is good to about one image), then the
+  // route images beyond them (recovery), then carry on along the leader's odometry.
   const int ahead = std::min(step.index + options_.lookahead_images, n - 1);
-  for (const int target : {ahead, ahead - 1, ahead + 1}) {
-    if (target < 0 || target >= n) continue;
-    const route::AppearanceRouteImage& image_j = *route.images[static_cast<std::size_t>(target)];
-    std::vector<control::WindowCorrespondence> matches;
-    for (const appearance::SubWindowMatch& m :
-         appearance::MatchSubWindows(image_j.windows, low, options_.windows)) {
-      matches.push_back({m.query, m.stored});
-    }
-    step.target = target;
-    step.steering = control::ComputeSubWindowSteering(matches, image_j.windows.windows(),
-                                                      options_.windows.step_px, options_.steering);
-    if (step.steering.ok) break;
-  }
-  if (!step.steering.ok) {
+  if (SteerTowards({ahead, ahead - 1, ahead + 1}, low, route, &step) ||
+      Recover(ahead, low, route, &step)) {
+    carrying_.reset();
+    carry_given_up_ = false;
+  } else if (const std::optional<Twist2> carry = CarryOn(odometry, route, &step)) {
+    stopped_frames_ = 0;
+    step.state = FollowerState::kFollowing;
+    step.command = *carry;
+    return step;
+  } else {
     // Safety: no steering decision, so the robot stops and says why; if that lasts, it makes the
     // small motions of the initial localization around its current position, which also change
     // the view.
@@ -454,6 +461,10 @@ FollowerStep AppearanceFollower::Decide(const cv::Mat& image, const Pose2& odome
   stopped_frames_ = 0;
   step.state = FollowerState::kFollowing;
   step.command = step.steering.twist;
+  heading_offsets_.push_back(WrapAngle(
+      odometry.theta_rad - route.images[static_cast<std::size_t>(step.index)]->odometry.theta_rad));
+  while (static_cast<int>(heading_offsets_.size()) > options_.carry_on_heading_frames)
+    heading_offsets_.pop_front();
   return step;
 }
 

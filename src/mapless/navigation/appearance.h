@@ -11,8 +11,10 @@
 // when it reaches the end of a route that is still being taught (it waits for the leader).
 #pragma once
 
+#include <deque>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +22,7 @@
 #include "mapless/appearance/pca.h"
 #include "mapless/appearance/subwindow.h"
 #include "mapless/control/subwindow_steering.h"
+#include "mapless/control/taught_path.h"
 #include "mapless/core/pose.h"
 #include "mapless/localization/initial.h"
 #include "mapless/localization/markov.h"
@@ -131,6 +134,23 @@ struct AppearanceFollowerOptions {
   int lookahead_images = 1;      // steer towards the route image this far ahead of the position
   int arrive_within_images = 1;  // arrived at the end of a complete route within this many
   int wait_within_images = 2;    // wait for a leader this close to the end it has taught so far
+  // Recovery (issue 21; not in the paper), for route images whose view has changed (something
+  // that filled them is gone). When the route image ahead and its neighbours give no consistent
+  // sub-window fit, the follower tries the route images up to recover_images beyond them, the
+  // most probable first by the Markov belief (the belief at the place each would be the one ahead
+  // from), and steers towards the first that fits. When none does, it carries on along the
+  // leader's odometry (the route images' poses, control/taught_path.h) from its place on the
+  // route: the belief then moves with the odometry alone (MarkovLocalizer::Predict: the images
+  // are known not to fit, so they are no evidence), and the images ahead are tried every frame;
+  // the first fit ends it. After carry_on.max_distance_m without a fit it stops and localizes
+  // again around where it is (as without recovery). Both need the Markov belief (use_markov).
+  // recover_images = 0, carry_on.max_distance_m = 0: off. The leader's poses are turned by the
+  // mean heading difference between the follower and the route images it was at over its last
+  // carry_on_heading_frames frames of following (the follower weaves about the route's heading;
+  // one frame's heading, often turning as the fits go wrong, drifts aside).
+  int recover_images = 10;
+  int carry_on_heading_frames = 60;
+  control::TaughtPathOptions carry_on;
   CameraCheckOptions camera;     // camera faults: stop until the images are usable again
   // Obstacle watch (not in the paper; obstacle_watch.h), as in the repeat: something on the way
   // ahead stops the follower (kStopped, the reason says so) until it is gone. On by default;
@@ -149,6 +169,7 @@ struct FollowerStep {
   int index = -1;            // localization on the route (route image)
   double probability = 0.0;  // Markov: belief mass around it
   int target = -1;           // route image steered towards
+  bool carrying_on = false;  // driving the leader's odometry (AppearanceFollowerOptions::carry_on)
   std::string reason;        // why the robot is stopped (kStopped, kWaitingForLeader)
   control::SubWindowSteering steering;
   std::vector<float> belief;  // Markov: the belief over the route images after this frame
@@ -172,6 +193,17 @@ class AppearanceFollower {
                           const route::AppearanceRoute& route);
   // centre_index < 0: around the route start (or the whole route when start_window_m is 0).
   void StartInitialization(const Pose2& odometry, int centre_index);
+  // Sub-window steering towards the first of `targets` that fits (step->target, step->steering).
+  bool SteerTowards(const std::vector<int>& targets, const cv::Mat& low,
+                    const route::AppearanceRoute& route, FollowerStep* step) const;
+  // Recovery: the route images beyond the lookahead target and its neighbours, by belief.
+  bool Recover(int ahead, const cv::Mat& low, const route::AppearanceRoute& route,
+               FollowerStep* step) const;
+  // Carrying on along the leader's odometry from route image step->index: the command, or
+  // nullopt when it is off, not possible or given up (then not again before the next fit or
+  // localization).
+  std::optional<Twist2> CarryOn(const Pose2& odometry, const route::AppearanceRoute& route,
+                                FollowerStep* step);
 
   AppearanceFollowerOptions options_;
   CameraMonitor camera_;
@@ -198,6 +230,11 @@ class AppearanceFollower {
   double since_localized_m_ = 0.0;
   double driven_m_ = 0.0;
   int start_index_ = -1;
+  std::optional<control::TaughtPathPursuit> carrying_;
+  bool carry_given_up_ = false;  // until the next fit or localization
+  // Heading of the follower minus the leader's at its route image, over the last frames of
+  // following (carry_on_heading_frames).
+  std::deque<double> heading_offsets_;
 };
 
 }  // namespace mapless::navigation

@@ -24,6 +24,7 @@ void FollowerFields(const navigation::FollowerStep& s, nlohmann::json* j) {
   (*j)["index"] = s.index;
   (*j)["probability"] = s.probability;
   (*j)["target"] = s.target;
+  if (s.carrying_on) (*j)["carrying_on"] = true;
   if (s.steering.ok) {
     (*j)["fit"] = s.steering.fit;
     (*j)["shift_px"] = s.steering.shift_px;
