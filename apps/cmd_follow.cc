@@ -80,6 +80,7 @@ void AddFollowCommand(CLI::App* app) {
     std::uint64_t seed = 1;
     double motion_noise = 0.1;
     std::string on_obstacle;  // empty: the robot file's, else stop
+    double carry_on_m = navigation::AppearanceFollowerOptions{}.carry_on.max_distance_m;
     FollowConnectArgs fleet;
     RecordArgs record;
     recording::PlaybackOptions playback;
@@ -110,6 +111,14 @@ void AddFollowCommand(CLI::App* app) {
   cmd->add_option("--robot", a->robot, "Drive a robot: its robot file (YAML)")->excludes(source);
   cmd->add_option("--log", a->log, "Per-frame decisions as JSON lines (- for stdout)");
   AddOnObstacleOption(cmd, &a->on_obstacle);
+  cmd->add_option("--carry-on-m", a->carry_on_m,
+                  "Where no route image near the localization fits (the view has changed): try "
+                  "the images up to 2 m further on, then drive the leader's odometry at most "
+                  "this many metres until one fits (0: neither, the paper's follower; "
+                  "docs/appearance_route_following.md#recovery-where-the-route-images-no-longer-"
+                  "fit-issue-21-not-in-the-paper)")
+      ->capture_default_str()
+      ->check(FiniteIn(0.0, 100.0));
   cmd->add_option("--seed", a->seed, "Simulator: seed of the motion noise")
       ->capture_default_str()
       ->check(SeedCheck());
@@ -126,6 +135,7 @@ void AddFollowCommand(CLI::App* app) {
       f.seed = a->seed;
       f.motion_noise = a->motion_noise;
       f.on_obstacle = a->on_obstacle;
+      f.carry_on_m = a->carry_on_m;
       RefuseOutputOverInputs(f.log, "--log", {SourceInput(f.source), f.robot});
       FollowConnected(f);
       return;
@@ -139,6 +149,7 @@ void AddFollowCommand(CLI::App* app) {
     const std::shared_ptr<const route::AppearanceRoute> route = RebuildRoute(a->route, &size);
     navigation::AppearanceFollowerOptions follower;
     follower.obstacle = ObstacleWatchFor(a->robot, a->on_obstacle, follower.obstacle, false);
+    SetFollowerRecovery(a->carry_on_m, &follower);
     robot::FollowMethod method([route] { return route; }, follower, size);
     if (!a->robot.empty()) {
       const auto recorder = OpenRecorder(a->record);

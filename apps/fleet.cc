@@ -326,6 +326,7 @@ void FollowConnected(const FollowConnectArgs& a) {
     navigation::RepeatOptions repeat;
     repeat.features.type = features::ParseDetectorType(header.detector);
     repeat.obstacle = ObstacleWatchFor(a.robot, a.on_obstacle, repeat.obstacle, true);
+    repeat.carry_on.max_distance_m = a.carry_on_m;
     if (scenario) {
       const double speed =
           eval::RepeatSpeedFor(*scenario, eval::RepeatRunOptions{}.max_repeat_speed_mps);
@@ -337,6 +338,7 @@ void FollowConnected(const FollowConnectArgs& a) {
   } else {
     navigation::AppearanceFollowerOptions follower;
     follower.obstacle = ObstacleWatchFor(a.robot, a.on_obstacle, follower.obstacle, false);
+    SetFollowerRecovery(a.carry_on_m, &follower);
     method = std::make_unique<robot::FollowMethod>([&copy] { return copy.AppearanceRoute(); },
                                                    follower, size);
   }

@@ -23,6 +23,7 @@ struct FollowConnectArgs {
   std::uint64_t seed = 1;
   double motion_noise = 0.1;
   std::string on_obstacle;  // the obstacle watch: stop, off, or empty (the robot file's, else stop)
+  double carry_on_m = 6.0;  // carrying on where the route no longer matches (0: off)
 };
 void FollowConnected(const FollowConnectArgs& a);
 

@@ -50,6 +50,11 @@ std::unique_ptr<robot::RobotLink> OpenRobotLink(const robot::RobotFile& robot, c
                    " is not available in this build");
 }
 
+void SetFollowerRecovery(double carry_on_m, navigation::AppearanceFollowerOptions* follower) {
+  follower->carry_on.max_distance_m = carry_on_m;
+  if (carry_on_m <= 0.0) follower->recover_images = 0;
+}
+
 navigation::ObstacleWatchOptions ObstacleWatchFor(const std::string& robot_path,
                                                   const std::string& on_obstacle,
                                                   const navigation::ObstacleWatchOptions& defaults,

@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "mapless/navigation/appearance.h"
 #include "mapless/recording/playback.h"
 #include "mapless/recording/run_recorder.h"
 #include "mapless/robot/link.h"
@@ -32,6 +33,9 @@ navigation::ObstacleWatchOptions ObstacleWatchFor(const std::string& robot_path,
                                                   const std::string& on_obstacle,
                                                   const navigation::ObstacleWatchOptions& defaults,
                                                   bool can_avoid);
+// `follow --carry-on-m`: the follower's recovery of route images and carrying on along the
+// leader's odometry at most `carry_on_m` metres; 0 switches both off (the paper's follower).
+void SetFollowerRecovery(double carry_on_m, navigation::AppearanceFollowerOptions* follower);
 // `--on-obstacle` of `repeat` and `follow` (stop, avoid, off).
 void AddOnObstacleOption(CLI::App* cmd, std::string* on_obstacle);
 
