@@ -186,6 +186,8 @@ expect_exit "eval potential refuses --carry-on-m" 2 "$MAPLESS" eval potential --
 # --on-obstacle avoid: teach & repeat only; the follower refuses it in one line.
 expect_exit "follow refuses --on-obstacle avoid" 2 "$MAPLESS" follow --route "$TMP/eroute" --source "$TMP/d1/frames" --poses "$TMP/d1/odometry.tum" --on-obstacle avoid
 grep -q "avoid is built for teach & repeat only" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "follow names --on-obstacle avoid in one line" $?
+expect_exit "follow: a negative --carry-on-m exits 2" 2 "$MAPLESS" follow --route "$TMP/eroute" --source "$TMP/d1/frames" --poses "$TMP/d1/odometry.tum" --carry-on-m -1
+grep -q -- "--carry-on-m" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "follow names a bad --carry-on-m in one line" $?
 expect_exit "an unknown --on-obstacle exits 2" 2 "$MAPLESS" repeat --route "$TMP/route" --source "$TMP/d1/frames" --on-obstacle swerve
 expect_exit "repeat with --on-obstacle avoid and nothing in the way" 0 "$MAPLESS" repeat --route "$TMP/simroute" --source sim:rotation_in_place --on-obstacle avoid --log "$TMP/rep3.jsonl"
 tail -1 "$TMP/rep3.jsonl" | grep -q '"status":"completed"' && ! grep -q '"avoiding":' "$TMP/rep3.jsonl"; check "avoid with nothing in the way: completed, never went round" $?
