@@ -8,8 +8,10 @@
 //      does not see the ground within about 0.9 m, and the looks below must see the obstacle,
 //   1. turns in place out to the chosen side (the force's angle theta of Eq. 16, clamped),
 //   2. drives straight until it is off the line by the obstacle's extent on that side (measured
-//      in the image where the watch stopped it, ObstacleExtent), the strip's half-width and a
-//      margin,
+//      in the image where the watch stopped it, ObstacleExtent; at least the strip's edge, since
+//      the obstacle stands in the strip and its points near an edge are often missed), the
+//      strip's half-width and a margin; something in the way of this step (a wall the turn
+//      faces) sends it round the other side, once,
 //   3. turns back parallel to the line and creeps until the watch has looked at the strip ahead:
 //      still blocked (or nothing seen within look_max_m: not known to be free), a step further
 //      aside (2-3 again),
@@ -19,7 +21,7 @@
 //   5. rejoins the line by pure pursuit; done within rejoined_m of it.
 // The caller re-acquires the route's keyframe then. A confirmed obstacle while passing or
 // rejoining sends the robot a step further aside; stepping aside beyond max_offset_m, or
-// something in the way while stepping aside, fails the detour (the robot stops).
+// something in the way while stepping aside on both sides, fails the detour (the robot stops).
 //
 // Departure from the paper's law (T = T_m cos theta, R = R_m sin theta every frame, Eq. 17): that
 // needs the dominant plane on every frame, and a level camera 0.4 m above the ground sees ground
@@ -102,7 +104,8 @@ class Detour {
  public:
   // `stopped_at`: the odometry pose where the watch stopped the robot; `theta_rad`: DetourAngle's
   // (its sign is the side); `extent` and `half_width_m`: how far aside to step first, the
-  // obstacle's side plus half_width_m and margin_m (beyond max_offset_m: failed at once).
+  // obstacle's side (at least half_width_m) plus half_width_m and margin_m (beyond max_offset_m:
+  // failed at once).
   Detour(const Pose2& stopped_at, double theta_rad, const ObstacleExtent& extent,
          double half_width_m, DetourOptions options);
   // The command at odometry pose `now`, the watch's view of this frame; `speed_mps`: the route's.
@@ -116,12 +119,17 @@ class Detour {
   Twist2 TurnTo(double heading_rad, double now_rad) const;  // in the line's frame
   Twist2 Pursue(const Pose2& local, double x_m, double y_m, double speed_mps) const;
   void StepFurther(double step_m);
+  // The first step's offset on `side`: the obstacle's extent there (at least the strip's edge),
+  // the strip's half-width and the margin.
+  double FirstOffset(const ObstacleExtent& extent, double half_width_m, double side) const;
 
   Pose2 origin_;  // the line: x along the heading where the robot stopped, y to the left
   DetourOptions options_;
   double side_ = 1.0;
   double turn_out_rad_ = 0.8;
   double offset_m_ = 0.0;  // lateral target of the current step, towards side_
+  double other_side_offset_m_ = 0.0;  // the first step's on the other side
+  bool tried_other_side_ = false;
   bool look_after_step_ = true;
   double look_from_m_ = 0.0;
   Pose2 look_start_;

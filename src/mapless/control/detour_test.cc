@@ -58,7 +58,7 @@ TEST(Detour, GoesRoundABoxOnTheLineAndRejoinsItBeyond) {
 
 TEST(Detour, FailsWhenTheWayStaysBlockedBeyondTheLargestOffset) {
   DetourOptions o;
-  o.max_offset_m = 0.6;
+  o.max_offset_m = 0.9;
   Detour detour({0.0, 0.0, 0.0}, 0.3, ObstacleExtent{}, 0.27, o);
   Pose2 pose;
   Twist2 last;
@@ -71,8 +71,41 @@ TEST(Detour, FailsWhenTheWayStaysBlockedBeyondTheLargestOffset) {
     pose = IntegrateTwist(pose, last, 0.1);
   }
   EXPECT_EQ(detour.phase(), DetourPhase::kFailed);
-  EXPECT_LT(pose.y_m, 0.6 + 0.15);  // it stopped stepping aside
+  EXPECT_GT(pose.y_m, 0.64 - 0.05);  // it stepped aside (0.64 m first) before giving up
+  EXPECT_LT(pose.y_m, 0.9 + 0.15);   // and stopped stepping aside beyond the largest offset
   EXPECT_EQ(detour.Command(pose, AheadView::kFree, 0.3).v_mps, 0.0);
+}
+
+// A wall beside the robot on the chosen side, seen only when stepping aside turns the camera to
+// it: the detour goes round by the other side; with walls on both sides it fails.
+TEST(Detour, AWallInTheWayOfTheStepAsideSendsItRoundTheOtherSide) {
+  for (const bool both : {false, true}) {
+    FakeWatch box{1.1, 0.0, 0.2};
+    Detour detour({0.0, 0.0, 0.0}, 0.5, ObstacleExtent{}, 0.27, DetourOptions{});
+    EXPECT_GT(detour.side(), 0.0);
+    Pose2 pose;
+    Twist2 last;
+    double max_left = 0.0;
+    for (int i = 0; i < 3000 && !detour.finished(); ++i) {
+      AheadView view = box.Look(pose, last, 0.1);
+      // Facing a wall: turned towards it (more than 0.5 rad) and within 0.5 m of the line.
+      const bool left_wall = pose.y_m > 0.5 && pose.theta_rad > 0.5;
+      const bool right_wall = pose.y_m < -0.5 && pose.theta_rad < -0.5;
+      if (left_wall || (both && right_wall)) view = AheadView::kBlocked;
+      last = detour.Command(pose, view, 0.3);
+      pose = IntegrateTwist(pose, last, 0.1);
+      max_left = std::max(max_left, pose.y_m);
+    }
+    if (both) {
+      EXPECT_EQ(detour.phase(), DetourPhase::kFailed);
+      EXPECT_LT(pose.y_m, -0.5 + 0.05);  // it tried the right as well
+    } else {
+      EXPECT_EQ(detour.phase(), DetourPhase::kDone);
+      EXPECT_LT(detour.side(), 0.0);  // round by the right
+      EXPECT_GT(pose.x_m, 1.1 + 0.2 + kRobotRadius);
+      EXPECT_LT(max_left, 0.5 + 0.1);
+    }
+  }
 }
 
 // Eq. 8-16 on the watch's map: obstacle points left of the image's centre push to the right
@@ -96,8 +129,8 @@ TEST(DetourAngle, TurnsAwayFromTheObstaclesSide) {
   EXPECT_GT(DetourAngle({}, {320, 240}, 0.55, 10.0, 0.5, o), 0.1);
 }
 
-// Without an extent (nothing measured) the first step is first_step_m; with one wider than
-// max_offset_m allows, the detour fails at once (the robot stops instead).
+// With an extent wider than max_offset_m allows, the detour fails at once (the robot stops
+// instead).
 TEST(Detour, AnObstacleTooWideToStepPastFailsAtOnce) {
   ObstacleExtent wide;
   wide.found = true;
@@ -105,8 +138,18 @@ TEST(Detour, AnObstacleTooWideToStepPastFailsAtOnce) {
   wide.right_m = -2.0;
   Detour detour({0.0, 0.0, 0.0}, 0.2, wide, 0.27, DetourOptions{});
   EXPECT_EQ(detour.phase(), DetourPhase::kFailed);
+  // Nothing measured: the obstacle may reach the strip's edge (0.27 m), so the first step is
+  // past it by the strip's half-width and the margin; an extent inside the strip the same.
   Detour plain({0.0, 0.0, 0.0}, 0.2, ObstacleExtent{}, 0.27, DetourOptions{});
-  EXPECT_NEAR(plain.offset_m(), 0.27 + DetourOptions{}.margin_m, 1e-9);
+  EXPECT_NEAR(plain.offset_m(), 0.27 + 0.27 + DetourOptions{}.margin_m, 1e-9);
+  ObstacleExtent narrow;
+  narrow.found = true;
+  narrow.left_m = 0.05;
+  narrow.right_m = -0.4;
+  EXPECT_NEAR(Detour({0.0, 0.0, 0.0}, 0.2, narrow, 0.27, DetourOptions{}).offset_m(),
+              0.27 + 0.27 + DetourOptions{}.margin_m, 1e-9);
+  EXPECT_NEAR(Detour({0.0, 0.0, 0.0}, -0.2, narrow, 0.27, DetourOptions{}).offset_m(),
+              0.4 + 0.27 + DetourOptions{}.margin_m, 1e-9);
 }
 
 // The strip's geometry: +-0.27 m is +-80 px at the bottom row of a 320x240 image. The extent
