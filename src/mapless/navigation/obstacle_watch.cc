@@ -106,6 +106,8 @@ void ObstacleWatchOptions::Validate() const {
                 "ObstacleWatchOptions.known_radius_px = " << known_radius_px << "; must be >= 0");
   MAPLESS_CHECK(min_region_points >= 1, "ObstacleWatchOptions.min_region_points = "
                                             << min_region_points << "; must be >= 1");
+  MAPLESS_CHECK(min_obstacle_points >= 1, "ObstacleWatchOptions.min_obstacle_points = "
+                                              << min_obstacle_points << "; must be >= 1");
   MAPLESS_CHECK(min_blocked_fraction > 0.0 && min_blocked_fraction < 1.0,
                 "ObstacleWatchOptions.min_blocked_fraction = " << min_blocked_fraction
                                                                << "; must be in (0, 1)");
@@ -369,7 +371,9 @@ ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, const std::vector<cv::Mat
     }
   }
   check.region_points = region_points;
-  if (check.region_points < options_.min_region_points) return check;
+  if (check.region_points < options_.min_region_points &&
+      obstacle_points < options_.min_obstacle_points)
+    return check;
   check.observed = true;
   check.blocked_fraction = static_cast<double>(obstacle_points) / check.region_points;
   votes_ = check.blocked_fraction > options_.min_blocked_fraction ? votes_ + 1 : 0;
