@@ -87,6 +87,23 @@ TEST(Stop, TheStandardLaneStopsForABoxThatHidesTheGround) {
   EXPECT_TRUE(run.success) << run.status;
 }
 
+// The same route and lane, seed 16: the standard funnel lane turns left and right on alternate
+// frames and the checks alternate with it, strong and weak (10 of 17 points off the plane, then
+// 2 of 21, 2 of 22, 15 of 16): two successive checks never agreed and the robot drove into the
+// box. One check with more than half of the region off the plane now stops it.
+TEST(Stop, TheStandardLaneStopsWhenEveryOtherCheckIsWeaker) {
+  const auto& [scenario, taught] = TaughtOnce("obstacle_box_table1");
+  RepeatRunOptions o;
+  o.seed = 16;
+  o.repeat.controller = navigation::Controller::kStandard;
+  const RepeatRun run = RepeatOnSimulator(scenario, taught, o);
+  EXPECT_FALSE(run.collided) << run.status;
+  EXPECT_TRUE(std::any_of(run.steps.begin(), run.steps.end(), [](const auto& s) {
+    return s.status == navigation::RepeatStatus::kBlocked;
+  }));
+  EXPECT_TRUE(run.success) << run.status;
+}
+
 // Without odometry (a camera-only robot) avoid cannot measure its way round: it stops as with
 // stop. Shown on the session directly: the watch's first confirmed obstacle gives kBlocked.
 TEST(Avoid, WithoutOdometryTheRobotStopsAsWithStop) {

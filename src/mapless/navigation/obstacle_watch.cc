@@ -106,6 +106,9 @@ void ObstacleWatchOptions::Validate() const {
                 "ObstacleWatchOptions.known_radius_px = " << known_radius_px << "; must be >= 0");
   MAPLESS_CHECK(min_region_points >= 1, "ObstacleWatchOptions.min_region_points = "
                                             << min_region_points << "; must be >= 1");
+  MAPLESS_CHECK(single_check_fraction > 0.0 && single_check_fraction <= 1.0,
+                "ObstacleWatchOptions.single_check_fraction = " << single_check_fraction
+                                                                << "; must be in (0, 1]");
   MAPLESS_CHECK(min_obstacle_points >= 1, "ObstacleWatchOptions.min_obstacle_points = "
                                               << min_obstacle_points << "; must be >= 1");
   MAPLESS_CHECK(min_blocked_fraction > 0.0 && min_blocked_fraction < 1.0,
@@ -377,7 +380,9 @@ ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, const std::vector<cv::Mat
   check.observed = true;
   check.blocked_fraction = static_cast<double>(obstacle_points) / check.region_points;
   votes_ = check.blocked_fraction > options_.min_blocked_fraction ? votes_ + 1 : 0;
-  if (votes_ >= options_.confirm_frames) {
+  const bool at_once = check.blocked_fraction > options_.single_check_fraction &&
+                       obstacle_points >= options_.min_obstacle_points;
+  if (votes_ >= options_.confirm_frames || at_once) {
     blocked_ = true;
     blocked_at_fraction_ = check.blocked_fraction;
     blocked_image_ = grey.clone();
