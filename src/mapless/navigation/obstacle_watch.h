@@ -16,8 +16,8 @@
 // does not return to within `max_round_trip_px` (a wrong track, dropped from the region's count;
 // only the points off the plane are tracked back, which halves the cost of
 // the check). When more than `min_blocked_fraction` of the region's points are obstacle points on
-// `confirm_frames` successive checks, the watch reports an obstacle and stays blocked: the robot
-// stops.
+// `confirm_frames` successive checks, or more than `single_check_fraction` on one, the watch
+// reports an obstacle and stays blocked: the robot stops.
 //
 // Departure from the paper: sparse flow on a grid instead of dense flow. With DIS (fast or
 // medium, at full or half resolution) on the 8 cm pairs the ground's flow was wrong over whole
