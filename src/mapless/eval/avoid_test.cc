@@ -16,6 +16,9 @@
 namespace mapless::eval {
 namespace {
 
+// The repeat's default obstacle watch.
+navigation::ObstacleWatchOptions RepeatOptionsWatch() { return navigation::RepeatOptions{}.obstacle; }
+
 // A camera-only robot: the frames come without odometry.
 class NoOdometry : public robot::RobotLink {
  public:
@@ -66,42 +69,37 @@ TEST(Avoid, ARepeatGoesRoundABoxOnTheRouteAndCompletesIt) {
   EXPECT_FALSE(std::isfinite(added.objects[0].leaves_s));
 }
 
-// `stop` on the standard funnel lane, the eval's run with seed 11: the box's face near the robot
-// gives few tracked points and hides the ground behind it, and the taught scene's features
-// (matched on the ground) keep most of its points out of the count, so the region had fewer than
-// min_region_points while the box filled it (11 of 19, 14 of 16 points off the ground's plane).
-// Without min_obstacle_points the robot drove into the box (`eval obstacles --seed 11`: 3
-// collisions in 10 standard runs). Measured with fresh matching on every frame, as here (with the
-// default of every 2nd frame this seed's run happens to see enough points).
-TEST(Stop, TheStandardLaneStopsForABoxThatHidesTheGround) {
+// `stop` on the standard funnel lane, table1's box, the eval's run with `seed`: the robot stops
+// before the box, without touching it, and completes the route once the box is gone.
+void ExpectTheStandardLaneStops(std::uint64_t seed, const navigation::ObstacleWatchOptions& watch) {
   const auto& [scenario, taught] = TaughtOnce("obstacle_box_table1");
   RepeatRunOptions o;
-  o.seed = 11;
+  o.seed = seed;
   o.repeat.controller = navigation::Controller::kStandard;
-  o.repeat.redetect_every_frames = 1;
+  o.repeat.obstacle = watch;
   const RepeatRun run = RepeatOnSimulator(scenario, taught, o);
-  EXPECT_FALSE(run.collided) << run.status;
+  EXPECT_FALSE(run.collided) << "seed " << seed << ": " << run.status;
   EXPECT_TRUE(std::any_of(run.steps.begin(), run.steps.end(), [](const auto& s) {
     return s.status == navigation::RepeatStatus::kBlocked;
-  }));
-  EXPECT_TRUE(run.success) << run.status;
+  })) << "seed " << seed;
+  EXPECT_TRUE(run.success) << "seed " << seed << ": " << run.status;
 }
 
-// The same route and lane, seed 16: the standard funnel lane turns left and right on alternate
-// frames and the checks alternate with it, strong and weak (10 of 17 points off the plane, then
-// 2 of 21, 2 of 22, 15 of 16): two successive checks never agreed and the robot drove into the
-// box. One check with more than half of the region off the plane now stops it.
+// Seed 11: the box's face near the robot gives few tracked points and hides the ground behind
+// it, and the taught scene's features (matched on the ground) keep others out of the count, so
+// the region had fewer than min_region_points while the box filled it (11 of 19, 14 of 16 points
+// off the ground's plane). Without min_obstacle_points the robot drove into the box (`eval
+// obstacles --seed 11`: 3 collisions in 10 standard runs).
+TEST(Stop, TheStandardLaneStopsForABoxThatHidesTheGround) {
+  ExpectTheStandardLaneStops(11, RepeatOptionsWatch());
+}
+
+// Seed 16: the standard funnel lane turns left and right on alternate frames and the checks
+// alternate with it, strong and weak (10 of 17 points off the plane, then 2 of 21, 2 of 22, 15
+// of 16): two successive checks never agreed and the robot drove into the box. One check with
+// more than half of the region off the plane now stops it (single_check_fraction).
 TEST(Stop, TheStandardLaneStopsWhenEveryOtherCheckIsWeaker) {
-  const auto& [scenario, taught] = TaughtOnce("obstacle_box_table1");
-  RepeatRunOptions o;
-  o.seed = 16;
-  o.repeat.controller = navigation::Controller::kStandard;
-  const RepeatRun run = RepeatOnSimulator(scenario, taught, o);
-  EXPECT_FALSE(run.collided) << run.status;
-  EXPECT_TRUE(std::any_of(run.steps.begin(), run.steps.end(), [](const auto& s) {
-    return s.status == navigation::RepeatStatus::kBlocked;
-  }));
-  EXPECT_TRUE(run.success) << run.status;
+  ExpectTheStandardLaneStops(16, RepeatOptionsWatch());
 }
 
 // Without odometry (a camera-only robot) avoid cannot measure its way round: it stops as with
