@@ -7,6 +7,7 @@
 
 #include "bench_util.h"
 #include "mapless/eval/teach_repeat.h"
+#include "mapless/features/features.h"
 #include "mapless/navigation/obstacle_watch.h"
 #include "mapless/navigation/repeat.h"
 #include "mapless/navigation/teach.h"
@@ -118,9 +119,8 @@ void BenchTeachRepeat(nlohmann::json* j) {
       dis->calc(grey[static_cast<std::size_t>(i)], grey[static_cast<std::size_t>(i) + 1], flow);
     }));
   }
-  (*j)["obstacle_watch_over_dis_fast"] =
-      (*j)["obstacle_watch_ms"].get<double>() /
-      (*j)["opencv_dis_fast_table1_320x240_ms"].get<double>();
+  (*j)["obstacle_watch_over_dis_fast"] = (*j)["obstacle_watch_ms"].get<double>() /
+                                         (*j)["opencv_dis_fast_table1_320x240_ms"].get<double>();
   (*j)["repeat_step_ms"] = repeat_median(taught.route, 0, true);
   (*j)["repeat_step_fresh_ms"] = repeat_median(taught.route, 1, false);
   // The last segment, where the local scale of nearby feature pairs also decides the route's end.
@@ -152,6 +152,29 @@ void BenchTeachRepeat(nlohmann::json* j) {
     orb->detectAndCompute(frames[static_cast<std::size_t>(i % n)], cv::noArray(), kp, desc);
   }));
   const double orb_ms = (*j)["opencv_orb500_320x240_ms"].get<double>();
+  // mapless's ORB settings (the FAST threshold 10) by OpenCV and by OrbDetector, which gives the
+  // same keypoints and descriptors (features/orb.h), on the same grey frames.
+  {
+    const features::FeatureOptions fo;
+    std::vector<cv::Mat> grey(frames.size());
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      grey[i] = frames[i];
+      if (grey[i].channels() == 3) cv::cvtColor(frames[i], grey[i], cv::COLOR_BGR2GRAY);
+    }
+    auto opencv = cv::ORB::create(fo.max_features, 1.2f, 8, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31,
+                                  fo.orb_fast_threshold);
+    (*j)["opencv_orb_mapless_settings_320x240_ms"] = Median(TimesMs(60, [&](int i) {
+      opencv->detectAndCompute(grey[static_cast<std::size_t>(i % n)], cv::noArray(), kp, desc);
+    }));
+    const features::OrbDetector ours(fo.max_features, fo.orb_fast_threshold);
+    (*j)["orb_detector_320x240_ms"] = Median(TimesMs(60, [&](int i) {
+      ours.DetectAndCompute(grey[static_cast<std::size_t>(i % n)], &kp, &desc);
+    }));
+    (*j)["orb_detector_over_opencv_same_settings"] =
+        (*j)["orb_detector_320x240_ms"].get<double>() /
+        (*j)["opencv_orb_mapless_settings_320x240_ms"].get<double>();
+    (*j)["orb_detector_over_orb"] = (*j)["orb_detector_320x240_ms"].get<double>() / orb_ms;
+  }
   (*j)["repeat_step_over_orb"] = (*j)["repeat_step_ms"].get<double>() / orb_ms;
   (*j)["repeat_step_default_over_orb"] = (*j)["repeat_step_default_ms"].get<double>() / orb_ms;
   (*j)["repeat_step_default_mean_over_orb"] =

@@ -73,8 +73,7 @@ FeatureExtractor::FeatureExtractor(FeatureOptions options) : options_(options) {
   options_.Validate();
   switch (options_.type) {
     case DetectorType::kOrb:
-      detector_ = cv::ORB::create(options_.max_features, 1.2f, 8, 31, 0, 2, cv::ORB::HARRIS_SCORE,
-                                  31, options_.orb_fast_threshold);
+      orb_ = std::make_unique<OrbDetector>(options_.max_features, options_.orb_fast_threshold);
       break;
     case DetectorType::kAkaze:
       detector_ = cv::AKAZE::create(cv::AKAZE::DESCRIPTOR_MLDB, 0, 3,
@@ -96,7 +95,11 @@ Features FeatureExtractor::Extract(const cv::Mat& image) const {
   if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
   Features out;
   out.binary = options_.type != DetectorType::kSift;
-  detector_->detectAndCompute(grey, cv::noArray(), out.keypoints, out.descriptors);
+  if (orb_) {
+    orb_->DetectAndCompute(grey, &out.keypoints, &out.descriptors);
+  } else {
+    detector_->detectAndCompute(grey, cv::noArray(), out.keypoints, out.descriptors);
+  }
   return out;
 }
 

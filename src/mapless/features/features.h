@@ -4,10 +4,13 @@
 // SIFT. Debian's OpenCV has no SURF, which the funnel-lane paper used.
 #pragma once
 
+#include <memory>
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
 #include <string>
 #include <vector>
+
+#include "mapless/features/orb.h"
 
 namespace mapless::features {
 
@@ -40,7 +43,8 @@ struct Features {
   bool binary = true;   // Hamming (ORB, AKAZE) or L2 (SIFT) distance
 };
 
-// Holds the OpenCV detector (not thread-safe: one per thread).
+// Holds the detector (not thread-safe: one per thread). ORB is OrbDetector: OpenCV's ORB, the
+// same keypoints and descriptors at less cost (orb.h).
 class FeatureExtractor {
  public:
   explicit FeatureExtractor(FeatureOptions options);
@@ -50,7 +54,8 @@ class FeatureExtractor {
 
  private:
   FeatureOptions options_;
-  cv::Ptr<cv::Feature2D> detector_;
+  std::unique_ptr<OrbDetector> orb_;  // ORB
+  cv::Ptr<cv::Feature2D> detector_;   // the others
 };
 
 struct MatchOptions {

@@ -1,0 +1,126 @@
+#include "mapless/features/orb.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+
+#include "mapless/sim/simulation.h"
+
+namespace mapless::features {
+namespace {
+
+cv::Mat Grey(const cv::Mat& image) {
+  cv::Mat grey = image;
+  if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  return grey;
+}
+
+// Grey frames ahead of a scenario's teach start, `spacing_m` apart, turned a little to and fro.
+std::vector<cv::Mat> SimFrames(const char* scenario, int count, double spacing_m) {
+  const sim::Scenario s = sim::LoadScenario(scenario);
+  sim::Simulation sim(s.world, s.camera, {}, 1);
+  sim.AddRobot(s.teach_start, s.robot);
+  std::vector<cv::Mat> frames;
+  for (int i = 0; i < count; ++i) {
+    Pose2 p = s.teach_start;
+    p.x_m += spacing_m * i * std::cos(p.theta_rad);
+    p.y_m += spacing_m * i * std::sin(p.theta_rad);
+    p.theta_rad += 0.05 * (i % 3 - 1);
+    sim.PlaceRobot(0, p);
+    frames.push_back(Grey(sim.RenderClean(0)));
+  }
+  return frames;
+}
+
+// The same keypoints (every field) and descriptors, in the same order, as cv::ORB; returns how
+// many.
+std::size_t ExpectSameAsOpenCv(const cv::Mat& grey, int max_features, int threshold,
+                               const std::string& what) {
+  EXPECT_EQ(OrbTestPairs().size(), 256u) << "without the test pairs OrbDetector is cv::ORB";
+  std::vector<cv::KeyPoint> ours;
+  cv::Mat ours_d;
+  OrbDetector(max_features, threshold).DetectAndCompute(grey, &ours, &ours_d);
+  std::vector<cv::KeyPoint> theirs;
+  cv::Mat theirs_d;
+  cv::ORB::create(max_features, 1.2f, 8, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31, threshold)
+      ->detectAndCompute(grey, cv::noArray(), theirs, theirs_d);
+  EXPECT_EQ(ours.size(), theirs.size()) << what;
+  if (ours.size() != theirs.size()) return 0;
+  for (std::size_t i = 0; i < ours.size(); ++i) {
+    const cv::KeyPoint& a = ours[i];
+    const cv::KeyPoint& b = theirs[i];
+    EXPECT_TRUE(a.pt == b.pt && a.size == b.size && a.angle == b.angle &&
+                a.response == b.response && a.octave == b.octave && a.class_id == b.class_id)
+        << what << ": keypoint " << i << " (" << a.pt << " " << a.angle << " " << a.response
+        << " level " << a.octave << ") vs (" << b.pt << " " << b.angle << " " << b.response
+        << " level " << b.octave << ")";
+    if (!(a.pt == b.pt && a.angle == b.angle)) return 0;
+  }
+  EXPECT_EQ(ours_d.size(), theirs_d.size()) << what;
+  EXPECT_EQ(ours_d.type(), theirs_d.type()) << what;
+  if (ours_d.size() != theirs_d.size() || ours_d.type() != theirs_d.type()) return 0;
+  for (int r = 0; r < ours_d.rows; ++r) {
+    EXPECT_EQ(std::memcmp(ours_d.ptr(r), theirs_d.ptr(r), static_cast<std::size_t>(ours_d.cols)), 0)
+        << what << ": descriptor " << r;
+  }
+  return ours.size();
+}
+
+TEST(OrbTestPairs, AreReadOffOpenCv) {
+  const std::vector<OrbTestPair>& pairs = OrbTestPairs();
+  ASSERT_EQ(pairs.size(), 256u);
+  for (const OrbTestPair& p : pairs) {
+    EXPECT_LE(std::abs(p.first.x), 13);
+    EXPECT_LE(std::abs(p.first.y), 13);
+    EXPECT_LE(std::abs(p.second.x), 13);
+    EXPECT_LE(std::abs(p.second.y), 13);
+    EXPECT_NE(p.first, p.second);
+  }
+}
+
+TEST(OrbDetector, GivesOpenCvsOrbOnSimulatorFrames) {
+  for (const char* scenario : {"table1_almost_straight", "corridor_25m", "outdoor_70m",
+                               "narrow_room_sharp_turn", "office_aliasing"}) {
+    const std::vector<cv::Mat> frames = SimFrames(scenario, 6, 0.7);
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      for (const int threshold : {10, 20}) {
+        const std::string what = std::string(scenario) + " frame " + std::to_string(i) +
+                                 " threshold " + std::to_string(threshold);
+        EXPECT_GE(ExpectSameAsOpenCv(frames[i], 500, threshold, what), 100u) << what;
+      }
+    }
+  }
+}
+
+TEST(OrbDetector, GivesOpenCvsOrbOnCameraImagesAndOtherSizes) {
+  const std::string dir = std::string(MAPLESS_SOURCE_DIR) + "/tests/data/stromovka/";
+  for (const char* name : {"0101.png", "0103.png", "0601.png", "1203.png"}) {
+    const cv::Mat image = cv::imread(dir + name, cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(image.empty()) << dir + name;
+    ExpectSameAsOpenCv(image, 500, 10, name);
+    ExpectSameAsOpenCv(image, 1000, 20, std::string(name) + " 1000 features");
+    cv::Mat large;
+    cv::resize(image, large, cv::Size(641, 481));
+    ExpectSameAsOpenCv(large, 500, 10, std::string(name) + " at 641x481");
+    cv::Mat small;
+    cv::resize(image, small, cv::Size(90, 70));
+    ExpectSameAsOpenCv(small, 500, 10, std::string(name) + " at 90x70");
+  }
+  cv::Mat colour;
+  cv::cvtColor(cv::imread(dir + "0101.png", cv::IMREAD_GRAYSCALE), colour, cv::COLOR_GRAY2BGR);
+  ExpectSameAsOpenCv(colour, 500, 10, "a colour image (cv::ORB's own path)");
+  cv::Mat noise(240, 320, CV_8U);
+  cv::RNG rng(7);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
+  ExpectSameAsOpenCv(noise, 500, 10, "noise");
+  ExpectSameAsOpenCv(cv::Mat(240, 320, CV_8U, cv::Scalar(128)), 500, 10, "flat");
+  ExpectSameAsOpenCv(cv::Mat(40, 50, CV_8U, cv::Scalar(0)), 500, 10, "too small for any keypoint");
+}
+
+}  // namespace
+}  // namespace mapless::features
