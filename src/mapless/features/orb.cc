@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -47,7 +46,8 @@ struct Probe {
   }
 };
 
-// The probe image's value at offset (u, v) from the centre.
+// One probe: the image value(u, v) at offset (u, v) from its centre, its descriptor's bits by
+// cv::ORB::compute and its blurred image.
 template <typename Value>
 bool RunProbe(const cv::Ptr<cv::ORB>& orb, const Value& value, std::vector<Probe>* probes) {
   cv::Mat image(kProbeSize, kProbeSize, CV_8U);
