@@ -250,6 +250,7 @@ tail -1 "$TMP/demo/repeat.jsonl" | grep -q '"status":"completed"' && tail -1 "$T
 expect_exit "bench --json" 0 "$MAPLESS" bench --json --repeats 5
 grep -q '"sim_render_320x240_ms":[0-9.]*' "$TMP/out" && grep -q '"opencv_dis_fast_320x240_ms"' "$TMP/out"; check "bench JSON has the render stage and DIS reference" $?
 grep -q '"dominant_plane_step_ms":[0-9.]*' "$TMP/out" && grep -q '"opencv_dis_fast_ground_320x240_ms"' "$TMP/out"; check "bench JSON has the potential step and its DIS reference" $?
+grep -q '"repeat_step_default_over_orb_interleaved":[0-9.]*' "$TMP/out" && grep -q '"orb_detector_over_opencv_same_settings":[0-9.]*' "$TMP/out"; check "bench JSON has the default step against ORB-500 timed after each step, and OrbDetector against OpenCV's ORB" $?
 [ "$(wc -l <"$TMP/out")" -eq 1 ]; check "bench JSON is one line" $?
 
 echo "$passed passed, $failed failed"
