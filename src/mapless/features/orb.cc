@@ -332,7 +332,7 @@ void OrbDetector::DetectAndCompute(const cv::Mat& grey, std::vector<cv::KeyPoint
     counts[l] = static_cast<int>(kps.size());
     candidates.insert(candidates.end(), kps.begin(), kps.end());
   }
-  if (candidates.empty()) {
+  if (candidates.empty()) {  // (a level with candidates keeps at least one below)
     descriptors->release();
     return;
   }

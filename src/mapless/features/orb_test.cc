@@ -120,6 +120,10 @@ TEST(OrbDetector, GivesOpenCvsOrbOnCameraImagesAndOtherSizes) {
   ExpectSameAsOpenCv(noise, 500, 10, "noise");
   ExpectSameAsOpenCv(cv::Mat(240, 320, CV_8U, cv::Scalar(128)), 500, 10, "flat");
   ExpectSameAsOpenCv(cv::Mat(40, 50, CV_8U, cv::Scalar(0)), 500, 10, "too small for any keypoint");
+  // Very few features: the geometric split gives none to most levels, the one to the last.
+  const cv::Mat stromovka = cv::imread(dir + "0101.png", cv::IMREAD_GRAYSCALE);
+  ExpectSameAsOpenCv(stromovka, 1, 10, "one feature");
+  ExpectSameAsOpenCv(stromovka, 12, 10, "12 features");
 }
 
 }  // namespace
