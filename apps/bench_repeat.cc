@@ -17,18 +17,26 @@ namespace mapless::app {
 
 namespace {
 
-// The obstacle watch alone on consecutive frames of a drive (`forward_m` per frame), median ms.
-double WatchMs(const std::vector<cv::Mat>& frames, double forward_m) {
+std::vector<cv::Mat> GreyFrames(const std::vector<cv::Mat>& frames) {
+  std::vector<cv::Mat> grey(frames.size());
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    grey[i] = frames[i];
+    if (grey[i].channels() == 3) cv::cvtColor(frames[i], grey[i], cv::COLOR_BGR2GRAY);
+  }
+  return grey;
+}
+
+// The obstacle watch alone on consecutive grey frames of a drive (`forward_m` per frame), median
+// ms.
+double WatchMs(const std::vector<cv::Mat>& grey, double forward_m) {
   navigation::ObstacleWatchOptions on;
   on.enabled = true;
   navigation::ObstacleWatch watch(on);
   std::vector<double> ms;
-  for (std::size_t i = 0; i < frames.size(); ++i) {
-    cv::Mat grey = frames[i];
-    if (grey.channels() == 3) cv::cvtColor(frames[i], grey, cv::COLOR_BGR2GRAY);
+  for (std::size_t i = 0; i < grey.size(); ++i) {
     const auto t0 = std::chrono::steady_clock::now();
-    const navigation::ObstacleCheck c =
-        watch.Update(grey, FromSeconds(0.1 * static_cast<double>(i)), i > 0 ? forward_m : 0.0, 0.0);
+    const navigation::ObstacleCheck c = watch.Update(
+        grey[i], FromSeconds(0.1 * static_cast<double>(i)), i > 0 ? forward_m : 0.0, 0.0);
     const double dt =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (c.observed) ms.push_back(dt);  // frames that compare two views (all but the first few)
@@ -128,14 +136,10 @@ void BenchTeachRepeat(nlohmann::json* j) {
   // The obstacle watch alone (issue 21): at the teach drive's 3 cm per frame, against DIS fast
   // on the same frames (the watch's target: <= 1x DIS fast on top of the step).
   const double forward_m = scenario.teach_speed_mps / scenario.camera.rate_hz;
-  (*j)["obstacle_watch_ms"] = WatchMs(frames, forward_m);
+  const std::vector<cv::Mat> grey = GreyFrames(frames);
+  (*j)["obstacle_watch_ms"] = WatchMs(grey, forward_m);
   {
     const auto dis = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_FAST);
-    std::vector<cv::Mat> grey(frames.size());
-    for (std::size_t i = 0; i < frames.size(); ++i) {
-      grey[i] = frames[i];
-      if (grey[i].channels() == 3) cv::cvtColor(frames[i], grey[i], cv::COLOR_BGR2GRAY);
-    }
     cv::Mat flow;
     (*j)["opencv_dis_fast_table1_320x240_ms"] = Median(TimesMs(n - 1, [&](int i) {
       dis->calc(grey[static_cast<std::size_t>(i)], grey[static_cast<std::size_t>(i) + 1], flow);
@@ -180,11 +184,6 @@ void BenchTeachRepeat(nlohmann::json* j) {
   // same keypoints and descriptors (features/orb.h), on the same grey frames.
   {
     const features::FeatureOptions fo;
-    std::vector<cv::Mat> grey(frames.size());
-    for (std::size_t i = 0; i < frames.size(); ++i) {
-      grey[i] = frames[i];
-      if (grey[i].channels() == 3) cv::cvtColor(frames[i], grey[i], cv::COLOR_BGR2GRAY);
-    }
     auto opencv = cv::ORB::create(fo.max_features, 1.2f, 8, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31,
                                   fo.orb_fast_threshold);
     const features::OrbDetector ours(fo.max_features, fo.orb_fast_threshold);
