@@ -26,8 +26,8 @@
 
 namespace mapless::app {
 
-void BenchRos1(nlohmann::json* j);   // bench_links.cc
-void BenchRos2(nlohmann::json* j);   // bench_links.cc
+// The middleware's robot-link latency rows (bench_links.cc).
+void BenchMiddleware(const std::string& middleware, nlohmann::json* j);
 void BenchFleet(nlohmann::json* j);  // bench_fleet.cc
 void BenchTeachRepeat(nlohmann::json* j);  // bench_repeat.cc
 
@@ -247,8 +247,8 @@ void AddBenchCommand(CLI::App* app) {
       if (!args->ros1 && !args->ros2 && !args->fleet)
         throw InputError("--links-only: add --ros1, --ros2 and/or --fleet");
       nlohmann::json j;
-      if (args->ros1) BenchRos1(&j);
-      if (args->ros2) BenchRos2(&j);
+      if (args->ros1) BenchMiddleware("ros1", &j);
+      if (args->ros2) BenchMiddleware("ros2", &j);
       if (args->fleet) BenchFleet(&j);
       if (args->json) {
         std::cout << j.dump() << "\n";
@@ -345,8 +345,8 @@ void AddBenchCommand(CLI::App* app) {
     BenchTeachRepeat(&j);
     BenchPotential(args->repeats, &j);
     BenchEigenspace(args->repeats, &j);
-    if (args->ros1) BenchRos1(&j);
-    if (args->ros2) BenchRos2(&j);
+    if (args->ros1) BenchMiddleware("ros1", &j);
+    if (args->ros2) BenchMiddleware("ros2", &j);
     if (args->fleet) BenchFleet(&j);
     if (args->json) {
       std::cout << j.dump() << "\n";

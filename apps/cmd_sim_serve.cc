@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "builtin_middlewares.h"
 #include "cli_common.h"
 #include "interrupt.h"
 #include "mapless/core/check.h"
@@ -14,14 +15,8 @@
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/io/atomic_file.h"
 #include "mapless/robot/robot_file.h"
+#include "mapless/robot/sim_serve.h"
 #include "robot_run.h"
-#ifdef MAPLESS_HAVE_ROS1
-#include "mapless/ros1/ros1_link.h"
-#include "mapless/ros1/sim_serve.h"
-#endif
-#ifdef MAPLESS_HAVE_ROS2
-#include "mapless/ros2/sim_serve.h"
-#endif
 
 namespace mapless::app {
 
@@ -131,25 +126,7 @@ void AddSimServeCommand(CLI::App* simcmd) {
     options.log = [](const std::string& m) { spdlog::info("{}", m); };
     options.encoding = a->encoding;
     options.size = size;
-    robot::ServeSummary s;
-    if (file.middleware == robot::Middleware::kRos1) {
-#ifdef MAPLESS_HAVE_ROS1
-      ros1::StartNode(file, "mapless_sim");
-      s = ros1::ServeSimulation(sim, r, file, options);
-#else
-      throw InputError(a->robot +
-                       ": middleware ros1, but this mapless was built without ROS 1 "
-                       "(scripts/setup.sh --ros, then build again)");
-#endif
-    } else {
-#ifdef MAPLESS_HAVE_ROS2
-      s = ros2::ServeSimulation(sim, r, file, options);
-#else
-      throw InputError(a->robot +
-                       ": middleware ros2, but this mapless was built without Cyclone DDS "
-                       "(scripts/setup.sh --ros, then build again)");
-#endif
-    }
+    const robot::ServeSummary s = BuiltinMiddlewares().For(file).serve(sim, r, file, options);
     spdlog::info("sim serve: {} after {} frames, {} commands{}, {:.1f} s simulated{}", s.end,
                  s.frames, s.commands,
                  s.resent > 0 ? ", " + std::to_string(s.resent) + " frames sent again" : "",
@@ -159,7 +136,7 @@ void AddSimServeCommand(CLI::App* simcmd) {
       j["scenario"] = scenario.name;
       j["like"] = a->like;
       j["seed"] = a->seed;
-      j["middleware"] = robot::MiddlewareName(file.middleware);
+      j["middleware"] = file.middleware;
       j["end"] = s.end;
       j["frames"] = s.frames;
       j["commands"] = s.commands;

@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/core/utils/logger.hpp>
 
+#include "builtin_middlewares.h"
 #include "cli_common.h"
 #include "fleet.h"
 #include "interrupt.h"
@@ -41,12 +42,23 @@ std::string OneLine(const std::string& text) {
   return out;
 }
 
+// `mapless --version`: the version and the robot links this build has.
+std::string VersionText() {
+  std::string links;
+  for (const std::string& n : mapless::app::BuiltinMiddlewares().names())
+    links += (links.empty() ? "" : ", ") + n;
+  return std::string("mapless ") + MAPLESS_VERSION + "\nrobot links: " +
+         (links.empty() ? "none (simulator, recordings, videos and cameras only; "
+                          "scripts/setup.sh --ros, then build again, for ROS 1 and ROS 2)"
+                        : links);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"mapless: appearance-based robot navigation from one uncalibrated camera, no map"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "mapless 0.1.0");
+  app.set_version_flag("--version", VersionText());
   // Logs go to stderr: stdout carries only results (JSON, tables, lists).
   spdlog::set_default_logger(spdlog::stderr_color_mt("mapless"));
   spdlog::set_pattern("%^[%l]%$ %v");

@@ -4,50 +4,20 @@
 
 #include <algorithm>
 
+#include "builtin_middlewares.h"
 #include "cli_common.h"
 #include "interrupt.h"
 #include "mapless/core/check.h"
 #include "mapless/recording/recording_link.h"
 #include "mapless/robot/loop.h"
 #include "mapless/robot/status.h"
-#ifdef MAPLESS_HAVE_ROS1
-#include "mapless/ros1/ros1_link.h"
-#endif
-#ifdef MAPLESS_HAVE_ROS2
-#include "mapless/ros2/ros2_link.h"
-#endif
 
 namespace mapless::app {
 
 std::unique_ptr<robot::RobotLink> OpenRobotLink(const robot::RobotFile& robot, cv::Size image_size,
                                                 const std::string& method) {
-  if (robot.middleware == robot::Middleware::kRos1) {
-#ifdef MAPLESS_HAVE_ROS1
-    ros1::StartNode(robot, robot.node_name);
-    auto link = std::make_unique<ros1::Ros1Link>(
-        robot, image_size, method, [](const std::string& m) { spdlog::warn("{}", m); });
-    link->Start();
-    return link;
-#else
-    throw InputError(robot.source +
-                     ": middleware ros1, but this mapless was built without ROS 1 (install it "
-                     "with scripts/setup.sh --ros and build again)");
-#endif
-  }
-  if (robot.middleware == robot::Middleware::kRos2) {
-#ifdef MAPLESS_HAVE_ROS2
-    auto link = std::make_unique<ros2::Ros2Link>(
-        robot, image_size, method, [](const std::string& m) { spdlog::warn("{}", m); });
-    link->Start();
-    return link;
-#else
-    throw InputError(robot.source +
-                     ": middleware ros2, but this mapless was built without Cyclone DDS (install "
-                     "it with scripts/setup.sh --ros and build again)");
-#endif
-  }
-  throw InputError(robot.source + ": middleware " + robot::MiddlewareName(robot.middleware) +
-                   " is not available in this build");
+  return BuiltinMiddlewares().For(robot).open_link(
+      robot, image_size, method, [](const std::string& m) { spdlog::warn("{}", m); });
 }
 
 void SetFollowerRecovery(double carry_on_m, navigation::AppearanceFollowerOptions* follower) {
@@ -101,7 +71,7 @@ void RunOnRobot(robot::Method& method, const std::string& robot_path, const std:
   if (recorder)
     recording = std::make_unique<recording::RecordingLink>(*link, *recorder, method.name());
   spdlog::info("{}: on {} ({}), commands to {}", method.name(), file.name,
-               robot::MiddlewareName(file.middleware), file.Resolve(file.topics.cmd_vel));
+               file.middleware, file.Resolve(file.topics.cmd_vel));
   int frame = 0;
   std::string last_state;
   const robot::LoopResult result = robot::RunLoop(

@@ -22,16 +22,23 @@ function(mapless_glue_code target)
   endif()
 endfunction()
 
-# mapless_library(NAME name SRCS ... PUBLIC_DEPS ... PRIVATE_DEPS ...)
-# One static library per module folder: mapless_<name>, alias mapless::<name>.
+# mapless_library(NAME name SRCS ... PUBLIC_DEPS ... PRIVATE_DEPS ... [NO_INSTALL])
+# One static library per module folder: mapless_<name>, alias mapless::<name>. Installed (with
+# `cmake --install`) and exported as mapless::<name> in the CMake package (cmake/MaplessInstall.cmake)
+# unless NO_INSTALL: the middleware adapters stay inside the `mapless` command.
 function(mapless_library)
-  cmake_parse_arguments(ARG "" "NAME" "SRCS;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "NO_INSTALL" "NAME" "SRCS;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
   set(target mapless_${ARG_NAME})
   add_library(${target} STATIC ${ARG_SRCS})
   add_library(mapless::${ARG_NAME} ALIAS ${target})
-  target_include_directories(${target} PUBLIC ${PROJECT_SOURCE_DIR}/src)
+  target_include_directories(${target} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/src>
+                                              $<INSTALL_INTERFACE:include>)
   target_link_libraries(${target} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
   mapless_target_warnings(${target})
+  if(NOT ARG_NO_INSTALL)
+    set_target_properties(${target} PROPERTIES EXPORT_NAME ${ARG_NAME})
+    set_property(GLOBAL APPEND PROPERTY MAPLESS_INSTALLED_MODULES ${ARG_NAME})
+  endif()
 endfunction()
 
 # mapless_test(NAME name SRCS ... DEPS ... [SANITIZE_ENV VAR=VALUE ...]): one GoogleTest binary,
@@ -53,4 +60,35 @@ function(mapless_test)
   else()
     gtest_discover_tests(${ARG_NAME} WORKING_DIRECTORY ${PROJECT_BINARY_DIR} DISCOVERY_TIMEOUT 60)
   endif()
+endfunction()
+
+# mapless_register_middleware(MODULE HEADER FUNCTION): a module that implements a middleware of the
+# robot link (src/mapless/robot/middleware.h) names its registration function, e.g.
+#   mapless_register_middleware(ros1 mapless/ros1/register.h mapless::ros1::RegisterMiddleware)
+# The command line calls every registered one (apps/builtin_middlewares.cc.in) and links the
+# module: a middleware that is not built is simply not there, with no #ifdef in the code using it.
+function(mapless_register_middleware module header function)
+  set_property(GLOBAL APPEND PROPERTY MAPLESS_MIDDLEWARE_MODULES ${module})
+  set_property(GLOBAL APPEND PROPERTY MAPLESS_MIDDLEWARE_HEADERS ${header})
+  set_property(GLOBAL APPEND PROPERTY MAPLESS_MIDDLEWARE_FUNCTIONS ${function})
+endfunction()
+
+# Writes the source of BuiltinMiddlewares() (apps/builtin_middlewares.h) into `out_var`'s file and
+# links every registered middleware module to `target`.
+function(mapless_builtin_middlewares target template out)
+  get_property(modules GLOBAL PROPERTY MAPLESS_MIDDLEWARE_MODULES)
+  get_property(headers GLOBAL PROPERTY MAPLESS_MIDDLEWARE_HEADERS)
+  get_property(functions GLOBAL PROPERTY MAPLESS_MIDDLEWARE_FUNCTIONS)
+  set(MAPLESS_MIDDLEWARE_INCLUDES "")
+  set(MAPLESS_MIDDLEWARE_CALLS "")
+  foreach(h IN LISTS headers)
+    string(APPEND MAPLESS_MIDDLEWARE_INCLUDES "#include \"${h}\"\n")
+  endforeach()
+  foreach(f IN LISTS functions)
+    string(APPEND MAPLESS_MIDDLEWARE_CALLS "    ${f}(&r);\n")
+  endforeach()
+  configure_file(${template} ${out} @ONLY)
+  foreach(m IN LISTS modules)
+    target_link_libraries(${target} PRIVATE mapless::${m})
+  endforeach()
 endfunction()

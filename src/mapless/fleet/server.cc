@@ -15,20 +15,15 @@
 
 namespace mapless::fleet {
 
-namespace {
-
-using Clock = std::chrono::steady_clock;
-
-struct Peer {
-  std::uint64_t next = 0;
-  Clock::time_point last_heard;
-  Clock::time_point last_sent;
-  std::string address;
-};
-
-}  // namespace
-
 struct LeaderServer::Impl {
+  using Clock = std::chrono::steady_clock;
+  struct Peer {
+    std::uint64_t next = 0;
+    Clock::time_point last_heard;
+    Clock::time_point last_sent;
+    std::string address;
+  };
+
   const RouteCopy& log;
   ServerOptions options;
   FleetLogger log_line;

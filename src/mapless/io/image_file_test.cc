@@ -19,7 +19,7 @@ std::string Encode(const std::string& ext, const cv::Mat& image) {
   return std::string(buffer.begin(), buffer.end());
 }
 
-cv::Mat Pattern(int width, int height) {
+cv::Mat TestImage(int width, int height) {
   cv::Mat m(height, width, CV_8UC1);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) m.at<uchar>(y, x) = static_cast<uchar>((x * 7 + y * 13) % 256);
@@ -27,7 +27,7 @@ cv::Mat Pattern(int width, int height) {
 }
 
 TEST(ImageHeader, ReadsTheSizeOfEveryFormatMaplessReads) {
-  const cv::Mat image = Pattern(37, 21);
+  const cv::Mat image = TestImage(37, 21);
   for (const std::string ext : {".png", ".jpg", ".bmp", ".pgm", ".tif"}) {
     SCOPED_TRACE(ext);
     const auto header = ReadImageHeader(Encode(ext, image));
@@ -43,7 +43,7 @@ TEST(ImageHeader, ReadsTheSizeOfEveryFormatMaplessReads) {
 
 TEST(ImageHeader, AHugeDeclaredSizeIsRefusedBeforeDecoding) {
   // A valid PNG whose header is rewritten to declare 30000 x 30000 pixels.
-  std::string png = Encode(".png", Pattern(20, 20));
+  std::string png = Encode(".png", TestImage(20, 20));
   const std::string big("\x00\x00\x75\x30\x00\x00\x75\x30", 8);
   png.replace(16, 8, big);
   const std::string error = testing::InputErrorOf([&] { DecodeImage(png, "big.png", 0); });
@@ -52,17 +52,17 @@ TEST(ImageHeader, AHugeDeclaredSizeIsRefusedBeforeDecoding) {
 }
 
 TEST(ImageHeader, SmallCutAndForeignImagesAreRefusedByName) {
-  const std::string png = Encode(".png", Pattern(8, 8));
+  const std::string png = Encode(".png", TestImage(8, 8));
   EXPECT_NE(testing::InputErrorOf([&] {
               DecodeImage(png, "s.png", 0, kMinImageSide);
             }).find("s.png (PNG): image is 8x8; at least 16x16"),
             std::string::npos);
-  const std::string whole = Encode(".png", Pattern(40, 30));
+  const std::string whole = Encode(".png", TestImage(40, 30));
   EXPECT_NE(testing::InputErrorOf([&] {
               DecodeImage(whole.substr(0, whole.size() - 20), "c.png", 0);
             }).find("c.png (PNG): corrupt image"),
             std::string::npos);
-  const std::string jpeg = Encode(".jpg", Pattern(40, 30));
+  const std::string jpeg = Encode(".jpg", TestImage(40, 30));
   EXPECT_NE(testing::InputErrorOf([&] {
               DecodeImage(jpeg.substr(0, jpeg.size() / 2), "c.jpg", 0);
             }).find("c.jpg (JPEG): corrupt image"),

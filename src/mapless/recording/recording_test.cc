@@ -20,7 +20,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string FreshPath(const std::string& name) {
+std::string FreshRecordingPath(const std::string& name) {
   const std::string path = ::testing::TempDir() + "mapless_recording_" + name + ".mcap";
   fs::remove(path);
   return path;
@@ -54,7 +54,7 @@ void RecordFrames(const std::string& path, int n, const std::string& images = "r
 }
 
 TEST(Recording, FramesPlayBackWithTheirTimesAndOdometry) {
-  const std::string path = FreshPath("frames");
+  const std::string path = FreshRecordingPath("frames");
   RecordFrames(path, 25);
   std::unique_ptr<io::FrameSource> source = OpenSource(path, {});
   io::Frame f;
@@ -70,7 +70,7 @@ TEST(Recording, FramesPlayBackWithTheirTimesAndOdometry) {
 
 TEST(Recording, CompressedFramesPlayBack) {
   for (const std::string images : {"png", "jpeg"}) {
-    const std::string path = FreshPath("compressed_" + images);
+    const std::string path = FreshRecordingPath("compressed_" + images);
     RecordFrames(path, 5, images);
     std::unique_ptr<io::FrameSource> source = OpenSource(path, {});
     io::Frame f;
@@ -86,7 +86,7 @@ TEST(Recording, CompressedFramesPlayBack) {
 }
 
 TEST(Recording, StartAndLoopLikeRos2BagPlay) {
-  const std::string path = FreshPath("loop");
+  const std::string path = FreshRecordingPath("loop");
   RecordFrames(path, 10);
   PlaybackOptions options;
   options.start_s = 0.45;  // frames 5..9
@@ -104,7 +104,7 @@ TEST(Recording, StartAndLoopLikeRos2BagPlay) {
 }
 
 TEST(Recording, TopicsAreChosenOrRefusedByName) {
-  const std::string path = FreshPath("topics");
+  const std::string path = FreshRecordingPath("topics");
   RecordFrames(path, 3);
   McapReader reader(path);
   std::vector<std::string> names;
@@ -131,7 +131,7 @@ TEST(Recording, TopicsAreChosenOrRefusedByName) {
 }
 
 TEST(Recording, ACutRecordingPlaysEveryWholeFrameBeforeTheCut) {
-  const std::string path = FreshPath("cut");
+  const std::string path = FreshRecordingPath("cut");
   RecordFrames(path, 30);
   const auto size = fs::file_size(path);
   fs::resize_file(path, size * 2 / 3);
@@ -147,10 +147,10 @@ TEST(Recording, ACutRecordingPlaysEveryWholeFrameBeforeTheCut) {
 }
 
 TEST(Recording, RecorderRefusesToOverwrite) {
-  const std::string path = FreshPath("exists");
+  const std::string path = FreshRecordingPath("exists");
   RecordFrames(path, 1);
   EXPECT_THROW(RecordFrames(path, 1), InputError);
-  EXPECT_THROW(RecordFrames(FreshPath("bad_images"), 1, "bmp"), InputError);
+  EXPECT_THROW(RecordFrames(FreshRecordingPath("bad_images"), 1, "bmp"), InputError);
 }
 
 // The fixtures of foxglove/rosbag (tests/data/rosbag1/README.md): the same recording stored

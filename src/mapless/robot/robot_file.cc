@@ -1,6 +1,8 @@
 #include "mapless/robot/robot_file.h"
 
+#include <algorithm>
 #include <cctype>
+#include <iterator>
 #include <cmath>
 
 #include "mapless/core/check.h"
@@ -10,7 +12,6 @@
 
 namespace mapless::robot {
 
-const char* MiddlewareName(Middleware m) { return m == Middleware::kRos1 ? "ros1" : "ros2"; }
 
 const char* CameraMountName(CameraMount m) {
   switch (m) {
@@ -86,13 +87,12 @@ RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
                         "obstacles", "camera", "safety", "use_sim_time"});
     RobotFile r;
     r.source = name;
-    const std::string middleware = map.GetString("middleware", "ros1");
-    if (middleware == "ros1") {
-      r.middleware = Middleware::kRos1;
-    } else if (middleware == "ros2") {
-      r.middleware = Middleware::kRos2;
-    } else {
-      map.Fail("middleware", "'" + middleware + "' is not one of ros1, ros2");
+    r.middleware = map.GetString("middleware", r.middleware);
+    if (std::find(std::begin(kMiddlewareNames), std::end(kMiddlewareNames), r.middleware) ==
+        std::end(kMiddlewareNames)) {
+      std::string known;
+      for (const char* n : kMiddlewareNames) known += (known.empty() ? "" : ", ") + std::string(n);
+      map.Fail("middleware", "'" + r.middleware + "' is not one of " + known);
     }
     r.name = map.GetString("name", r.name);
     r.ns = map.GetString("namespace", "");

@@ -12,8 +12,9 @@
 
 namespace mapless::robot {
 
-enum class Middleware { kRos1, kRos2 };
-const char* MiddlewareName(Middleware m);
+// The middleware names a robot file may use; which of them this build can reach is
+// robot/middleware.h's registry.
+inline constexpr const char* kMiddlewareNames[] = {"ros1", "ros2"};
 
 // How the camera is mounted: the image is turned upright before the method sees it.
 enum class CameraMount { kUpright, kRotated180, kMirrored, kFlippedVertically };
@@ -32,7 +33,7 @@ struct RobotTopics {
 
 struct RobotFile {
   std::string source;  // the file it came from (for messages)
-  Middleware middleware = Middleware::kRos1;
+  std::string middleware = "ros1";  // one of kMiddlewareNames
   std::string name = "robot";         // a name for logs
   std::string ns;                     // namespace prefixed to relative topics ("/robot1")
   std::string node_name = "mapless";  // the ROS node name

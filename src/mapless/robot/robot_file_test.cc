@@ -9,7 +9,7 @@ namespace {
 
 TEST(RobotFile, DefaultsAreTheRosConventions) {
   const RobotFile r = ParseRobotFile("{}", "robot.yaml");
-  EXPECT_EQ(r.middleware, Middleware::kRos1);
+  EXPECT_EQ(r.middleware, "ros1");
   EXPECT_EQ(r.Resolve(r.topics.image), "/camera/image_raw");
   EXPECT_EQ(r.Resolve(r.topics.odometry), "/odom");
   EXPECT_EQ(r.Resolve(r.topics.cmd_vel), "/cmd_vel");
