@@ -41,22 +41,31 @@ function(mapless_library)
   endif()
 endfunction()
 
-# mapless_test(NAME name SRCS ... DEPS ... [SANITIZE_ENV VAR=VALUE ...]): one GoogleTest binary,
-# tests discovered by ctest. SANITIZE_ENV: extra environment for its tests in the sanitizer build.
+# mapless_test(NAME name SRCS ... DEPS ... [SANITIZE_ENV VAR=VALUE ...] [COST N]): one GoogleTest
+# binary, tests discovered by ctest. SANITIZE_ENV: extra environment for its tests in the sanitizer
+# build. COST: ctest starts tests of higher cost first (closed loops: a clean clone has no timing
+# history, and a long test started last would end the run alone on one core).
 function(mapless_test)
   if(NOT MAPLESS_BUILD_TESTS)
     return()
   endif()
-  cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS;SANITIZE_ENV" ${ARGN})
+  cmake_parse_arguments(ARG "" "NAME;COST" "SRCS;DEPS;SANITIZE_ENV" ${ARGN})
   add_executable(${ARG_NAME} ${ARG_SRCS})
-  target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
+  target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} GTest::gtest mapless_test_main)
   target_compile_definitions(${ARG_NAME} PRIVATE
     MAPLESS_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   mapless_target_warnings(${ARG_NAME})
   mapless_glue_code(${ARG_NAME})
+  set(properties "")
+  if(ARG_COST)
+    list(APPEND properties COST ${ARG_COST})
+  endif()
   if(MAPLESS_SANITIZE AND ARG_SANITIZE_ENV)
+    list(APPEND properties ENVIRONMENT "${ARG_SANITIZE_ENV}")
+  endif()
+  if(properties)
     gtest_discover_tests(${ARG_NAME} WORKING_DIRECTORY ${PROJECT_BINARY_DIR} DISCOVERY_TIMEOUT 60
-                         PROPERTIES ENVIRONMENT "${ARG_SANITIZE_ENV}")
+                         PROPERTIES ${properties})
   else()
     gtest_discover_tests(${ARG_NAME} WORKING_DIRECTORY ${PROJECT_BINARY_DIR} DISCOVERY_TIMEOUT 60)
   endif()

@@ -1,19 +1,23 @@
 #!/usr/bin/env bash
-# Installs every Debian package mapless needs to build, test and benchmark.
-# Idempotent: packages already installed are skipped; nothing is done when all are present.
-# Usage: scripts/setup.sh            (as root, or with sudo available)
-#        scripts/setup.sh --ros      also ROS 1 (roscpp, the message packages, roscore) and Cyclone
-#                                    DDS for ROS 2: the robot links over ROS 1 and ROS 2 are built
-#                                    when they are present. About 180
-#                                    Debian packages, so the demo (README command 1) does without;
-#                                    the test command (command 2) and robot users take them
-#                                    (with Chromium, which the report's test opens the report in).
+# Installs every Debian package mapless needs. Idempotent: packages already installed are
+# skipped; nothing is done when all are present.
+# Usage: scripts/setup.sh            build and run mapless on the simulator, recordings, videos and
+#                                    cameras (README command 1; as root, or with sudo available)
+#        scripts/setup.sh --ros      also ROS 1 (roscpp, the message packages, roscore, rosbag) and
+#                                    Cyclone DDS for ROS 2: the robot links over ROS 1 and ROS 2 are
+#                                    built when they are present (about 180 Debian packages, so
+#                                    the demo does without)
+#        scripts/setup.sh --test     --ros and what the test command (README command 2) uses
+#                                    besides: Chromium (the report opened headless), clang-format
+#                                    (the style check), dpkg-dev (the .deb's dependencies)
 set -euo pipefail
 WITH_ROS=0
+WITH_TEST=0
 for arg in "$@"; do
   case "$arg" in
     --ros) WITH_ROS=1 ;;
-    *) echo "setup: unknown option $arg (known: --ros)" >&2; exit 2 ;;
+    --test) WITH_ROS=1; WITH_TEST=1 ;;
+    *) echo "setup: unknown option $arg (known: --ros, --test)" >&2; exit 2 ;;
   esac
 done
 
@@ -39,7 +43,13 @@ if [ "$WITH_ROS" = "1" ]; then
     cyclonedds-dev cyclonedds-tools   # ROS 2 over DDS (Cyclone 0.10, as in Humble and Jazzy)
     libsodium-dev          # SHA-256 of the ROS 2 type descriptions (the RIHS01 type hash)
     librosbag-storage-dev libbz2-dev  # reading ROS 1 bags (recordings as sources; bz2 chunks checked)
-    chromium               # tests: the HTML report opened headless (no console error, a screenshot)
+  )
+fi
+if [ "$WITH_TEST" = "1" ]; then
+  PACKAGES+=(
+    chromium               # the HTML report opened headless (no console error, a screenshot)
+    clang-format           # the style check (scripts/check_format.sh)
+    dpkg-dev               # dpkg-shlibdeps: the Depends of the .deb (cpack)
   )
 fi
 

@@ -1,16 +1,36 @@
 #!/usr/bin/env bash
-# README command 2: install what is missing, build, and run the whole test suite: first the release
-# build, then the same suite under AddressSanitizer + UndefinedBehaviorSanitizer (preset `asan`,
-# unit tests, closed-loop runs, the short soak and the kept fuzz inputs, but for the release-only
-# tests listed in tests/release_only_tests.txt). .ci/run calls exactly this.
-# Extra arguments go to both ctest runs (e.g. -R Renderer). MAPLESS_SKIP_SANITIZERS=1 skips the
-# second run (a quicker local check; CI never sets it).
+# README command 2: install what is missing, check the style, build and run the whole test suite.
+# .ci/run calls exactly this.
+#   1. the release build with both robot links (ROS 1 and ROS 2), every test;
+#   2. the configurations with one robot link each: configured, and the code that differs between
+#      configurations (the registration of the middlewares) compiled;
+#   3. the configuration a newcomer gets (no ROS 1, no ROS 2; preset `asan`), under
+#      AddressSanitizer + UndefinedBehaviorSanitizer: every test but the release-only ones
+#      (tests/release_only_tests.txt), and `mapless demo`, the main job (newcomer.demo).
+# Extra arguments go to both ctest runs (e.g. -R Renderer). MAPLESS_SKIP_SANITIZERS=1 skips step 3
+# (a quicker local check; CI never sets it). Where the time goes: docs/ci.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/setup.sh --ros
+jobs=$(nproc)
+bash scripts/setup.sh --test
+bash scripts/check_format.sh
+
 cmake --preset release
-cmake --build --preset release -j "$(nproc)"
-ctest --preset release -j "$(nproc)" "$@"
+cmake --build --preset release -j "$jobs"
+ctest --preset release -j "$jobs" "$@"
+
+for only in ros1 ros2; do
+  other=$([ "$only" = ros1 ] && echo ROS2 || echo ROS1)
+  dir=build/only-$only
+  cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=Release -DMAPLESS_${other}=OFF \
+    -DMAPLESS_BUILD_TESTS=OFF -DMAPLESS_BUILD_BENCHMARKS=OFF >"$dir.log" 2>&1 ||
+    { cat "$dir.log"; exit 1; }
+  grep -q "mapless: $(tr a-z A-Z <<<"${only:0:3}") ${only:3} robot link: built" "$dir.log" ||
+    { echo "test.sh: $dir: the $only link is not built"; cat "$dir.log"; exit 1; }
+  cmake --build "$dir" --target apps/CMakeFiles/mapless.dir/builtin_middlewares.cc.o
+  echo "test.sh: the configuration with $only alone compiles its robot links"
+done
+
 if [ "${MAPLESS_SKIP_SANITIZERS:-0}" = "1" ]; then
   echo "test.sh: sanitizer suite skipped (MAPLESS_SKIP_SANITIZERS=1)"
   exit 0
@@ -24,5 +44,5 @@ for name in $release_only; do
 done
 exclude="^($(sed 's/\./\\./g' <<<"$release_only" | paste -sd'|'))\$"
 cmake --preset asan
-cmake --build --preset asan -j "$(nproc)"
-ctest --preset asan -j "$(nproc)" -E "$exclude" "$@"
+cmake --build --preset asan -j "$jobs"
+ctest --preset asan -j "$jobs" -E "$exclude" "$@"

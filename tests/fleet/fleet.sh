@@ -10,7 +10,7 @@
 #   fleet.sh MAPLESS funnel|eigenspace [--faults] [--no-curve]
 # The simulations run at 6x the wall clock (short routes, to keep the suite short); the outage is
 # 10 s of wall clock, as the issue asks. --no-curve skips the CURVE and garbage checks (CI runs
-# them once, with the plain funnel run).
+# them once, with the funnel run with faults).
 set -euo pipefail
 mapless=$1
 method=$2
