@@ -6,10 +6,10 @@
 #include <functional>
 #include <iostream>
 #include <memory>
-#include <sstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/video/tracking.hpp>
+#include <sstream>
 
 #include "bench_util.h"
 #include "cli_common.h"
@@ -28,7 +28,7 @@ namespace mapless::app {
 
 // The middleware's robot-link latency rows (bench_links.cc).
 void BenchMiddleware(const std::string& middleware, nlohmann::json* j);
-void BenchFleet(nlohmann::json* j);  // bench_fleet.cc
+void BenchFleet(nlohmann::json* j);        // bench_fleet.cc
 void BenchTeachRepeat(nlohmann::json* j);  // bench_repeat.cc
 
 namespace {
@@ -261,8 +261,7 @@ void AddBenchCommand(CLI::App* app) {
       int w = 0, h = 0;
       char x = 0;
       std::istringstream in(args->size);
-      if (!(in >> w >> x >> h) || x != 'x' || !in.eof() || w < 64 || h < 48 || w > 4096 ||
-          h > 4096)
+      if (!(in >> w >> x >> h) || x != 'x' || !in.eof() || w < 64 || h < 48 || w > 4096 || h > 4096)
         throw InputError("--size '" + args->size + "': expected WxH, 64x48 to 4096x4096");
       BenchFrameSize() = cv::Size(w, h);
     }
@@ -292,8 +291,8 @@ void AddBenchCommand(CLI::App* app) {
     nlohmann::json j;
     j["scenarios"] = names;
     j["threads"] = cv::getNumThreads();
-    j["frame"] = std::to_string(BenchFrameSize().width) + "x" +
-                 std::to_string(BenchFrameSize().height);
+    j["frame"] =
+        std::to_string(BenchFrameSize().width) + "x" + std::to_string(BenchFrameSize().height);
     j["repeats"] = args->repeats;
     cv::Mat sink;
     j["sim_render_320x240_ms"] = MedianMs(args->repeats, 3, [&](int i) {
@@ -387,7 +386,8 @@ void AddBenchCommand(CLI::App* app) {
     std::printf("%-34s %10.2f  (issue 3: <= 1.5)\n", "repeat_step / orb500",
                 j["repeat_step_over_orb"].get<double>());
     std::printf("%-34s %10.2f  (issue 3: <= 1.5; ORB-500 timed after each step)\n",
-                "repeat_step / orb500 interl.", j["repeat_step_over_orb_interleaved"].get<double>());
+                "repeat_step / orb500 interl.",
+                j["repeat_step_over_orb_interleaved"].get<double>());
     std::printf("%-34s %10.2f  (issue 21: <= 1.5)\n", "repeat_step_default / orb500",
                 j["repeat_step_default_over_orb"].get<double>());
     std::printf("%-34s %10.2f  (issue 21: <= 1.5; ORB-500 timed after each step)\n",

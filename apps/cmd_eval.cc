@@ -1,6 +1,7 @@
 // `mapless eval SUITE`: reproduce a paper's experiments on the simulator; one JSON object
 // {"suite", "results": [{"scenario", "controller", "runs", "successes", "final_error_m_rms",
-// "final_error_m_std", "final_error_m_max", "lateral_rms_m", "collisions", ...}]} and a readable table.
+// "final_error_m_std", "final_error_m_max", "lateral_rms_m", "collisions", ...}]} and a readable
+// table.
 #include <spdlog/spdlog.h>
 
 #include <cmath>

@@ -8,7 +8,6 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
-#include "robot_run.h"
 #include "interrupt.h"
 #include "mapless/core/check.h"
 #include "mapless/io/atomic_file.h"
@@ -17,6 +16,7 @@
 #include "mapless/io/tum.h"
 #include "mapless/sim/world.h"
 #include "mapless/viz/topdown.h"
+#include "robot_run.h"
 
 namespace mapless::app {
 

@@ -6,9 +6,9 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <iostream>
-#include <string>
 #include <opencv2/core.hpp>
 #include <opencv2/core/utils/logger.hpp>
+#include <string>
 
 #include "builtin_middlewares.h"
 #include "cli_common.h"

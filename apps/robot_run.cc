@@ -70,8 +70,8 @@ void RunOnRobot(robot::Method& method, const std::string& robot_path, const std:
   std::unique_ptr<robot::RobotLink> recording;
   if (recorder)
     recording = std::make_unique<recording::RecordingLink>(*link, *recorder, method.name());
-  spdlog::info("{}: on {} ({}), commands to {}", method.name(), file.name,
-               file.middleware, file.Resolve(file.topics.cmd_vel));
+  spdlog::info("{}: on {} ({}), commands to {}", method.name(), file.name, file.middleware,
+               file.Resolve(file.topics.cmd_vel));
   int frame = 0;
   std::string last_state;
   const robot::LoopResult result = robot::RunLoop(

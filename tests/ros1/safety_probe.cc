@@ -11,8 +11,8 @@
 //   safety_probe kill|int|estop PID LIMIT_S [NONZERO_COMMANDS]
 #include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
-#include <signal.h>
 #include <sensor_msgs/Image.h>
+#include <signal.h>
 #include <std_msgs/Bool.h>
 #include <std_msgs/String.h>
 
@@ -107,14 +107,16 @@ int main(int argc, char** argv) {
     while (Clock::now() < until) {
       {
         std::lock_guard<std::mutex> lock(m);
-        if (good_statuses >= 10 && good_images >= (std::getenv("MAPLESS_DEBUG_IMAGE_OUT") ? 25 : 5)) break;
+        if (good_statuses >= 10 && good_images >= (std::getenv("MAPLESS_DEBUG_IMAGE_OUT") ? 25 : 5))
+          break;
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
     std::lock_guard<std::mutex> lock(m);
-    std::printf("{\"mode\": \"topics\", \"statuses\": %d, \"good_statuses\": %d, "
-                "\"debug_images\": %d, \"good_debug_images\": %d}\n",
-                statuses, good_statuses, images, good_images);
+    std::printf(
+        "{\"mode\": \"topics\", \"statuses\": %d, \"good_statuses\": %d, "
+        "\"debug_images\": %d, \"good_debug_images\": %d}\n",
+        statuses, good_statuses, images, good_images);
     (void)pid;
     (void)limit;
     (void)wanted;

@@ -67,7 +67,9 @@ std::vector<Kind> Kinds() {
   const Timestamp t = 1732454400LL * kNsPerSecond + 123456789;
   return {
       {"twist", "geometry_msgs/msg/Twist", &geometry_msgs_msg_dds__Twist__desc, Qos::kDefault,
-       [](dds_entity_t w) { return WriteTwist(w, Twist2{0.25, -0.5}); },
+       [](dds_entity_t w) {
+         return WriteTwist(w, Twist2{0.25, -0.5});
+       },
        [](const void* s) { return Twist(*static_cast<const geometry_msgs_msg_dds__Twist_*>(s)); }},
       {"string", "std_msgs/msg/String", &std_msgs_msg_dds__String__desc, Qos::kDefault,
        [](dds_entity_t w) {
@@ -88,7 +90,9 @@ std::vector<Kind> Kinds() {
          return json{{"clock", Time(static_cast<const rosgraph_msgs_msg_dds__Clock_*>(s)->clock)}};
        }},
       {"odometry", "nav_msgs/msg/Odometry", &nav_msgs_msg_dds__Odometry__desc, Qos::kDefault,
-       [t](dds_entity_t w) { return WriteOdometry(w, t, Pose2{1.5, -2.25, 0.75}); },
+       [t](dds_entity_t w) {
+         return WriteOdometry(w, t, Pose2{1.5, -2.25, 0.75});
+       },
        [](const void* s) {
          const auto* m = static_cast<const nav_msgs_msg_dds__Odometry_*>(s);
          const auto& p = m->pose.pose;

@@ -1,6 +1,6 @@
 // A plain Cyclone DDS program (no mapless code; issue 18's discovery test): joins the ROS domain
-// (ROS_DOMAIN_ID; loopback when ROS_LOCALHOST_ONLY=1, as mapless does) and lists, for SECONDS, every
-// remote reader and writer it discovers, one JSON object a line:
+// (ROS_DOMAIN_ID; loopback when ROS_LOCALHOST_ONLY=1, as mapless does) and lists, for SECONDS,
+// every remote reader and writer it discovers, one JSON object a line:
 //   {"kind":"writer","topic":"rt/cmd_vel","type":"geometry_msgs::msg::dds_::Twist_",
 //    "reliability":"reliable","history":10,"durability":"volatile","user_data":"typehash=...;"}
 //   dds_spy SECONDS
@@ -55,8 +55,7 @@ void Drain(dds_entity_t reader, const char* kind, std::set<std::string>* seen) {
                   kind, Escape(topic).c_str(), Escape(e->type_name ? e->type_name : "").c_str(),
                   rel == DDS_RELIABILITY_RELIABLE ? "reliable" : "best_effort",
                   hist == DDS_HISTORY_KEEP_ALL ? -1 : depth,
-                  dur == DDS_DURABILITY_VOLATILE ? "volatile" : "other",
-                  Escape(user_data).c_str());
+                  dur == DDS_DURABILITY_VOLATILE ? "volatile" : "other", Escape(user_data).c_str());
     if (seen->insert(line).second) std::printf("%s\n", line);
   }
   if (n > 0) dds_return_loan(reader, samples, n);
@@ -87,8 +86,7 @@ int main(int argc, char** argv) {
   const dds_entity_t subs =
       dds_create_reader(participant, DDS_BUILTIN_TOPIC_DCPSSUBSCRIPTION, nullptr, nullptr);
   std::set<std::string> seen;
-  const auto until =
-      std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (std::chrono::steady_clock::now() < until) {
     Drain(pubs, "writer", &seen);
     Drain(subs, "reader", &seen);

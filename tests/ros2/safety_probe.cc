@@ -108,9 +108,10 @@ int main(int argc, char** argv) {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
     std::lock_guard<std::mutex> lock(g_mutex);
-    std::printf("{\"mode\": \"topics\", \"statuses\": %d, \"good_statuses\": %d, "
-                "\"debug_images\": %d, \"good_debug_images\": %d}\n",
-                g_statuses, g_good_statuses, g_images, g_good_images);
+    std::printf(
+        "{\"mode\": \"topics\", \"statuses\": %d, \"good_statuses\": %d, "
+        "\"debug_images\": %d, \"good_debug_images\": %d}\n",
+        g_statuses, g_good_statuses, g_images, g_good_images);
     std::fflush(stdout);
     const bool ok = g_good_statuses >= 10 && g_good_images >= 5 && g_good_statuses == g_statuses;
     std::_Exit(ok ? 0 : 1);  // no DDS teardown while listeners may run

@@ -42,7 +42,8 @@ cv::Mat LowResolution(const cv::Mat& image, const AppearanceImageOptions& option
 
 Vector ToVector(const cv::Mat& low_resolution) {
   MAPLESS_CHECK(low_resolution.type() == CV_32FC1, "appearance: expected a CV_32FC1 image");
-  const cv::Mat continuous = low_resolution.isContinuous() ? low_resolution : low_resolution.clone();
+  const cv::Mat continuous =
+      low_resolution.isContinuous() ? low_resolution : low_resolution.clone();
   return Eigen::Map<const Vector>(continuous.ptr<float>(), continuous.rows * continuous.cols);
 }
 

@@ -12,9 +12,9 @@
 namespace mapless::appearance {
 
 struct AppearanceImageOptions {
-  int width = 64;          // low-resolution image width, px
-  int height = 64;         // low-resolution image height, px
-  bool normalize = true;   // zero mean, unit standard deviation per image
+  int width = 64;         // low-resolution image width, px
+  int height = 64;        // low-resolution image height, px
+  bool normalize = true;  // zero mean, unit standard deviation per image
   void Validate() const;
 };
 

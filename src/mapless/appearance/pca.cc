@@ -14,7 +14,8 @@ namespace {
 // components without variance.
 int UsableDimensions(const Vector& sorted_eigenvalues, int requested) {
   int k = std::min<int>(requested, static_cast<int>(sorted_eigenvalues.size()));
-  const float floor = sorted_eigenvalues.size() > 0 ? 1e-7F * std::max(sorted_eigenvalues(0), 0.0F) : 0.0F;
+  const float floor =
+      sorted_eigenvalues.size() > 0 ? 1e-7F * std::max(sorted_eigenvalues(0), 0.0F) : 0.0F;
   while (k > 0 && !(sorted_eigenvalues(k - 1) > floor)) --k;
   return k;
 }
@@ -42,7 +43,8 @@ Eigenspace BatchPcaSvd(const Matrix& images, int dimensions) {
   space.mean = images.rowwise().mean();
   const Matrix centred = images.colwise() - space.mean;
   const Eigen::BDCSVD<Matrix> svd(centred, Eigen::ComputeThinU | Eigen::ComputeThinV);
-  const Vector eigenvalues = svd.singularValues().array().square() / static_cast<float>(images.cols());
+  const Vector eigenvalues =
+      svd.singularValues().array().square() / static_cast<float>(images.cols());
   const int k = UsableDimensions(eigenvalues, dimensions);
   space.basis = svd.matrixU().leftCols(k);
   space.eigenvalues = eigenvalues.head(k);
@@ -77,14 +79,14 @@ Eigenspace BatchPcaGram(const Matrix& images, int dimensions) {
 void IncrementalPcaOptions::Validate() const {
   MAPLESS_CHECK(max_dimensions >= 1,
                 "IncrementalPcaOptions.max_dimensions = " << max_dimensions << "; must be >= 1");
-  MAPLESS_CHECK(extra_dimensions >= 0,
-                "IncrementalPcaOptions.extra_dimensions = " << extra_dimensions << "; must be >= 0");
+  MAPLESS_CHECK(extra_dimensions >= 0, "IncrementalPcaOptions.extra_dimensions = "
+                                           << extra_dimensions << "; must be >= 0");
   MAPLESS_CHECK(min_eigenvalue_ratio >= 0.0 && min_eigenvalue_ratio < 1.0,
                 "IncrementalPcaOptions.min_eigenvalue_ratio = " << min_eigenvalue_ratio
-                                                                 << "; must be in [0, 1)");
+                                                                << "; must be in [0, 1)");
   MAPLESS_CHECK(min_relative_residual >= 0.0 && min_relative_residual < 1.0,
                 "IncrementalPcaOptions.min_relative_residual = " << min_relative_residual
-                                                                  << "; must be in [0, 1)");
+                                                                 << "; must be in [0, 1)");
 }
 
 IncrementalPca::IncrementalPca(IncrementalPcaOptions options) : options_(options) {
@@ -92,9 +94,9 @@ IncrementalPca::IncrementalPca(IncrementalPcaOptions options) : options_(options
 }
 
 Vector IncrementalPca::Project(const Vector& image) const {
-  MAPLESS_CHECK(n_ > 0 && image.size() == mean_.size(),
-                "IncrementalPca::Project: image of " << image.size() << " pixels, model of "
-                                                     << mean_.size());
+  MAPLESS_CHECK(n_ > 0 && image.size() == mean_.size(), "IncrementalPca::Project: image of "
+                                                            << image.size() << " pixels, model of "
+                                                            << mean_.size());
   const Vector all = q_.transpose() * (u_.transpose() * (image - mean_));
   return all.head(dimensions());
 }

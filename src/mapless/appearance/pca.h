@@ -28,7 +28,7 @@ struct Eigenspace {
 
   int dimensions() const { return static_cast<int>(basis.cols()); }
   int images() const { return static_cast<int>(projections.cols()); }
-  Vector Project(const Vector& image) const;  // Vᵀ(x - m)
+  Vector Project(const Vector& image) const;           // Vᵀ(x - m)
   Vector Reconstruct(const Vector& projection) const;  // V p + m
   // ‖x - (V Vᵀ(x - m) + m)‖: how much of the image the eigenspace cannot represent.
   float ReconstructionError(const Vector& image) const;

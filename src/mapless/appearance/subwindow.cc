@@ -30,7 +30,8 @@ void SubWindowOptions::Validate() const {
   MAPLESS_CHECK(band_top >= 0.0 && band_top < band_bottom && band_bottom <= 1.0,
                 "SubWindowOptions.band_top/band_bottom = " << band_top << "/" << band_bottom
                                                            << "; need 0 <= top < bottom <= 1");
-  MAPLESS_CHECK(dimensions >= 1, "SubWindowOptions.dimensions = " << dimensions << "; must be >= 1");
+  MAPLESS_CHECK(dimensions >= 1,
+                "SubWindowOptions.dimensions = " << dimensions << "; must be >= 1");
   MAPLESS_CHECK(correspondences >= 5,
                 "SubWindowOptions.correspondences = " << correspondences << "; must be >= 5");
 }
@@ -93,7 +94,8 @@ std::vector<SubWindowMatch> MatchSubWindows(const SubWindowEigenspace& route,
   std::vector<SubWindowMatch> all;
   all.reserve(static_cast<std::size_t>(5 * count));
   for (int q = 0; q < 5; ++q) {
-    const Vector f = route.space.Project(SubWindow(current, query[static_cast<std::size_t>(q)], options));
+    const Vector f =
+        route.space.Project(SubWindow(current, query[static_cast<std::size_t>(q)], options));
     for (int i = 0; i < count; ++i) {
       all.push_back({q, i, (route.space.projections.col(i) - f).norm()});
     }
@@ -108,7 +110,8 @@ std::vector<SubWindowMatch> MatchSubWindows(const SubWindowEigenspace& route,
   std::vector<bool> used(all.size(), false);
   for (int q = 0; q < 5; ++q) {
     std::size_t best = all.size();
-    for (std::size_t i = static_cast<std::size_t>(q * count); i < static_cast<std::size_t>((q + 1) * count); ++i) {
+    for (std::size_t i = static_cast<std::size_t>(q * count);
+         i < static_cast<std::size_t>((q + 1) * count); ++i) {
       if (best == all.size() || nearer(all[i], all[best])) best = i;
     }
     kept.push_back(all[best]);
@@ -118,9 +121,10 @@ std::vector<SubWindowMatch> MatchSubWindows(const SubWindowEigenspace& route,
   for (std::size_t i = 0; i < all.size(); ++i) {
     if (!used[i]) rest.push_back(all[i]);
   }
-  const std::size_t more = std::min(
-      rest.size(), static_cast<std::size_t>(std::max(0, options.correspondences - 5)));
-  std::partial_sort(rest.begin(), rest.begin() + static_cast<std::ptrdiff_t>(more), rest.end(), nearer);
+  const std::size_t more =
+      std::min(rest.size(), static_cast<std::size_t>(std::max(0, options.correspondences - 5)));
+  std::partial_sort(rest.begin(), rest.begin() + static_cast<std::ptrdiff_t>(more), rest.end(),
+                    nearer);
   kept.insert(kept.end(), rest.begin(), rest.begin() + static_cast<std::ptrdiff_t>(more));
   std::sort(kept.begin(), kept.end(), nearer);
   all.swap(kept);

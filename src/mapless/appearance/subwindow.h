@@ -16,12 +16,12 @@
 namespace mapless::appearance {
 
 struct SubWindowOptions {
-  int window_width_px = 16;   // sub-window width in the low-resolution image, px
-  int step_px = 1;            // horizontal scan step, px; N' = (width - window_width) / step + 1
-  double band_top = 0.1;      // central band: top row as a fraction of the image height
-  double band_bottom = 0.9;   // bottom row (exclusive) as a fraction of the image height
-  int dimensions = 8;         // K', components of each image's sub-window eigenspace
-  int correspondences = 7;    // total correspondences kept for the five query windows (>= 5)
+  int window_width_px = 16;  // sub-window width in the low-resolution image, px
+  int step_px = 1;           // horizontal scan step, px; N' = (width - window_width) / step + 1
+  double band_top = 0.1;     // central band: top row as a fraction of the image height
+  double band_bottom = 0.9;  // bottom row (exclusive) as a fraction of the image height
+  int dimensions = 8;        // K', components of each image's sub-window eigenspace
+  int correspondences = 7;   // total correspondences kept for the five query windows (>= 5)
   void Validate() const;
 };
 

@@ -2,8 +2,9 @@
 
 #include <gtest/gtest.h>
 
-#include "mapless/appearance/image.h"
 #include <opencv2/imgproc.hpp>
+
+#include "mapless/appearance/image.h"
 
 namespace mapless::appearance {
 namespace {
@@ -18,7 +19,8 @@ TEST(SubWindows, AnAlignedViewMatchesTheQueryWindowsThemselves) {
   ASSERT_EQ(matches.size(), 7U);
   const auto query = QueryWindowIndices(route.windows());
   int exact = 0;
-  for (const SubWindowMatch& m : matches) exact += m.stored == query[static_cast<std::size_t>(m.query)];
+  for (const SubWindowMatch& m : matches)
+    exact += m.stored == query[static_cast<std::size_t>(m.query)];
   EXPECT_EQ(exact, 5);  // every query window finds itself; two more are neighbours
 }
 

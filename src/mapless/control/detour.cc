@@ -14,16 +14,15 @@ void DetourOptions::Validate() const {
                 "DetourOptions.turn_out_min_rad/turn_out_max_rad = "
                     << turn_out_min_rad << "/" << turn_out_max_rad
                     << "; must be 0 < min <= max < pi/2");
-  MAPLESS_CHECK(back_off_m >= 0.0,
-                "DetourOptions.back_off_m = " << back_off_m << "; must be >= 0");
+  MAPLESS_CHECK(back_off_m >= 0.0, "DetourOptions.back_off_m = " << back_off_m << "; must be >= 0");
   MAPLESS_CHECK(first_step_m > 0.0 && step_m > 0.0 && margin_m >= 0.0,
                 "DetourOptions: first_step_m and step_m must be > 0, margin_m >= 0");
   MAPLESS_CHECK(max_offset_m >= first_step_m,
                 "DetourOptions.max_offset_m = " << max_offset_m << "; must be >= first_step_m");
   MAPLESS_CHECK(look_max_m > 0.0, "DetourOptions.look_max_m = " << look_max_m << "; must be > 0");
-  MAPLESS_CHECK(look_speed_fraction > 0.0 && look_speed_fraction <= 1.0,
-                "DetourOptions.look_speed_fraction = " << look_speed_fraction
-                                                       << "; must be in (0, 1]");
+  MAPLESS_CHECK(
+      look_speed_fraction > 0.0 && look_speed_fraction <= 1.0,
+      "DetourOptions.look_speed_fraction = " << look_speed_fraction << "; must be in (0, 1]");
   MAPLESS_CHECK(pass_m > 0.0 && lookahead_m > 0.0 && rejoined_m > 0.0,
                 "DetourOptions: pass_m, lookahead_m and rejoined_m must be > 0");
   MAPLESS_CHECK(aligned_rad > 0.0 && max_omega_radps > 0.0,
@@ -54,9 +53,9 @@ const char* DetourPhaseName(DetourPhase phase) {
   return "?";
 }
 
-double DetourAngle(const std::vector<cv::Point2f>& obstacle_px, cv::Size image,
-                   double top_fraction, double point_radius_px,
-                   double theta_d_rad, const VisualPotentialOptions& options) {
+double DetourAngle(const std::vector<cv::Point2f>& obstacle_px, cv::Size image, double top_fraction,
+                   double point_radius_px, double theta_d_rad,
+                   const VisualPotentialOptions& options) {
   MAPLESS_CHECK(image.width > 0 && image.height > 0 && top_fraction >= 0.0 && top_fraction < 1.0,
                 "DetourAngle: bad image size or top fraction");
   const int top = static_cast<int>(std::lround(top_fraction * image.height));
@@ -83,9 +82,8 @@ double DetourAngle(const std::vector<cv::Point2f>& obstacle_px, cv::Size image,
 
 ObstacleExtent MeasureObstacleExtent(const std::vector<cv::Point2f>& region_px,
                                      const std::vector<cv::Point2f>& off_plane_px, cv::Size image,
-                                     double region_width_fraction,
-                                     double region_top_fraction, double half_width_m,
-                                     double gap_m) {
+                                     double region_width_fraction, double region_top_fraction,
+                                     double half_width_m, double gap_m) {
   const double cx = 0.5 * image.width;
   // The strip's half-width in pixels at the bottom row.
   const double half_px = 0.5 * region_width_fraction * image.width;
@@ -94,7 +92,7 @@ ObstacleExtent MeasureObstacleExtent(const std::vector<cv::Point2f>& region_px,
   // more than gap_m apart: the clusters holding region points are the obstacle.
   std::vector<std::pair<double, bool>> points;  // lateral, from the region
   const double top = region_top_fraction * image.height;
-    for (const cv::Point2f& p : region_px) points.emplace_back(lateral(p), true);
+  for (const cv::Point2f& p : region_px) points.emplace_back(lateral(p), true);
   for (const cv::Point2f& p : off_plane_px) {
     if (p.y >= top) points.emplace_back(lateral(p), false);
   }
@@ -123,8 +121,8 @@ Detour::Detour(const Pose2& stopped_at, double theta_rad, const ObstacleExtent& 
     : origin_(stopped_at), options_(options) {
   options_.Validate();
   MAPLESS_CHECK(half_width_m > 0.0, "Detour: half_width_m = " << half_width_m << "; must be > 0");
-  turn_out_rad_ = std::clamp(std::abs(theta_rad), options_.turn_out_min_rad,
-                             options_.turn_out_max_rad);
+  turn_out_rad_ =
+      std::clamp(std::abs(theta_rad), options_.turn_out_min_rad, options_.turn_out_max_rad);
   // Clear of the obstacle's side by the strip's half-width (the robot's and its margin) and a
   // margin, on the side the force points to.
   side_ = theta_rad >= 0.0 ? 1.0 : -1.0;
@@ -137,8 +135,8 @@ double Detour::FirstOffset(const ObstacleExtent& extent, double half_width_m, do
   // The obstacle stands in the watch's strip, somewhere: its side reaches at least the strip's
   // edge unless the image shows it reaching further (its points near an edge are few and often
   // missed: one measured 0.19 m short of the box's edge, from 6 points).
-  const double beyond = std::max(
-      half_width_m, extent.found ? (side > 0.0 ? extent.left_m : -extent.right_m) : 0.0);
+  const double beyond =
+      std::max(half_width_m, extent.found ? (side > 0.0 ? extent.left_m : -extent.right_m) : 0.0);
   return std::max(options_.first_step_m, beyond + half_width_m + options_.margin_m);
 }
 

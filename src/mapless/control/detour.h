@@ -39,21 +39,21 @@
 namespace mapless::control {
 
 struct DetourOptions {
-  double back_off_m = 0.4;        // reversing along the line before stepping aside
+  double back_off_m = 0.4;  // reversing along the line before stepping aside
   // Heading off the line while stepping aside: |theta| of the potential's force, clamped to this
   // range. Steep: each step then brings the robot little closer to the obstacle.
   double turn_out_min_rad = 1.2;
   double turn_out_max_rad = 1.4;
-  double first_step_m = 0.3;      // the first lateral step off the line at least
-  double step_m = 0.2;            // each further step while the way ahead is still blocked
-  double margin_m = 0.1;          // beside the obstacle's extent and the strip's half-width
-  double max_offset_m = 1.5;      // stepping aside farther than this: the detour fails
-  double look_max_m = 0.2;        // creep at most this far for one look ahead
+  double first_step_m = 0.3;         // the first lateral step off the line at least
+  double step_m = 0.2;               // each further step while the way ahead is still blocked
+  double margin_m = 0.1;             // beside the obstacle's extent and the strip's half-width
+  double max_offset_m = 1.5;         // stepping aside farther than this: the detour fails
+  double look_max_m = 0.2;           // creep at most this far for one look ahead
   double look_speed_fraction = 0.5;  // of the speed, while creeping to look
-  double pass_m = 3.0;         // drive past until this far along the line from where it stopped
-  double lookahead_m = 1.0;    // pure pursuit along the offset lane and back to the line
-  double rejoined_m = 0.1;     // this close to the line: done
-  double aligned_rad = 0.03;   // turning in place ends within this of the target heading
+  double pass_m = 3.0;        // drive past until this far along the line from where it stopped
+  double lookahead_m = 1.0;   // pure pursuit along the offset lane and back to the line
+  double rejoined_m = 0.1;    // this close to the line: done
+  double aligned_rad = 0.03;  // turning in place ends within this of the target heading
   double max_omega_radps = 0.6;
   void Validate() const;  // throws InputError naming the field
 };
@@ -66,7 +66,17 @@ enum class AheadView {
   kBlocked,  // confirmed by the watch
 };
 
-enum class DetourPhase { kBackOff, kTurnOut, kStepAside, kTurnBack, kLook, kPass, kRejoin, kDone, kFailed };
+enum class DetourPhase {
+  kBackOff,
+  kTurnOut,
+  kStepAside,
+  kTurnBack,
+  kLook,
+  kPass,
+  kRejoin,
+  kDone,
+  kFailed
+};
 const char* DetourPhaseName(DetourPhase phase);
 
 // The side and angle to step aside by: Eq. 8-16 on the map of the lower image (from row
@@ -74,9 +84,9 @@ const char* DetourPhaseName(DetourPhase phase);
 // ground, with the attraction the desired flow towards theta_d_rad (0: ahead; Eq. 13 with the
 // paper's uniform pure flows). Returns theta of Eq. 16 (positive: to the left); a sigma of half
 // the image (Eq. 9) makes its side component small, but its sign is the side with more ground.
-double DetourAngle(const std::vector<cv::Point2f>& obstacle_px, cv::Size image,
-                   double top_fraction, double point_radius_px,
-                   double theta_d_rad, const VisualPotentialOptions& options);
+double DetourAngle(const std::vector<cv::Point2f>& obstacle_px, cv::Size image, double top_fraction,
+                   double point_radius_px, double theta_d_rad,
+                   const VisualPotentialOptions& options);
 
 // The obstacle's lateral extent (metres, positive to the left of the robot's centre line) from
 // image points, without calibration: the watch's strip is half_width_m on either side of the
@@ -96,9 +106,8 @@ struct ObstacleExtent {
 };
 ObstacleExtent MeasureObstacleExtent(const std::vector<cv::Point2f>& region_px,
                                      const std::vector<cv::Point2f>& off_plane_px, cv::Size image,
-                                     double region_width_fraction,
-                                     double region_top_fraction, double half_width_m,
-                                     double gap_m = 0.15);
+                                     double region_width_fraction, double region_top_fraction,
+                                     double half_width_m, double gap_m = 0.15);
 
 class Detour {
  public:
@@ -111,8 +120,8 @@ class Detour {
   // The command at odometry pose `now`, the watch's view of this frame; `speed_mps`: the route's.
   Twist2 Command(const Pose2& now, AheadView ahead, double speed_mps);
   DetourPhase phase() const { return phase_; }
-  double side() const { return side_; }            // +1: round by the left, -1: by the right
-  double offset_m() const { return offset_m_; }    // the lane's distance off the line
+  double side() const { return side_; }          // +1: round by the left, -1: by the right
+  double offset_m() const { return offset_m_; }  // the lane's distance off the line
   bool finished() const { return phase_ == DetourPhase::kDone || phase_ == DetourPhase::kFailed; }
 
  private:
@@ -127,7 +136,7 @@ class Detour {
   DetourOptions options_;
   double side_ = 1.0;
   double turn_out_rad_ = 0.8;
-  double offset_m_ = 0.0;  // lateral target of the current step, towards side_
+  double offset_m_ = 0.0;             // lateral target of the current step, towards side_
   double other_side_offset_m_ = 0.0;  // the first step's on the other side
   bool tried_other_side_ = false;
   bool look_after_step_ = true;

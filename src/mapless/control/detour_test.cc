@@ -50,7 +50,7 @@ TEST(Detour, GoesRoundABoxOnTheLineAndRejoinsItBeyond) {
     }
     EXPECT_EQ(detour.phase(), DetourPhase::kDone) << "box at y = " << oy;
     EXPECT_GT(closest, kRobotRadius + 0.05) << "box at y = " << oy;
-    EXPECT_GT(pose.x_m, 1.35 + 0.3);           // beyond the box
+    EXPECT_GT(pose.x_m, 1.35 + 0.3);            // beyond the box
     EXPECT_LT(std::abs(pose.y_m), 0.1 + 0.01);  // back on the line
     EXPECT_EQ(detour.side() < 0.0, oy > 0.0);
   }
@@ -64,9 +64,8 @@ TEST(Detour, FailsWhenTheWayStaysBlockedBeyondTheLargestOffset) {
   Twist2 last;
   for (int i = 0; i < 3000 && !detour.finished(); ++i) {
     // A wall across the way: every look is blocked.
-    const AheadView view = last.omega_radps == 0.0 && last.v_mps > 0.0
-                               ? AheadView::kSuspect
-                               : AheadView::kUnknown;
+    const AheadView view =
+        last.omega_radps == 0.0 && last.v_mps > 0.0 ? AheadView::kSuspect : AheadView::kUnknown;
     last = detour.Command(pose, view, 0.3);
     pose = IntegrateTwist(pose, last, 0.1);
   }

@@ -98,14 +98,14 @@ const char kLetters[] = "ABCDE";
 }  // namespace
 
 void SubWindowSteeringOptions::Validate() const {
-  MAPLESS_CHECK(outlier_windows > 0.0,
-                "SubWindowSteeringOptions.outlier_windows = " << outlier_windows << "; must be > 0");
+  MAPLESS_CHECK(outlier_windows > 0.0, "SubWindowSteeringOptions.outlier_windows = "
+                                           << outlier_windows << "; must be > 0");
   MAPLESS_CHECK(outlier_fraction_of_slope >= 0.0,
-                "SubWindowSteeringOptions.outlier_fraction_of_slope = "
-                    << outlier_fraction_of_slope << "; must be >= 0");
-  MAPLESS_CHECK(slope_tolerance > 0.0 && slope_tolerance < 1.0,
-                "SubWindowSteeringOptions.slope_tolerance = " << slope_tolerance
-                                                              << "; must be in (0, 1)");
+                "SubWindowSteeringOptions.outlier_fraction_of_slope = " << outlier_fraction_of_slope
+                                                                        << "; must be >= 0");
+  MAPLESS_CHECK(
+      slope_tolerance > 0.0 && slope_tolerance < 1.0,
+      "SubWindowSteeringOptions.slope_tolerance = " << slope_tolerance << "; must be in (0, 1)");
   MAPLESS_CHECK(min_inliers >= 2,
                 "SubWindowSteeringOptions.min_inliers = " << min_inliers << "; must be >= 2");
   MAPLESS_CHECK(turn_gain_radps_per_px >= 0.0, "SubWindowSteeringOptions.turn_gain_radps_per_px = "
@@ -125,17 +125,17 @@ SubWindowSteering ComputeSubWindowSteering(const std::vector<WindowCorrespondenc
                                            int window_count, int step_px,
                                            const SubWindowSteeringOptions& options) {
   options.Validate();
-  MAPLESS_CHECK(window_count >= 5, "sub-window steering: window_count = " << window_count
-                                                                          << "; must be >= 5");
+  MAPLESS_CHECK(window_count >= 5,
+                "sub-window steering: window_count = " << window_count << "; must be >= 5");
   MAPLESS_CHECK(step_px >= 1, "sub-window steering: step_px = " << step_px << "; must be >= 1");
   SubWindowSteering result;
   const double expected_slope = (window_count - 1) / 4.0;
   const double threshold =
       std::max(options.outlier_windows, options.outlier_fraction_of_slope * expected_slope);
   for (const WindowCorrespondence& m : matches) {
-    MAPLESS_CHECK(m.query >= 0 && m.query < 5 && m.stored >= 0 && m.stored < window_count,
-                  "sub-window steering: correspondence (" << m.query << ", " << m.stored
-                                                          << ") out of range");
+    MAPLESS_CHECK(
+        m.query >= 0 && m.query < 5 && m.stored >= 0 && m.stored < window_count,
+        "sub-window steering: correspondence (" << m.query << ", " << m.stored << ") out of range");
   }
 
   // Step 1: the seven fits of the paper (first 2, 3, 4 windows, all, last 4, 3, 2).
@@ -154,7 +154,8 @@ SubWindowSteering ComputeSubWindowSteering(const std::vector<WindowCorrespondenc
     // Step 4: outliers removed before the final regression.
     Candidate c = FitWithoutOutliers(points, threshold);
     if (!c.ok || c.inliers < options.min_inliers) continue;
-    if (std::abs(c.line.slope - expected_slope) > options.slope_tolerance * expected_slope) continue;
+    if (std::abs(c.line.slope - expected_slope) > options.slope_tolerance * expected_slope)
+      continue;
     c.span = range[1] - range[0] + 1;
     c.name = std::string(1, kLetters[range[0]]) + "-" + std::string(1, kLetters[range[1]]);
     // Step 2: most correspondences, then the lowest residual, then the slope nearest the
@@ -178,8 +179,8 @@ SubWindowSteering ComputeSubWindowSteering(const std::vector<WindowCorrespondenc
                : right_half;
   }
   if (!best.ok) {
-    result.reason = "no consistent sub-window fit (" + std::to_string(matches.size()) +
-                    " correspondences)";
+    result.reason =
+        "no consistent sub-window fit (" + std::to_string(matches.size()) + " correspondences)";
     return result;
   }
 

@@ -8,12 +8,12 @@
 namespace mapless::control {
 
 void VisualPotentialOptions::Validate() const {
-  MAPLESS_CHECK(sigma_fraction > 0.0 && sigma_fraction <= 2.0,
-                "VisualPotentialOptions.sigma_fraction = " << sigma_fraction
-                                                           << "; must be in (0, 2]");
-  MAPLESS_CHECK(work_width_px >= 16 && work_width_px <= 4096,
-                "VisualPotentialOptions.work_width_px = " << work_width_px
-                                                          << "; must be in [16, 4096]");
+  MAPLESS_CHECK(
+      sigma_fraction > 0.0 && sigma_fraction <= 2.0,
+      "VisualPotentialOptions.sigma_fraction = " << sigma_fraction << "; must be in (0, 2]");
+  MAPLESS_CHECK(
+      work_width_px >= 16 && work_width_px <= 4096,
+      "VisualPotentialOptions.work_width_px = " << work_width_px << "; must be in [16, 4096]");
   MAPLESS_CHECK(repulsion_gain >= 0.0,
                 "VisualPotentialOptions.repulsion_gain = " << repulsion_gain << "; must be >= 0");
   MAPLESS_CHECK(max_translation_mps >= 0.0 && max_rotation_radps >= 0.0,
@@ -24,8 +24,7 @@ cv::Mat RepulsionField(const cv::Mat& plane_mask, const VisualPotentialOptions& 
   options.Validate();
   MAPLESS_CHECK(plane_mask.type() == CV_8UC1 && !plane_mask.empty(),
                 "RepulsionField: the dominant-plane map must be a non-empty CV_8UC1 image");
-  const double scale =
-      std::min(1.0, static_cast<double>(options.work_width_px) / plane_mask.cols);
+  const double scale = std::min(1.0, static_cast<double>(options.work_width_px) / plane_mask.cols);
   cv::Mat d;
   plane_mask.convertTo(d, CV_32F);
   cv::Mat small = d;
@@ -80,7 +79,7 @@ cv::Vec2d ControlForce(const cv::Mat& potential, const cv::Rect& roi) {
 PotentialCommand CommandFromForce(const cv::Vec2d& force, const VisualPotentialOptions& options) {
   PotentialCommand c;
   if (std::hypot(force[0], force[1]) < 1e-12) return c;  // no force: stand still
-  c.theta_rad = std::atan2(-force[0], -force[1]);         // from (0, -1), positive to the left
+  c.theta_rad = std::atan2(-force[0], -force[1]);        // from (0, -1), positive to the left
   c.twist.v_mps = options.max_translation_mps * std::cos(c.theta_rad);
   c.twist.omega_radps = options.max_rotation_radps * std::sin(c.theta_rad);
   return c;

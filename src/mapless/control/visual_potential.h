@@ -15,10 +15,10 @@
 namespace mapless::control {
 
 struct VisualPotentialOptions {
-  double sigma_fraction = 0.5;   // Gaussian sigma as a fraction of the image width (Eq. 9: half)
-  int work_width_px = 80;        // the smoothing runs on the map resized to this width (speed; a
-                                 // sigma of half the image makes the result smooth anyway)
-  double repulsion_gain = 1.0;   // weight of g against the flow (1: the paper's Eq. 11)
+  double sigma_fraction = 0.5;  // Gaussian sigma as a fraction of the image width (Eq. 9: half)
+  int work_width_px = 80;       // the smoothing runs on the map resized to this width (speed; a
+                                // sigma of half the image makes the result smooth anyway)
+  double repulsion_gain = 1.0;  // weight of g against the flow (1: the paper's Eq. 11)
   double max_translation_mps = 0.2;  // T_m of Eq. 17
   double max_rotation_radps = 0.5;   // R_m of Eq. 17
   void Validate() const;

@@ -17,7 +17,9 @@ namespace mapless::eval {
 namespace {
 
 // The repeat's default obstacle watch.
-navigation::ObstacleWatchOptions RepeatOptionsWatch() { return navigation::RepeatOptions{}.obstacle; }
+navigation::ObstacleWatchOptions RepeatOptionsWatch() {
+  return navigation::RepeatOptions{}.obstacle;
+}
 
 // A camera-only robot: the frames come without odometry.
 class NoOdometry : public robot::RobotLink {
@@ -79,9 +81,10 @@ void ExpectTheStandardLaneStops(std::uint64_t seed, const navigation::ObstacleWa
   o.repeat.obstacle = watch;
   const RepeatRun run = RepeatOnSimulator(scenario, taught, o);
   EXPECT_FALSE(run.collided) << "seed " << seed << ": " << run.status;
-  EXPECT_TRUE(std::any_of(run.steps.begin(), run.steps.end(), [](const auto& s) {
-    return s.status == navigation::RepeatStatus::kBlocked;
-  })) << "seed " << seed;
+  EXPECT_TRUE(
+      std::any_of(run.steps.begin(), run.steps.end(),
+                  [](const auto& s) { return s.status == navigation::RepeatStatus::kBlocked; }))
+      << "seed " << seed;
   EXPECT_TRUE(run.success) << "seed " << seed << ": " << run.status;
 }
 
@@ -117,8 +120,8 @@ TEST(Avoid, WithoutOdometryTheRobotStopsAsWithStop) {
   EXPECT_TRUE(std::any_of(run.steps.begin(), run.steps.end(), [](const auto& s) {
     return s.status == navigation::RepeatStatus::kBlocked;
   }));
-  EXPECT_TRUE(std::none_of(run.steps.begin(), run.steps.end(),
-                           [](const auto& s) { return s.avoiding; }));
+  EXPECT_TRUE(
+      std::none_of(run.steps.begin(), run.steps.end(), [](const auto& s) { return s.avoiding; }));
 }
 
 }  // namespace

@@ -123,9 +123,9 @@ bool FollowerFrame(sim::Simulation* sim, int robot, navigation::AppearanceFollow
   const cv::Mat image = sim->Render(robot);
   const Pose2 truth = sim->robot(robot).pose();
   run->follower_path.push_back(truth);
-  const navigation::FollowerStep step = follower->Update(
-      camera->Apply(image, ToSeconds(sim->now_ns())), sim->robot(robot).odometry(), route,
-      sim->now_ns());
+  const navigation::FollowerStep step =
+      follower->Update(camera->Apply(image, ToSeconds(sim->now_ns())), sim->robot(robot).odometry(),
+                       route, sim->now_ns());
   metrics->Add(truth, step, image, route, image_truth, run->leader_path, options);
   if (observer) observer(step, truth);
   if (step.state == navigation::FollowerState::kArrived) return true;
@@ -204,8 +204,8 @@ EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario,
           was_blocked = step.obstacle.blocked;
           if (!now.objects.empty()) {
             run.min_clearance_m =
-                std::min(run.min_clearance_m, sim::ClearanceTo(now, truth.x_m, truth.y_m) -
-                                                  scenario.robot.radius_m);
+                std::min(run.min_clearance_m,
+                         sim::ClearanceTo(now, truth.x_m, truth.y_m) - scenario.robot.radius_m);
           }
           run.follower_path.push_back(truth);
           metrics.Add(truth, step, obs.image, *route, image_truth, run.leader_path, options);
@@ -295,7 +295,8 @@ EigenspaceRunOptions EigenspaceEntryOptions(const EigenspaceEntry& entry, std::u
   } else if (e == "no-markov") {
     options.follower.use_markov = false;
   } else if (e == "concurrent") {
-    options.concurrent = true;  } else if (e == "no-recovery") {
+    options.concurrent = true;
+  } else if (e == "no-recovery") {
     options.follower.recover_images = 0;
     options.follower.carry_on.max_distance_m = 0.0;
   } else {

@@ -63,8 +63,8 @@ struct EigenspaceRun {
   int obstacle_stops = 0;
   int stops_at_added_object = 0;
   double min_clearance_m = std::numeric_limits<double>::infinity();
-  std::vector<Pose2> leader_path;        // ground truth
-  std::vector<Pose2> follower_path;      // ground truth
+  std::vector<Pose2> leader_path;    // ground truth
+  std::vector<Pose2> follower_path;  // ground truth
 };
 
 // Called for every follower frame (for logs and debugging).

@@ -22,11 +22,11 @@ const char* FlowMethodName(FlowMethod method);
 // solved at once: the structure tensor and the mismatch vector are box-filtered images, and the
 // 2x2 systems are solved element-wise.
 struct DenseLkOptions {
-  int window = 5;           // side of the square window (odd)
-  int levels = 5;           // pyramid levels 0..levels-1
-  int iterations = 3;       // warping iterations per level
+  int window = 5;          // side of the square window (odd)
+  int levels = 5;          // pyramid levels 0..levels-1
+  int iterations = 3;      // warping iterations per level
   double min_eigen = 0.5;  // smaller eigenvalue of the window-averaged tensor (grey^2/px^2)
-                          // below this: a flat window, no update
+                           // below this: a flat window, no update
   // A 3x3 median of each level's result before it is expanded to the next level. Not in the paper:
   // a 5x5 window leaves isolated wild vectors that the coarse-to-fine expansion spreads.
   bool median = true;

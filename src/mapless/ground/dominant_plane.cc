@@ -11,8 +11,8 @@ namespace mapless::ground {
 namespace {
 
 cv::Rect RoiOf(cv::Size size, double top_fraction) {
-  const int top = std::clamp(static_cast<int>(std::lround(top_fraction * size.height)), 0,
-                             size.height - 1);
+  const int top =
+      std::clamp(static_cast<int>(std::lround(top_fraction * size.height)), 0, size.height - 1);
   return {0, top, size.width, size.height - top};
 }
 
@@ -50,9 +50,9 @@ void DominantPlaneOptions::Validate() const {
                 "DominantPlaneOptions.epsilon_px = " << epsilon_px << "; must be > 0");
   MAPLESS_CHECK(epsilon_relative >= 0.0,
                 "DominantPlaneOptions.epsilon_relative = " << epsilon_relative << "; must be >= 0");
-  MAPLESS_CHECK(sample_step_px >= 1 && sample_step_px <= 64,
-                "DominantPlaneOptions.sample_step_px = " << sample_step_px
-                                                         << "; must be in [1, 64]");
+  MAPLESS_CHECK(
+      sample_step_px >= 1 && sample_step_px <= 64,
+      "DominantPlaneOptions.sample_step_px = " << sample_step_px << "; must be in [1, 64]");
   MAPLESS_CHECK(confidence > 0.0 && confidence < 1.0,
                 "DominantPlaneOptions.confidence = " << confidence << "; must be in (0, 1)");
   MAPLESS_CHECK(fit_bottom_fraction > 0.0 && fit_bottom_fraction <= 1.0,
@@ -60,12 +60,12 @@ void DominantPlaneOptions::Validate() const {
                                                               << "; must be in (0, 1]");
   MAPLESS_CHECK(max_iterations >= 0, "DominantPlaneOptions.max_iterations = "
                                          << max_iterations << "; must be >= 0 (0: the paper's)");
-  MAPLESS_CHECK(roi_top_fraction >= 0.0 && roi_top_fraction < 1.0,
-                "DominantPlaneOptions.roi_top_fraction = " << roi_top_fraction
-                                                           << "; must be in [0, 1)");
-  MAPLESS_CHECK(min_plane_fraction >= 0.0 && min_plane_fraction < 1.0,
-                "DominantPlaneOptions.min_plane_fraction = " << min_plane_fraction
-                                                             << "; must be in [0, 1)");
+  MAPLESS_CHECK(
+      roi_top_fraction >= 0.0 && roi_top_fraction < 1.0,
+      "DominantPlaneOptions.roi_top_fraction = " << roi_top_fraction << "; must be in [0, 1)");
+  MAPLESS_CHECK(
+      min_plane_fraction >= 0.0 && min_plane_fraction < 1.0,
+      "DominantPlaneOptions.min_plane_fraction = " << min_plane_fraction << "; must be in [0, 1)");
   MAPLESS_CHECK(open_px >= 0 && open_px <= 10,
                 "DominantPlaneOptions.open_px = " << open_px << "; must be in [0, 10]");
 }
@@ -109,15 +109,14 @@ DominantPlane DetectDominantPlane(const cv::Mat& flow, const DominantPlaneOption
   const int minimal = options.model == PlaneModel::kAffine ? 3 : 4;
   if (static_cast<int>(from.size()) < 2 * minimal) return result;
   // The paper iterates at most width * height / 2 times; the adaptive count stops far earlier.
-  const int max_iterations = options.max_iterations > 0
-                                 ? options.max_iterations
-                                 : std::max(100, flow.cols * flow.rows / 2);
+  const int max_iterations = options.max_iterations > 0 ? options.max_iterations
+                                                        : std::max(100, flow.cols * flow.rows / 2);
   std::vector<uchar> inliers;
   cv::Mat model;
   if (options.model == PlaneModel::kAffine) {
-    const cv::Mat a = cv::estimateAffine2D(from, to, inliers, cv::RANSAC, options.epsilon_px,
-                                           static_cast<std::size_t>(max_iterations),
-                                           options.confidence, 10);
+    const cv::Mat a =
+        cv::estimateAffine2D(from, to, inliers, cv::RANSAC, options.epsilon_px,
+                             static_cast<std::size_t>(max_iterations), options.confidence, 10);
     if (!a.empty()) {
       model = cv::Mat::eye(3, 3, CV_64F);
       a.copyTo(model.rowRange(0, 2));

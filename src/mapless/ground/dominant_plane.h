@@ -25,7 +25,7 @@ struct DominantPlaneOptions {
   // near zero at the horizon), so a fixed epsilon is too strict below and too loose above
   // (distant buildings, whose flow is as small as the ground's there). 0: the paper's Eq. 5.
   double epsilon_relative = 0.0;
-  int sample_step_px = 4;   // RANSAC draws from flow vectors on this grid
+  int sample_step_px = 4;  // RANSAC draws from flow vectors on this grid
   // RANSAC: adaptive iteration count from the inlier ratio (confidence), capped at the paper's
   // fixed count width * height / 2.
   double confidence = 0.999;
@@ -51,9 +51,9 @@ struct DominantPlaneOptions {
 };
 
 struct DominantPlane {
-  bool found = false;      // false: no plane covers enough of the ROI (e.g. a wall fills the view)
-  cv::Mat mask;            // d(x, y, t): CV_8UC1, 255 on the dominant plane, 0 elsewhere
-  cv::Mat model;           // 3x3 (CV_64F): x' = model * x (affine: last row 0 0 1)
+  bool found = false;  // false: no plane covers enough of the ROI (e.g. a wall fills the view)
+  cv::Mat mask;        // d(x, y, t): CV_8UC1, 255 on the dominant plane, 0 elsewhere
+  cv::Mat model;       // 3x3 (CV_64F): x' = model * x (affine: last row 0 0 1)
   double roi_fraction = 0.0;  // fraction of the ROI on the plane
   int iterations = 0;         // RANSAC iterations used
 };
@@ -74,7 +74,8 @@ struct HierarchicalPlanes {
 HierarchicalPlanes DetectHierarchicalPlanes(const std::vector<cv::Mat>& layer_flows,
                                             const DominantPlaneOptions& options);
 
-// P(A ⊂ B) = |A ∩ B| / |B| for masks (B resized to A's size by nearest neighbour); 1 when B is empty.
+// P(A ⊂ B) = |A ∩ B| / |B| for masks (B resized to A's size by nearest neighbour); 1 when B is
+// empty.
 double InclusionMeasure(const cv::Mat& a, const cv::Mat& b);
 
 // Intersection over union of two 0/255 masks inside `roi` (the whole image when empty).

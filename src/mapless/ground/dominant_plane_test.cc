@@ -61,8 +61,8 @@ TEST(DetectDominantPlane, TheAffineModelRecoversAnAffineFlow) {
 
 TEST(DetectDominantPlane, AWallFillingTheViewIsNoPlane) {
   // 70% of the image (the top, down to near the bottom) moves unlike the ground.
-  const cv::Mat flow = SyntheticFlow(GroundHomography(), cv::Rect(0, 0, 320, 170),
-                                     cv::Vec2f(0.3f, 0.2f));
+  const cv::Mat flow =
+      SyntheticFlow(GroundHomography(), cv::Rect(0, 0, 320, 170), cv::Vec2f(0.3f, 0.2f));
   DominantPlaneOptions options;
   options.epsilon_px = 0.5;
   const DominantPlane plane = DetectDominantPlane(flow, options);
@@ -93,10 +93,10 @@ TEST(MaskIoU, CountsInsideTheRoi) {
   EXPECT_DOUBLE_EQ(MaskIoU(a, b, cv::Rect(0, 3, 4, 1)), 1.0);
 }
 
-// Real data: CamVid, a car camera in town with hand-labelled road and pavement (shared data folder).
-// The configuration of `mapless ground`: DIS medium, homography, epsilon 0.4 px + 0.4 |u_hat|,
-// bottom-half ROI, RANSAC on the bottom half of it; IoU over the bottom half, mean over all 50
-// consecutive pairs (measured 0.803; the issue asks for more than 0.8).
+// Real data: CamVid, a car camera in town with hand-labelled road and pavement (shared data
+// folder). The configuration of `mapless ground`: DIS medium, homography, epsilon 0.4 px + 0.4
+// |u_hat|, bottom-half ROI, RANSAC on the bottom half of it; IoU over the bottom half, mean over
+// all 50 consecutive pairs (measured 0.803; the issue asks for more than 0.8).
 TEST(DetectDominantPlane, CamVidGroundIoU) {
   const std::string dir = std::string(MAPLESS_SOURCE_DIR) + "/../shared/data/camvid_seq";
   if (!std::filesystem::exists(dir + "/frames")) GTEST_SKIP() << "shared data not found at " << dir;

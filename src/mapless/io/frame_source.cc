@@ -16,7 +16,6 @@
 namespace mapless::io {
 namespace {
 
-
 cv::Mat ToGrey(const cv::Mat& in) {
   if (in.channels() == 1) return in;
   cv::Mat grey;

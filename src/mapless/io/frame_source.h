@@ -12,9 +12,9 @@
 namespace mapless::io {
 
 struct Frame {
-  cv::Mat image;       // CV_8UC1
-  Timestamp t_ns = 0;  // from the video's frame times, or index / fps for folders
-  std::string name;    // file name (folders) or frame number
+  cv::Mat image;                  // CV_8UC1
+  Timestamp t_ns = 0;             // from the video's frame times, or index / fps for folders
+  std::string name;               // file name (folders) or frame number
   std::optional<Pose2> odometry;  // the wheel odometry at the frame (recordings that have it)
 };
 

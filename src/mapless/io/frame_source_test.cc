@@ -4,7 +4,6 @@
 
 #include <cstdio>
 #include <filesystem>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -54,7 +53,8 @@ TEST(FrameSource, FolderWithAnImageOfAnotherSizeNamesIt) {
   auto source = OpenFrameSource(dir);
   Frame f;
   ASSERT_TRUE(source->Next(&f));
-  EXPECT_NE(testing::InputErrorOf([&] { source->Next(&f); }).find("b.png: image is 32x32"), std::string::npos);
+  EXPECT_NE(testing::InputErrorOf([&] { source->Next(&f); }).find("b.png: image is 32x32"),
+            std::string::npos);
 }
 
 TEST(FrameSource, VideoFileFramesAreReadInOrder) {
@@ -78,18 +78,22 @@ TEST(FrameSource, VideoFileFramesAreReadInOrder) {
 }
 
 TEST(FrameSource, MissingOrEmptySourcesGiveOneClearError) {
-  EXPECT_NE(testing::InputErrorOf([] { OpenFrameSource("/nonexistent/video.mp4"); }).find("no such file"),
-            std::string::npos);
+  EXPECT_NE(
+      testing::InputErrorOf([] { OpenFrameSource("/nonexistent/video.mp4"); }).find("no such file"),
+      std::string::npos);
   const std::string empty = FreshDir("empty");
-  EXPECT_NE(testing::InputErrorOf([&] { OpenFrameSource(empty); }).find("no image files"), std::string::npos);
+  EXPECT_NE(testing::InputErrorOf([&] { OpenFrameSource(empty); }).find("no image files"),
+            std::string::npos);
   const std::string junk = FreshDir("junk") + "/junk.mp4";
   {
     std::FILE* f = std::fopen(junk.c_str(), "w");
     std::fputs("not a video", f);
     std::fclose(f);
   }
-  EXPECT_NE(testing::InputErrorOf([&] { OpenFrameSource(junk); }).find("cannot open video"), std::string::npos);
-  EXPECT_NE(testing::InputErrorOf([] { OpenFrameSource("camera:x"); }).find("camera:N"), std::string::npos);
+  EXPECT_NE(testing::InputErrorOf([&] { OpenFrameSource(junk); }).find("cannot open video"),
+            std::string::npos);
+  EXPECT_NE(testing::InputErrorOf([] { OpenFrameSource("camera:x"); }).find("camera:N"),
+            std::string::npos);
 }
 
 }  // namespace

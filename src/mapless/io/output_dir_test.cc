@@ -38,10 +38,13 @@ TEST(OutputDirectory, WhatIsThereIsReplacedOnlyWhenAskedAndOnlyOnCommit) {
   const std::string dir = Fresh("replace");
   MakeDirectories(dir);
   WriteFileAtomic(dir + "/old.txt", "old");
-  EXPECT_NE(testing::InputErrorOf([&] { OutputDirectory(dir, false, "route", "old.txt"); }).find("not empty"),
+  EXPECT_NE(testing::InputErrorOf([&] {
+              OutputDirectory(dir, false, "route", "old.txt");
+            }).find("not empty"),
             std::string::npos);
-  EXPECT_NE(testing::InputErrorOf([&] { OutputDirectory(dir, true, "route", "manifest.json"); })
-                .find("holds something else than a route (no manifest.json)"),
+  EXPECT_NE(testing::InputErrorOf([&] {
+              OutputDirectory(dir, true, "route", "manifest.json");
+            }).find("holds something else than a route (no manifest.json)"),
             std::string::npos);
   {
     OutputDirectory out(dir, true, "route", "old.txt");
@@ -78,7 +81,9 @@ TEST(OutputDirectory, ASecondWriterIsRefusedWhileTheFirstHoldsTheDirectory) {
 TEST(OutputDirectory, AFileIsNotADirectory) {
   const std::string file = Fresh("file");
   WriteFileAtomic(file, "x");
-  EXPECT_NE(testing::InputErrorOf([&] { OutputDirectory(file, true, "route", "a.txt"); }).find("is a file"),
+  EXPECT_NE(testing::InputErrorOf([&] {
+              OutputDirectory(file, true, "route", "a.txt");
+            }).find("is a file"),
             std::string::npos);
 }
 

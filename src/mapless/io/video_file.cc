@@ -80,8 +80,9 @@ class FfmpegVideo : public FrameSource {
     const int opened = avformat_open_input(&format, path.c_str(), nullptr, &options);
     av_dict_free(&options);
     if (opened < 0) {
-      Fail(": cannot open video (missing file, or not a video in a container mapless reads: "
-           "AVI, MP4/MOV, MKV/WebM, MPEG-TS/PS, FLV, Ogg, ASF, raw MJPEG/H.264/H.265)");
+      Fail(
+          ": cannot open video (missing file, or not a video in a container mapless reads: "
+          "AVI, MP4/MOV, MKV/WebM, MPEG-TS/PS, FLV, Ogg, ASF, raw MJPEG/H.264/H.265)");
     }
     format_.reset(format);
     if (avformat_find_stream_info(format_.get(), nullptr) < 0) {
@@ -127,15 +128,15 @@ class FfmpegVideo : public FrameSource {
     size_ = size;
     // Converted at the decoded frame's own size, into a buffer of that size.
     scaler_.reset(sws_getCachedContext(scaler_.release(), frame_->width, frame_->height,
-                                   static_cast<AVPixelFormat>(frame_->format), frame_->width,
-                                   frame_->height, AV_PIX_FMT_GRAY8, SWS_BILINEAR, nullptr,
-                                   nullptr, nullptr));
+                                       static_cast<AVPixelFormat>(frame_->format), frame_->width,
+                                       frame_->height, AV_PIX_FMT_GRAY8, SWS_BILINEAR, nullptr,
+                                       nullptr, nullptr));
     if (!scaler_) throw InputError(name + ": a pixel format mapless cannot convert");
     cv::Mat grey(frame_->height, frame_->width, CV_8UC1);
     std::uint8_t* planes[4] = {grey.data, nullptr, nullptr, nullptr};
     const int strides[4] = {static_cast<int>(grey.step), 0, 0, 0};
-    if (sws_scale(scaler_.get(), frame_->data, frame_->linesize, 0, frame_->height, planes, strides) !=
-        frame_->height) {
+    if (sws_scale(scaler_.get(), frame_->data, frame_->linesize, 0, frame_->height, planes,
+                  strides) != frame_->height) {
       throw InputError(name + ": the frame does not convert to grey");
     }
     out->image = grey;

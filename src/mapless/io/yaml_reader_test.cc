@@ -67,9 +67,8 @@ TEST(YamlMap, AsDoublesChecksEachElement) {
 }
 
 TEST(YamlMap, WithYamlErrorsTurnsYamlCppExceptionsIntoInputErrors) {
-  const std::string err = testing::InputErrorOf([] {
-    WithYamlErrors("x.yaml", [] { return YAML::Load("a: [1]")["a"].as<int>(); });
-  });
+  const std::string err = testing::InputErrorOf(
+      [] { WithYamlErrors("x.yaml", [] { return YAML::Load("a: [1]")["a"].as<int>(); }); });
   EXPECT_NE(err.find("x.yaml:1:"), std::string::npos) << err;
 }
 

@@ -11,9 +11,9 @@ namespace mapless::localization {
 void ClusteringOptions::Validate() const {
   MAPLESS_CHECK(join_distance_images > 0.0, "ClusteringOptions.join_distance_images = "
                                                 << join_distance_images << "; must be > 0");
-  MAPLESS_CHECK(min_member_fraction >= 0.0 && min_member_fraction <= 1.0,
-                "ClusteringOptions.min_member_fraction = " << min_member_fraction
-                                                           << "; must be in [0, 1]");
+  MAPLESS_CHECK(
+      min_member_fraction >= 0.0 && min_member_fraction <= 1.0,
+      "ClusteringOptions.min_member_fraction = " << min_member_fraction << "; must be in [0, 1]");
 }
 
 InitialLocalization LocalizeByClustering(const std::vector<int>& localizations,
@@ -45,7 +45,8 @@ InitialLocalization LocalizeByClustering(const std::vector<int>& localizations,
     cluster.centre = sum / static_cast<double>(cluster.members.size());
   }
   std::size_t largest = 0;
-  for (const Cluster& cluster : result.clusters) largest = std::max(largest, cluster.members.size());
+  for (const Cluster& cluster : result.clusters)
+    largest = std::max(largest, cluster.members.size());
   const double min_members = options.min_member_fraction * static_cast<double>(largest);
   double best_variance = std::numeric_limits<double>::infinity();
   for (std::size_t c = 0; c < result.clusters.size(); ++c) {
@@ -59,7 +60,8 @@ InitialLocalization LocalizeByClustering(const std::vector<int>& localizations,
     const bool better =
         cluster.variance < best_variance ||
         (cluster.variance == best_variance &&
-         cluster.members.size() > result.clusters[static_cast<std::size_t>(result.chosen)].members.size());
+         cluster.members.size() >
+             result.clusters[static_cast<std::size_t>(result.chosen)].members.size());
     if (better) {
       best_variance = cluster.variance;
       result.chosen = static_cast<int>(c);
@@ -72,7 +74,8 @@ InitialLocalization LocalizeByClustering(const std::vector<int>& localizations,
     return result;
   }
   result.ok = true;
-  result.index = static_cast<int>(std::lround(result.clusters[static_cast<std::size_t>(result.chosen)].centre));
+  result.index = static_cast<int>(
+      std::lround(result.clusters[static_cast<std::size_t>(result.chosen)].centre));
   return result;
 }
 

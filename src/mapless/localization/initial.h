@@ -22,16 +22,16 @@ struct ClusteringOptions {
 };
 
 struct Cluster {
-  double centre = 0.0;          // route index (mean of the members)
-  std::vector<int> members;     // localizations (route indices)
-  double variance = 0.0;        // of the members' distance to the centre, images²
+  double centre = 0.0;       // route index (mean of the members)
+  std::vector<int> members;  // localizations (route indices)
+  double variance = 0.0;     // of the members' distance to the centre, images²
 };
 
 struct InitialLocalization {
   bool ok = false;
-  std::string reason;    // when !ok
-  int index = -1;        // route image of the chosen cluster's centre
-  int chosen = -1;       // which cluster
+  std::string reason;  // when !ok
+  int index = -1;      // route image of the chosen cluster's centre
+  int chosen = -1;     // which cluster
   std::vector<Cluster> clusters;
 };
 

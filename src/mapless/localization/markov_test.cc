@@ -205,7 +205,7 @@ TEST(MarkovLocalizer, PredictionAloneMovesTheBeliefByTheAdvanceAndNeverLosesIt) 
   }
   EXPECT_EQ(by_advance.status, LocalizationStatus::kTracking);
   EXPECT_NEAR(by_advance.index, 30, 1);
-  EXPECT_LT(by_advance.probability, 0.5);  // spread by the motion model
+  EXPECT_LT(by_advance.probability, 0.5);            // spread by the motion model
   EXPECT_LT(by_images.index, by_advance.index - 3);  // held back by the view of place 10
   EXPECT_GT(lost, 0);
   // The limits hold too.

@@ -10,9 +10,9 @@ namespace mapless::localization {
 std::vector<Neighbour> NearestProjections(const Eigen::MatrixXf& projections,
                                           const Eigen::VectorXf& query, int k) {
   MAPLESS_CHECK(k >= 1, "nearest projections: k = " << k << "; must be >= 1");
-  MAPLESS_CHECK(projections.rows() == query.size(),
-                "nearest projections: query of " << query.size() << " components, route of "
-                                                 << projections.rows());
+  MAPLESS_CHECK(projections.rows() == query.size(), "nearest projections: query of "
+                                                        << query.size() << " components, route of "
+                                                        << projections.rows());
   const int n = static_cast<int>(projections.cols());
   std::vector<Neighbour> all(static_cast<std::size_t>(n));
   const Eigen::VectorXf squared = (projections.colwise() - query).colwise().squaredNorm();
@@ -21,7 +21,8 @@ std::vector<Neighbour> NearestProjections(const Eigen::MatrixXf& projections,
     return a.distance != b.distance ? a.distance < b.distance : a.index < b.index;
   };
   const std::size_t keep = std::min(all.size(), static_cast<std::size_t>(k));
-  std::partial_sort(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(keep), all.end(), nearer);
+  std::partial_sort(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(keep), all.end(),
+                    nearer);
   all.resize(keep);
   for (Neighbour& neighbour : all) neighbour.distance = std::sqrt(neighbour.distance);
   return all;

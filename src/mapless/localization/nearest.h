@@ -9,7 +9,7 @@
 namespace mapless::localization {
 
 struct Neighbour {
-  int index = -1;        // route image (column of the projections)
+  int index = -1;         // route image (column of the projections)
   float distance = 0.0F;  // Euclidean distance in the eigenspace
 };
 

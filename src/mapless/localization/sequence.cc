@@ -17,11 +17,11 @@ void SequenceLocalizationOptions::Validate() const {
   image.Validate();
   pca.Validate();
   markov.Validate();
-  MAPLESS_CHECK(std::isfinite(advance_per_query) && advance_per_query >= 0.0,
-                "SequenceLocalizationOptions.advance_per_query = " << advance_per_query
-                                                                    << "; must be >= 0");
-  MAPLESS_CHECK(advance_sigma > 0.0, "SequenceLocalizationOptions.advance_sigma = "
-                                         << advance_sigma << "; must be > 0");
+  MAPLESS_CHECK(
+      std::isfinite(advance_per_query) && advance_per_query >= 0.0,
+      "SequenceLocalizationOptions.advance_per_query = " << advance_per_query << "; must be >= 0");
+  MAPLESS_CHECK(advance_sigma > 0.0,
+                "SequenceLocalizationOptions.advance_sigma = " << advance_sigma << "; must be > 0");
 }
 
 appearance::Eigenspace BuildRouteEigenspace(const std::vector<cv::Mat>& database,
@@ -31,13 +31,15 @@ appearance::Eigenspace BuildRouteEigenspace(const std::vector<cv::Mat>& database
                 "localization: the database needs at least 2 images, got " << database.size());
   if (options.incremental_pca) {
     appearance::IncrementalPca pca(options.pca);
-    for (const cv::Mat& image : database) pca.Add(appearance::AppearanceVector(image, options.image));
+    for (const cv::Mat& image : database)
+      pca.Add(appearance::AppearanceVector(image, options.image));
     return pca.Model();
   }
   appearance::Matrix data(static_cast<Eigen::Index>(options.image.width) * options.image.height,
                           static_cast<Eigen::Index>(database.size()));
   for (std::size_t i = 0; i < database.size(); ++i) {
-    data.col(static_cast<Eigen::Index>(i)) = appearance::AppearanceVector(database[i], options.image);
+    data.col(static_cast<Eigen::Index>(i)) =
+        appearance::AppearanceVector(database[i], options.image);
   }
   return appearance::BatchPcaSvd(data, options.pca.max_dimensions);
 }
@@ -54,7 +56,8 @@ std::vector<QueryLocalization> LocalizeSequence(const appearance::Eigenspace& ro
   MarkovLocalizer markov(markov_options);
   markov.ResetUniform(route.images());
   for (std::size_t i = 0; i < queries.size(); ++i) {
-    const appearance::Vector z = route.Project(appearance::AppearanceVector(queries[i], options.image));
+    const appearance::Vector z =
+        route.Project(appearance::AppearanceVector(queries[i], options.image));
     QueryLocalization q;
     if (options.method == SequenceMethod::kNearest) {
       const std::vector<Neighbour> nn = NearestProjections(route.projections, z, 2);
@@ -64,7 +67,8 @@ std::vector<QueryLocalization> LocalizeSequence(const appearance::Eigenspace& ro
                           : 1.0;
       q.status = LocalizationStatus::kTracking;
     } else {
-      const Localization loc = markov.Update(route.projections, z, i == 0 ? 0.0 : options.advance_per_query);
+      const Localization loc =
+          markov.Update(route.projections, z, i == 0 ? 0.0 : options.advance_per_query);
       q.index = loc.index;
       q.probability = loc.probability;
       q.status = loc.status;

@@ -23,10 +23,10 @@ struct SequenceLocalizationOptions {
   SequenceMethod method = SequenceMethod::kMarkov;
   appearance::AppearanceImageOptions image;
   appearance::IncrementalPcaOptions pca;
-  bool incremental_pca = true;      // false: batch PCA (SVD) with pca.max_dimensions components
+  bool incremental_pca = true;  // false: batch PCA (SVD) with pca.max_dimensions components
   MarkovOptions markov;
-  double advance_per_query = 1.0;   // Markov motion model: database images per query image ...
-  double advance_sigma = 0.2;       // ... and its standard deviation per query, images
+  double advance_per_query = 1.0;  // Markov motion model: database images per query image ...
+  double advance_sigma = 0.2;      // ... and its standard deviation per query, images
   void Validate() const;
 };
 

@@ -21,7 +21,8 @@ bool LoadNordland(Nordland* data) {
   const fs::path root = fs::path(MAPLESS_SOURCE_DIR) / ".." / "shared" / "data" / "nordland_64x32";
   if (!fs::is_directory(root / "summer")) return false;
   std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(root / "summer")) names.push_back(e.path().filename().string());
+  for (const auto& e : fs::directory_iterator(root / "summer"))
+    names.push_back(e.path().filename().string());
   std::sort(names.begin(), names.end());
   for (const std::string& n : names) {
     data->summer.push_back(cv::imread((root / "summer" / n).string(), cv::IMREAD_GRAYSCALE));
@@ -32,7 +33,8 @@ bool LoadNordland(Nordland* data) {
 
 double FractionWithin(const std::vector<QueryLocalization>& r, int tolerance) {
   int ok = 0;
-  for (std::size_t i = 0; i < r.size(); ++i) ok += std::abs(r[i].index - static_cast<int>(i)) <= tolerance;
+  for (std::size_t i = 0; i < r.size(); ++i)
+    ok += std::abs(r[i].index - static_cast<int>(i)) <= tolerance;
   return static_cast<double>(ok) / static_cast<double>(r.size());
 }
 

@@ -176,9 +176,8 @@ void AppearanceFollowerOptions::Validate() const {
                                                << arrive_within_images << "; must be >= 0");
   MAPLESS_CHECK(wait_within_images >= 0, "AppearanceFollowerOptions.wait_within_images = "
                                              << wait_within_images << "; must be >= 0");
-  MAPLESS_CHECK(carry_on_heading_frames >= 1,
-                "AppearanceFollowerOptions.carry_on_heading_frames = "
-                    << carry_on_heading_frames << "; must be >= 1");
+  MAPLESS_CHECK(carry_on_heading_frames >= 1, "AppearanceFollowerOptions.carry_on_heading_frames = "
+                                                  << carry_on_heading_frames << "; must be >= 1");
   MAPLESS_CHECK(recover_images >= 0, "AppearanceFollowerOptions.recover_images = "
                                          << recover_images << "; must be >= 0");
   carry_on.Validate();

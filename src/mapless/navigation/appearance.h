@@ -151,7 +151,7 @@ struct AppearanceFollowerOptions {
   int recover_images = 10;
   int carry_on_heading_frames = 60;
   control::TaughtPathOptions carry_on;
-  CameraCheckOptions camera;     // camera faults: stop until the images are usable again
+  CameraCheckOptions camera;  // camera faults: stop until the images are usable again
   // Obstacle watch (not in the paper; obstacle_watch.h), as in the repeat: something on the way
   // ahead stops the follower (kStopped, the reason says so) until it is gone. On by default;
   // enabled = false: the paper's follower. The route has no features, so everything off the

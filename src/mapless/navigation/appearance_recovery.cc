@@ -20,15 +20,15 @@ bool AppearanceFollower::SteerTowards(const std::vector<int>& targets, const cv:
       matches.push_back({m.query, m.stored});
     }
     step->target = target;
-    step->steering = control::ComputeSubWindowSteering(
-        matches, image_j.windows.windows(), options_.windows.step_px, options_.steering);
+    step->steering = control::ComputeSubWindowSteering(matches, image_j.windows.windows(),
+                                                       options_.windows.step_px, options_.steering);
     if (step->steering.ok) return true;
   }
   return false;
 }
 
-bool AppearanceFollower::Recover(int ahead, const cv::Mat& low,
-                                 const route::AppearanceRoute& route, FollowerStep* step) const {
+bool AppearanceFollower::Recover(int ahead, const cv::Mat& low, const route::AppearanceRoute& route,
+                                 FollowerStep* step) const {
   if (options_.recover_images <= 0 || !options_.use_markov) return false;
   // Route image j is the one ahead from place j - lookahead_images: try them by the belief
   // there, the nearer first among equals.

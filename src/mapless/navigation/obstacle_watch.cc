@@ -76,7 +76,7 @@ void ObstacleWatchOptions::Validate() const {
   MAPLESS_CHECK(region_width > 0.0 && region_width <= 1.0,
                 "ObstacleWatchOptions.region_width = " << region_width << "; must be in (0, 1]");
   MAPLESS_CHECK(region_half_width_m > 0.0, "ObstacleWatchOptions.region_half_width_m = "
-                                                << region_half_width_m << "; must be > 0");
+                                               << region_half_width_m << "; must be > 0");
   MAPLESS_CHECK(horizon >= 0.0 && horizon < region_top,
                 "ObstacleWatchOptions.horizon = " << horizon << "; must be in [0, region_top = "
                                                   << region_top << ")");
@@ -362,7 +362,8 @@ ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, const std::vector<cv::Mat
     cv::calcOpticalFlowPyrLK(earlier->pyramid, pyramid, candidates_there, back, ok_back, err,
                              window, options_.levels, stop, 0, options_.min_eigen);
     for (std::size_t c = 0; c < candidates.size(); ++c) {
-      const bool right = ok_back[c] && cv::norm(back[c] - candidates[c]) <= options_.max_round_trip_px;
+      const bool right =
+          ok_back[c] && cv::norm(back[c] - candidates[c]) <= options_.max_round_trip_px;
       if (right) check.off_plane_px.push_back(candidates[c]);
       if (!candidate_in_region[c]) continue;
       if (right) {

@@ -108,8 +108,8 @@ struct ObstacleWatchOptions {
 };
 
 struct ObstacleCheck {
-  bool observed = false;          // two frames far enough apart were compared this frame
-  bool plane_found = false;       // the ground's homography was fitted (observed frames only)
+  bool observed = false;     // two frames far enough apart were compared this frame
+  bool plane_found = false;  // the ground's homography was fitted (observed frames only)
   // Two frames were compared, with tracked points in the bottom rows, but they fit no ground
   // plane: a wall or a large object fills the view (not observed: the region is not measured).
   bool no_ground = false;

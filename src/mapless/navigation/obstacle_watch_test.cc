@@ -2,10 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/imgproc.hpp>
 
 #include "mapless/sim/simulation.h"
 
@@ -63,8 +62,8 @@ WatchRun DriveAt(double box_x, double box_leaves_s, double drive_s, std::uint64_
       grey = image;
     }
     const double dt = i > 0 ? period : 0.0;
-    const ObstacleCheck c = watch.Update(grey, FromSeconds(i * period), command.v_mps * dt,
-                                         command.omega_radps * dt);
+    const ObstacleCheck c =
+        watch.Update(grey, FromSeconds(i * period), command.v_mps * dt, command.omega_radps * dt);
     if (c.observed) ++out.observed;
     if (c.observed && out.first_blocked < 0)
       out.max_fraction = std::max(out.max_fraction, c.blocked_fraction);

@@ -10,9 +10,9 @@ namespace mapless::navigation {
 namespace {
 
 cv::Mat Grey(const cv::Mat& image) {
-  MAPLESS_CHECK(!image.empty() && image.depth() == CV_8U &&
-                    (image.channels() == 1 || image.channels() == 3),
-                "PotentialNavigator: expected a non-empty 8-bit grey or BGR image");
+  MAPLESS_CHECK(
+      !image.empty() && image.depth() == CV_8U && (image.channels() == 1 || image.channels() == 3),
+      "PotentialNavigator: expected a non-empty 8-bit grey or BGR image");
   if (image.channels() == 1) return image.clone();
   cv::Mat grey;
   cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
@@ -31,8 +31,8 @@ double MeanMagnitude(const cv::Mat& field) {
 
 cv::Mat CalibratePlanarModel(const std::vector<cv::Mat>& frames, const flow::FlowOptions& flow,
                              const ground::DominantPlaneOptions& plane) {
-  MAPLESS_CHECK(frames.size() >= 2, "planar-flow calibration needs at least two frames, got "
-                                        << frames.size());
+  MAPLESS_CHECK(frames.size() >= 2,
+                "planar-flow calibration needs at least two frames, got " << frames.size());
   cv::Mat sum = cv::Mat::zeros(3, 3, CV_64F);
   int count = 0;
   for (std::size_t i = 1; i < frames.size(); ++i) {
@@ -74,9 +74,9 @@ void PotentialNavOptions::Validate() const {
   MAPLESS_CHECK(creep_fraction > 0.0 && creep_fraction <= 1.0,
                 "PotentialNavOptions.creep_fraction = " << creep_fraction << "; must be in (0, 1]");
   MAPLESS_CHECK(min_motion_m >= 0.0, "PotentialNavOptions.min_motion_m must be >= 0");
-  MAPLESS_CHECK(search_step_rad > 0.0 && search_step_rad <= kPi,
-                "PotentialNavOptions.search_step_rad = " << search_step_rad
-                                                         << "; must be in (0, pi]");
+  MAPLESS_CHECK(
+      search_step_rad > 0.0 && search_step_rad <= kPi,
+      "PotentialNavOptions.search_step_rad = " << search_step_rad << "; must be in (0, pi]");
   MAPLESS_CHECK(search_rate_fraction > 0.0 && search_rate_fraction <= 1.0,
                 "PotentialNavOptions.search_rate_fraction must be in (0, 1]");
   MAPLESS_CHECK(max_search_steps >= 1, "PotentialNavOptions.max_search_steps must be >= 1");
@@ -89,26 +89,31 @@ void PotentialNavOptions::Validate() const {
                 "PotentialNavOptions.ahead_rows and ahead_cols must be in (0, 1]");
   MAPLESS_CHECK(plane_scale > 0.0 && plane_scale <= 1.0,
                 "PotentialNavOptions.plane_scale = " << plane_scale << "; must be in (0, 1]");
-  MAPLESS_CHECK(potential_width_px >= 16,
-                "PotentialNavOptions.potential_width_px = " << potential_width_px
-                                                            << "; must be >= 16");
+  MAPLESS_CHECK(potential_width_px >= 16, "PotentialNavOptions.potential_width_px = "
+                                              << potential_width_px << "; must be >= 16");
   MAPLESS_CHECK(plane_noise_fraction >= 0.0 && plane_noise_fraction <= 1.0,
                 "PotentialNavOptions.plane_noise_fraction must be in [0, 1]");
   MAPLESS_CHECK(force_filter > 0.0 && force_filter <= 1.0,
                 "PotentialNavOptions.force_filter = " << force_filter << "; must be in (0, 1]");
-  MAPLESS_CHECK(misses_before_search >= 1,
-                "PotentialNavOptions.misses_before_search must be >= 1");
+  MAPLESS_CHECK(misses_before_search >= 1, "PotentialNavOptions.misses_before_search must be >= 1");
 }
 
 const char* PotentialStatusName(PotentialStatus s) {
   switch (s) {
-    case PotentialStatus::kDriving: return "driving";
-    case PotentialStatus::kLooking: return "looking";
-    case PotentialStatus::kSearching: return "searching";
-    case PotentialStatus::kTurningAround: return "turning_around";
-    case PotentialStatus::kArrived: return "arrived";
-    case PotentialStatus::kAborted: return "aborted";
-    case PotentialStatus::kCameraFault: return "camera_fault";
+    case PotentialStatus::kDriving:
+      return "driving";
+    case PotentialStatus::kLooking:
+      return "looking";
+    case PotentialStatus::kSearching:
+      return "searching";
+    case PotentialStatus::kTurningAround:
+      return "turning_around";
+    case PotentialStatus::kArrived:
+      return "arrived";
+    case PotentialStatus::kAborted:
+      return "aborted";
+    case PotentialStatus::kCameraFault:
+      return "camera_fault";
   }
   return "?";
 }
@@ -125,16 +130,17 @@ PotentialNavigator::PotentialNavigator(PlanarFlowCalibration calibration,
   translational_flow_ = ground::PlanarFlow(calibration_.translational, size);
   rotational_flow_ = ground::PlanarFlow(calibration_.rotational, size);
   flow_scale_ = MeanMagnitude(translational_flow_);
-  MAPLESS_CHECK(flow_scale_ > 1e-3, "PlanarFlowCalibration.translational: the calibrated "
-                                    "forward flow is zero (did the robot move?)");
+  MAPLESS_CHECK(flow_scale_ > 1e-3,
+                "PlanarFlowCalibration.translational: the calibrated "
+                "forward flow is zero (did the robot move?)");
   translational_flow_ /= flow_scale_;
   // The rotational field keeps its size relative to the translational one per unit of speed:
   // Eq. 13 mixes them as unit motions, so normalise it to the same mean magnitude.
   rotational_flow_ /= MeanMagnitude(rotational_flow_);
   const int w = std::min(options_.potential_width_px, calibration_.width);
-  work_size_ = cv::Size(w, std::max(1, static_cast<int>(std::lround(
-                                           static_cast<double>(calibration_.height) * w /
-                                           calibration_.width))));
+  work_size_ = cv::Size(
+      w, std::max(1, static_cast<int>(std::lround(static_cast<double>(calibration_.height) * w /
+                                                  calibration_.width))));
   cv::resize(translational_flow_, translational_flow_, work_size_, 0, 0, cv::INTER_AREA);
   cv::resize(rotational_flow_, rotational_flow_, work_size_, 0, 0, cv::INTER_AREA);
 }
@@ -175,9 +181,9 @@ double PotentialNavigator::GroundMismatch(const cv::Mat& model, const Pose2& mot
 }
 
 double PotentialNavigator::AvoidanceDirection(const Pose2& odometry, double theta_rad) {
-  const bool recent = have_avoided_ && std::hypot(odometry.x_m - avoided_at_.x_m,
-                                                  odometry.y_m - avoided_at_.y_m) <
-                                           options_.escape_distance_m;
+  const bool recent =
+      have_avoided_ && std::hypot(odometry.x_m - avoided_at_.x_m, odometry.y_m - avoided_at_.y_m) <
+                           options_.escape_distance_m;
   if (!recent) avoid_direction_ = theta_rad < 0.0 ? -1.0 : 1.0;
   have_avoided_ = true;
   avoided_at_ = odometry;
@@ -204,8 +210,8 @@ PotentialStep PotentialNavigator::Search(PotentialStep step, const Pose2& odomet
   }
   step.status = status_;
   step.reason = why + ": stopped, turning in place to look for free ground";
-  step.command = {0.0, turn_direction_ * options_.search_rate_fraction *
-                           options_.potential.max_rotation_radps};
+  step.command = {
+      0.0, turn_direction_ * options_.search_rate_fraction * options_.potential.max_rotation_radps};
   return step;
 }
 
@@ -289,8 +295,8 @@ PotentialStep PotentialNavigator::Decide(const cv::Mat& image, const Pose2& odom
   }
 
   // The plane is observable only when the camera translated between the two frames.
-  const double moved = std::hypot(odometry.x_m - previous_odometry_.x_m,
-                                  odometry.y_m - previous_odometry_.y_m);
+  const double moved =
+      std::hypot(odometry.x_m - previous_odometry_.x_m, odometry.y_m - previous_odometry_.y_m);
   if (!previous_.empty() && moved < options_.min_motion_m &&
       last_plane_fraction_ < options_.full_speed_plane_fraction) {
     // Stopped with an obstacle in view (a force pointing back, a potential minimum): creeping on
@@ -318,8 +324,7 @@ PotentialStep PotentialNavigator::Decide(const cv::Mat& image, const Pose2& odom
   if (options_.plane_scale < 1.0) {
     // The plane on a coarser flow field: the field is averaged down and its vectors (and the
     // tolerance, and the RANSAC grid) are scaled to the coarse pixels.
-    cv::resize(flow, flow, cv::Size(), options_.plane_scale, options_.plane_scale,
-               cv::INTER_AREA);
+    cv::resize(flow, flow, cv::Size(), options_.plane_scale, options_.plane_scale, cv::INTER_AREA);
     flow *= options_.plane_scale;
     plane_options.epsilon_px *= options_.plane_scale;
     plane_options.sample_step_px = std::max(
@@ -397,14 +402,13 @@ PotentialStep PotentialNavigator::Decide(const cv::Mat& image, const Pose2& odom
   control::VisualPotentialOptions potential_options = options_.potential;
   potential_options.work_width_px = std::min(d.cols, options_.potential.work_width_px);
   // g per pixel of the full image (the gain is tuned in those units).
-  const cv::Mat repulsion = control::RepulsionField(d, potential_options) *
-                            (static_cast<double>(d.cols) / grey.cols);
-  const cv::Mat potential =
-      control::PotentialField(d, repulsion, attraction, options_.potential);
+  const cv::Mat repulsion =
+      control::RepulsionField(d, potential_options) * (static_cast<double>(d.cols) / grey.cols);
+  const cv::Mat potential = control::PotentialField(d, repulsion, attraction, options_.potential);
   const cv::Vec2d force = control::ControlForce(potential);
-  filtered_force_ = have_force_ ? options_.force_filter * force +
-                                      (1.0 - options_.force_filter) * filtered_force_
-                                : force;
+  filtered_force_ =
+      have_force_ ? options_.force_filter * force + (1.0 - options_.force_filter) * filtered_force_
+                  : force;
   have_force_ = true;
   step.force = filtered_force_;
   const control::PotentialCommand c = control::CommandFromForce(step.force, options_.potential);
@@ -427,9 +431,8 @@ PotentialStep PotentialNavigator::Decide(const cv::Mat& image, const Pose2& odom
   }
   if (options_.full_speed_plane_fraction > options_.plane.min_plane_fraction) {
     const double lo = options_.plane.min_plane_fraction;
-    step.command.v_mps *= std::clamp((plane.roi_fraction - lo) /
-                                         (options_.full_speed_plane_fraction - lo),
-                                     0.0, 1.0);
+    step.command.v_mps *=
+        std::clamp((plane.roi_fraction - lo) / (options_.full_speed_plane_fraction - lo), 0.0, 1.0);
   }
   if (goal_distance_m_ >= 0.0 && goal_distance_m_ < options_.approach_radius_m) {
     const double cap = std::max(options_.creep_fraction * vmax,

@@ -306,8 +306,9 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
   // features that are about to be replaced.
   ++frames_since_detect_;
   // Carrying on matches every frame afresh.
-  const bool refresh = carry_active_ || reacquire_ || (options_.redetect_every_frames > 0 &&
-                                         frames_since_detect_ >= options_.redetect_every_frames);
+  const bool refresh = carry_active_ || reacquire_ ||
+                       (options_.redetect_every_frames > 0 &&
+                        frames_since_detect_ >= options_.redetect_every_frames);
   // Algorithm 1, lines 16-18: track the matched features inside the segment.
   if (!refresh && !previous_.empty() && !current_px_.empty()) {
     const features::KltResult tracked =

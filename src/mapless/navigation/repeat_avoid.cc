@@ -19,8 +19,8 @@ bool RepeatSession::StartDetour(const ObstacleCheck& obstacle, cv::Size image) {
   // The side: Eq. 8-16 on the lower image (where the watch fits the ground; every point off the
   // ground's plane repels), the destination straight ahead (the route's direction where the
   // robot stopped). How far aside: the obstacle's extent in the image.
-  const double theta = control::DetourAngle(obstacle.off_plane_px, image, w.fit_top, w.grid_px,
-                                            0.0, potential);
+  const double theta =
+      control::DetourAngle(obstacle.off_plane_px, image, w.fit_top, w.grid_px, 0.0, potential);
   const control::ObstacleExtent extent =
       control::MeasureObstacleExtent(obstacle.obstacle_px, obstacle.off_plane_px, image,
                                      w.region_width, w.region_top, w.region_half_width_m);

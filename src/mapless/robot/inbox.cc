@@ -14,8 +14,8 @@ std::int64_t SteadyNs() {
       .count();
 }
 
-FrameInbox::FrameInbox(const RobotFile& robot, cv::Size size, std::string camera_topic,
-                       Logger warn, InboxClock clock)
+FrameInbox::FrameInbox(const RobotFile& robot, cv::Size size, std::string camera_topic, Logger warn,
+                       InboxClock clock)
     : robot_(robot),
       size_(size),
       camera_topic_(std::move(camera_topic)),
@@ -102,7 +102,8 @@ LinkEvent FrameInbox::Next() {
     // from may never advance the ROS clock.
     const double without_s = ToSeconds(SteadyNs() - last_frame_steady_ns_);
     if (robot_.give_up_without_frames_s > 0.0 && without_s > robot_.give_up_without_frames_s) {
-      return {LinkEventType::kClosed, {},
+      return {LinkEventType::kClosed,
+              {},
               WhyNoFrame("no usable camera frame on " + camera_topic_ + " for " +
                          std::to_string(static_cast<int>(without_s)) + " s: giving up")};
     }
@@ -117,7 +118,8 @@ LinkEvent FrameInbox::Next() {
                                       : std::max(robot_.camera_timeout_s, robot_.connect_timeout_s);
     if (ToSeconds(now - last_event_ns_) >= timeout) {
       last_event_ns_ = now;
-      return {LinkEventType::kNoFrame, {},
+      return {LinkEventType::kNoFrame,
+              {},
               WhyNoFrame("no camera frame on " + camera_topic_ + " for " +
                          std::to_string(timeout).substr(0, 4) + " s")};
     }

@@ -59,7 +59,8 @@ TEST(FrameInbox, EStopWinsOverFramesUntilReleased) {
 TEST(FrameInbox, BadInputIsSaidOnceAndNamedInTheStop) {
   FakeClock clock;
   int said = 0;
-  FrameInbox inbox(Robot(), {}, "/camera", [&](const std::string&) { ++said; }, clock.clock());
+  FrameInbox inbox(
+      Robot(), {}, "/camera", [&](const std::string&) { ++said; }, clock.clock());
   inbox.Start();
   inbox.Warn("image:yuv422", "/camera: encoding 'yuv422' is not supported");
   inbox.Warn("image:yuv422", "/camera: encoding 'yuv422' is not supported");

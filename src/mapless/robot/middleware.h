@@ -24,7 +24,8 @@ namespace mapless::robot {
 struct MiddlewareKind {
   std::string name;  // as a robot file names it: `middleware: ros1`
   // The robot link for a method that wants frames of `image_size` (0x0: as they come); `method`
-  // names the method in the status the link publishes; `warn` hears about bad input. Started, ready for RobotLink::Next.
+  // names the method in the status the link publishes; `warn` hears about bad input. Started, ready
+  // for RobotLink::Next.
   std::function<std::unique_ptr<RobotLink>(const RobotFile& file, cv::Size image_size,
                                            const std::string& method, const Logger& warn)>
       open_link;

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cctype>
-#include <iterator>
 #include <cmath>
+#include <iterator>
 
 #include "mapless/core/check.h"
 #include "mapless/io/atomic_file.h"
@@ -11,7 +11,6 @@
 #include "mapless/io/yaml_reader.h"
 
 namespace mapless::robot {
-
 
 const char* CameraMountName(CameraMount m) {
   switch (m) {

@@ -32,8 +32,8 @@ struct RobotTopics {
 };
 
 struct RobotFile {
-  std::string source;  // the file it came from (for messages)
-  std::string middleware = "ros1";  // one of kMiddlewareNames
+  std::string source;                 // the file it came from (for messages)
+  std::string middleware = "ros1";    // one of kMiddlewareNames
   std::string name = "robot";         // a name for logs
   std::string ns;                     // namespace prefixed to relative topics ("/robot1")
   std::string node_name = "mapless";  // the ROS node name
@@ -51,8 +51,8 @@ struct RobotFile {
   // the image region the robot drives through next, for this robot's camera.
   navigation::ObstacleWatchOptions obstacle;
   bool obstacle_baseline_given = false;  // obstacles.baseline_m is in the file (else each method's)
-  bool use_sim_time = false;        // ROS `use_sim_time`: the clock comes from /clock
-  double connect_timeout_s = 10.0;  // waiting for the master / the first subscriber
+  bool use_sim_time = false;             // ROS `use_sim_time`: the clock comes from /clock
+  double connect_timeout_s = 10.0;       // waiting for the master / the first subscriber
   // The full name of a topic: absolute topics stay, relative ones get the namespace.
   std::string Resolve(const std::string& topic) const;
   LoopOptions Loop() const;

@@ -15,8 +15,7 @@ namespace mapless::robot {
 
 CameraMessage EncodeCamera(const cv::Mat& grey, const std::string& enc, cv::Size size) {
   cv::Mat frame = grey;
-  if (size.area() > 0 && size != grey.size())
-    cv::resize(grey, frame, size, 0, 0, cv::INTER_LINEAR);
+  if (size.area() > 0 && size != grey.size()) cv::resize(grey, frame, size, 0, 0, cv::INTER_LINEAR);
   CameraMessage msg;
   msg.encoding = enc;
   if (enc == "jpeg" || enc == "png") {

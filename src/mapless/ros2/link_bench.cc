@@ -45,9 +45,9 @@ void OnTwist(dds_entity_t reader, void* arg) {
 // camera forked into a process of its own never matched the link here; not investigated further.
 // The closed-loop tests cross the loopback sockets.) Returns the end-to-end latencies, ms.
 std::vector<double> Camera(const robot::RobotFile& file, const robot::LinkBenchOptions& options) {
-  const dds_entity_t camera = MakeWriter(&sensor_msgs_msg_dds__Image__desc,
-                                         file.Resolve(file.topics.image), "sensor_msgs/msg/Image",
-                                         Qos::kSensorData);
+  const dds_entity_t camera =
+      MakeWriter(&sensor_msgs_msg_dds__Image__desc, file.Resolve(file.topics.image),
+                 "sensor_msgs/msg/Image", Qos::kSensorData);
   Listener listener;
   dds_listener_t* l = dds_create_listener(&listener);
   dds_lset_data_available(l, OnTwist);

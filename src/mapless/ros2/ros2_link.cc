@@ -50,9 +50,9 @@ class Ros2Link::Impl {
     }
     if (!robot.topics.odometry.empty()) {
       dds_lset_data_available(listener_, &Impl::OnOdometry);
-      odometry_ = MakeReader(&nav_msgs_msg_dds__Odometry__desc,
-                             robot.Resolve(robot.topics.odometry), "nav_msgs/msg/Odometry",
-                             Qos::kSensorData, listener_);
+      odometry_ =
+          MakeReader(&nav_msgs_msg_dds__Odometry__desc, robot.Resolve(robot.topics.odometry),
+                     "nav_msgs/msg/Odometry", Qos::kSensorData, listener_);
     }
     if (!robot.topics.estop.empty()) {
       dds_lset_data_available(listener_, &Impl::OnEStop);
@@ -69,9 +69,9 @@ class Ros2Link::Impl {
     status_ = MakeWriter(&std_msgs_msg_dds__String__desc, robot.Resolve(robot.topics.status),
                          "std_msgs/msg/String", Qos::kDefault);
     if (!robot.topics.debug_image.empty())
-      debug_ = MakeWriter(&sensor_msgs_msg_dds__Image__desc,
-                          robot.Resolve(robot.topics.debug_image), "sensor_msgs/msg/Image",
-                          Qos::kSensorData);
+      debug_ =
+          MakeWriter(&sensor_msgs_msg_dds__Image__desc, robot.Resolve(robot.topics.debug_image),
+                     "sensor_msgs/msg/Image", Qos::kSensorData);
   }
 
   ~Impl() {
@@ -168,8 +168,8 @@ class Ros2Link::Impl {
     Impl* self = Self(arg);
     TakeAll<nav_msgs_msg_dds__Odometry_>(reader, [&](const nav_msgs_msg_dds__Odometry_& m) {
       const auto& p = m.pose.pose;
-      const double yaw = YawFromQuaternion(p.orientation.x, p.orientation.y, p.orientation.z,
-                                           p.orientation.w);
+      const double yaw =
+          YawFromQuaternion(p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w);
       if (!std::isfinite(p.position.x) || !std::isfinite(p.position.y) || !std::isfinite(yaw)) {
         self->inbox_.Warn("odometry", self->robot_.Resolve(self->robot_.topics.odometry) +
                                           ": odometry that is not finite");

@@ -69,9 +69,8 @@ class Transport : public robot::SimTransport {
   }
   static void OnString(dds_entity_t reader, void* arg) {
     auto* self = static_cast<Transport*>(arg);
-    TakeAll<std_msgs_msg_dds__String_>(reader, [&](const std_msgs_msg_dds__String_& s) {
-      self->OnStatus(s.data ? s.data : "");
-    });
+    TakeAll<std_msgs_msg_dds__String_>(
+        reader, [&](const std_msgs_msg_dds__String_& s) { self->OnStatus(s.data ? s.data : ""); });
   }
 
   dds_entity_t image_ = 0, odometry_ = 0, clock_ = 0, cmd_ = 0, status_ = 0;

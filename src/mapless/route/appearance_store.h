@@ -14,8 +14,8 @@
 // that lists it, so a teach killed at any moment leaves a route that loads with every whole image.
 #pragma once
 
-#include <opencv2/core.hpp>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 #include <string_view>
 #include <vector>

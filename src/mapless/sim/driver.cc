@@ -108,8 +108,9 @@ Twist2 ScriptedDriver::FollowPolyline(const Pose2& pose) {
   // A leg ends at its last point once the robot has come most of the way along it (a closed loop
   // passes its end point near the start, too).
   const bool near_end_of_leg = progress_m_ >= total - std::max(1.0, 2.0 * options_.lookahead_m);
-  if (near_end_of_leg && ((end - p).norm() < options_.goal_tolerance_m ||
-                          (progress_m_ >= total - 1e-6 && (end - p).norm() < 3.0 * options_.goal_tolerance_m))) {
+  if (near_end_of_leg &&
+      ((end - p).norm() < options_.goal_tolerance_m ||
+       (progress_m_ >= total - 1e-6 && (end - p).norm() < 3.0 * options_.goal_tolerance_m))) {
     ++leg_;
     leg_started_ = false;
     return Twist2{};

@@ -33,10 +33,11 @@ int main(int argc, char** argv) {
     for (const cv::DMatch& m : matches)
       pairs.push_back({cur.keypoints[m.queryIdx].pt.x - cx, kf.keypoints[m.trainIdx].pt.x - cx});
     const c::SlopedFunnelLaneResult r = c::ComputeSlopedFunnelLane(pairs, {});
-    std::printf("matches %zu std_ratio %.3f slope_x %.3f slope_y %.3f command %s v_mps %.3f "
-                "omega_radps %.3f\n",
-                pairs.size(), r.std_ratio, r.slope_x, r.slope_y, c::TurnCommandName(r.command),
-                r.twist.v_mps, r.twist.omega_radps);
+    std::printf(
+        "matches %zu std_ratio %.3f slope_x %.3f slope_y %.3f command %s v_mps %.3f "
+        "omega_radps %.3f\n",
+        pairs.size(), r.std_ratio, r.slope_x, r.slope_y, c::TurnCommandName(r.command),
+        r.twist.v_mps, r.twist.omega_radps);
     return r.ok ? 0 : 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "funnel_lane_command: %s\n", e.what());
