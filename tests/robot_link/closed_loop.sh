@@ -8,7 +8,7 @@
 #       [--methods repeat,navigate,follow] [--repeat-scenarios S1,S2] [--seed S] [--out DIR]
 #       [--mapless BIN]
 # --repeat-scenarios: the scenarios `repeat` is run on (default both Table I paths; CI runs the
-# sharp low-texture turn, the harder one).
+# sharp low-texture turn, the harder one). --no-homing: navigate to the destination only (CI).
 #
 # Per line: runs that completed through ROS, runs that completed directly, the largest distance
 # between the final poses of the two (the pose at the method's last decision), collisions. A line
@@ -20,6 +20,7 @@ cd "$(dirname "$0")/../.."
 RUNS=10
 METHODS=repeat,navigate,follow
 REPEAT_SCENARIOS=table1_sharp_turn_low_texture,table1_almost_straight
+HOMING=--homing
 SEED=1
 OUT=""
 BIN=build/release/apps/mapless
@@ -29,6 +30,7 @@ while [ $# -gt 0 ]; do
     --runs) RUNS="$2"; shift 2 ;;
     --methods) METHODS="$2"; shift 2 ;;
     --repeat-scenarios) REPEAT_SCENARIOS="$2"; shift 2 ;;
+    --no-homing) HOMING=""; shift ;;
     --seed) SEED="$2"; shift 2 ;;
     --out) OUT="$2"; shift 2 ;;
     --mapless) BIN="$2"; shift 2 ;;
@@ -118,11 +120,11 @@ for m in "${M[@]}"; do
         >"$OUT/calibrate.log" 2>&1 || true
       [ -s "$OUT/obstacle_field_calibration.yaml" ] ||
         { echo "closed_loop.sh: calibration failed (see $OUT/calibrate.log)"; exit 1; }
-      DIRECT=("$BIN" navigate --scenario obstacle_field --destination-index 0 --homing
+      DIRECT=("$BIN" navigate --scenario obstacle_field --destination-index 0 $HOMING
               --calibration "$OUT/obstacle_field_calibration.yaml")
       ROSCMD=("$BIN" navigate --robot "$OUT/robot.yaml" --scenario obstacle_field
-              --destination-index 0 --homing --calibration "$OUT/obstacle_field_calibration.yaml")
-      line "navigate obstacle_field destination 0 + home" obstacle_field navigate ;;
+              --destination-index 0 $HOMING --calibration "$OUT/obstacle_field_calibration.yaml")
+      line "navigate obstacle_field destination 0${HOMING:+ + home}" obstacle_field navigate ;;
     follow)
       "$BIN" teach --source sim:office_aliasing --method eigenspace --out "$OUT/routes/office_eigenspace" \
         --overwrite >"$OUT/teach_office_eigenspace.log" 2>&1 ||
