@@ -56,19 +56,17 @@ function(mapless_test)
     MAPLESS_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   mapless_target_warnings(${ARG_NAME})
   mapless_glue_code(${ARG_NAME})
-  set(properties "")
+  # Label `unit`: a GoogleTest case (scripts/test.sh runs these under the sanitizers, and in the
+  # release build only those in tests/release_only_tests.txt).
+  set(properties LABELS unit)
   if(ARG_COST)
     list(APPEND properties COST ${ARG_COST})
   endif()
   if(MAPLESS_SANITIZE AND ARG_SANITIZE_ENV)
     list(APPEND properties ENVIRONMENT "${ARG_SANITIZE_ENV}")
   endif()
-  if(properties)
-    gtest_discover_tests(${ARG_NAME} WORKING_DIRECTORY ${PROJECT_BINARY_DIR} DISCOVERY_TIMEOUT 60
-                         PROPERTIES ${properties})
-  else()
-    gtest_discover_tests(${ARG_NAME} WORKING_DIRECTORY ${PROJECT_BINARY_DIR} DISCOVERY_TIMEOUT 60)
-  endif()
+  gtest_discover_tests(${ARG_NAME} WORKING_DIRECTORY ${PROJECT_BINARY_DIR} DISCOVERY_TIMEOUT 60
+                       PROPERTIES ${properties})
 endfunction()
 
 # mapless_register_middleware(MODULE HEADER FUNCTION): a module that implements a middleware of the

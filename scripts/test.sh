@@ -1,49 +1,60 @@
 #!/usr/bin/env bash
 # README command 2: install what is missing, check the style, build and run the whole test suite.
-# .ci/run calls exactly this.
-#   1. the release build with both robot links (ROS 1 and ROS 2), every test but the closed loops
-#      that step 3 runs under the sanitizers (tests/sanitizer_only_tests.txt);
+# .ci/run calls exactly this. Each test runs in one build (docs/ci.md: where the time goes):
+#   1. the release build with both robot links (ROS 1 and ROS 2): the script tests (the command
+#      line, the robot links, the fleet, recordings, installing; lowercase names like cli.probe)
+#      and the GoogleTest cases listed in tests/release_only_tests.txt (statistics and closed loops
+#      whose code other tests run under the sanitizers);
 #   2. the configurations with one robot link each: configured, and the code that differs between
 #      configurations (the registration of the middlewares) compiled;
 #   3. the configuration a newcomer gets (no ROS 1, no ROS 2; preset `asan`), under
-#      AddressSanitizer + UndefinedBehaviorSanitizer: every test but the release-only ones
-#      (tests/release_only_tests.txt: statistics and closed loops whose code other tests run
-#      under the sanitizers), and `mapless demo`, the main job (newcomer.demo).
-# Extra arguments go to both ctest runs (e.g. -R Renderer). MAPLESS_SKIP_SANITIZERS=1 skips step 3
-# and runs every test in step 1 (a quicker local check; CI never sets it). Where the time goes:
-# docs/ci.md.
+#      AddressSanitizer + UndefinedBehaviorSanitizer: every GoogleTest case but the release-only
+#      ones, the bad-input probe and the soak (memory errors and leaks; the release build checks
+#      their time and memory), and `mapless demo`, the main job (newcomer.demo).
+# The sanitizer build compiles at low priority (nice) while step 1's tests run: many of those wait
+# on real time (ROS, the fleet), and the compiler takes the core they leave.
+# Extra arguments go to both ctest runs (e.g. -E Renderer; an -R replaces step 1's selection). MAPLESS_SKIP_SANITIZERS=1 skips step 3
+# and runs every test in step 1 (a quicker local check; CI never sets it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
 bash scripts/setup.sh --test
 bash scripts/check_format.sh
 
-# A test may run in one of the two builds only (each list says why); every name must be a test.
+# A GoogleTest case (label `unit`) runs in the release build only when tests/release_only_tests.txt
+# names it; every name there must be one.
 list_names() { grep -v '^[[:space:]]*#' "$1" | awk 'NF {print $1}'; }
 as_regex() { echo "^($(sed 's/\./\\./g' <<<"$1" | paste -sd'|'))\$"; }
 check_names() {  # check_names FILE NAMES...
   local file=$1 listed name
   shift
-  listed=$(ctest --preset release -N | sed -n 's/^ *Test *#[0-9]*: //p')
+  listed=$(ctest --preset release -N -L unit | sed -n 's/^ *Test *#[0-9]*: //p')
   for name in "$@"; do
-    grep -qxF "$name" <<<"$listed" || { echo "test.sh: $file names $name, which is not a test" >&2; exit 1; }
+    grep -qxF "$name" <<<"$listed" ||
+      { echo "test.sh: $file names $name, which is not a GoogleTest case" >&2; exit 1; }
   done
 }
 release_only=$(list_names tests/release_only_tests.txt)
-sanitizer_only=$(list_names tests/sanitizer_only_tests.txt)
-both=$(comm -12 <(sort <<<"$release_only") <(sort <<<"$sanitizer_only"))
-[ -z "$both" ] || { echo "test.sh: in both lists, so run by neither build: $both" >&2; exit 1; }
 
 cmake --preset release
 cmake --build --preset release -j "$jobs"
 # shellcheck disable=SC2086
 check_names tests/release_only_tests.txt $release_only
-# shellcheck disable=SC2086
-check_names tests/sanitizer_only_tests.txt $sanitizer_only
+scripts=$(ctest --preset release -N -LE unit | sed -n 's/^ *Test *#[0-9]*: //p')
+
+asan_build=""
+if [ "${MAPLESS_SKIP_SANITIZERS:-0}" != "1" ]; then
+  cmake --preset asan
+  setsid nice -n 19 cmake --build --preset asan -j "$jobs" >build/asan.log 2>&1 &
+  asan_build=$!  # a process group of its own (setsid), stopped whole if this script ends early
+  trap '[ -z "$asan_build" ] || kill -- "-$asan_build" 2>/dev/null' EXIT
+fi
+release_rc=0
 if [ "${MAPLESS_SKIP_SANITIZERS:-0}" = "1" ]; then
-  ctest --preset release -j "$jobs" "$@"
+  ctest --preset release -j "$jobs" "$@" || release_rc=$?
 else
-  ctest --preset release -j "$jobs" -E "$(as_regex "$sanitizer_only")" "$@"
+  ctest --preset release -j "$jobs" -R "$(as_regex "$scripts"$'\n'"$release_only")" "$@" ||
+    release_rc=$?
 fi
 
 for only in ros1 ros2; do
@@ -60,8 +71,11 @@ done
 
 if [ "${MAPLESS_SKIP_SANITIZERS:-0}" = "1" ]; then
   echo "test.sh: sanitizer suite skipped (MAPLESS_SKIP_SANITIZERS=1)"
-  exit 0
+  exit "$release_rc"
 fi
-cmake --preset asan
-cmake --build --preset asan -j "$jobs"
-ctest --preset asan -j "$jobs" -E "$(as_regex "$release_only")" "$@"
+echo "test.sh: waiting for the sanitizer build (log: build/asan.log)"
+wait "$asan_build" || { tail -40 build/asan.log; echo "test.sh: the sanitizer build failed"; exit 1; }
+asan_build=""
+tail -1 build/asan.log
+ctest --preset asan -j "$jobs" -E "$(as_regex "$release_only")" "$@" || exit $?
+exit "$release_rc"
