@@ -45,8 +45,13 @@ scripts=$(ctest --preset release -N -LE unit | sed -n 's/^ *Test *#[0-9]*: //p')
 asan_build=""
 if [ "${MAPLESS_SKIP_SANITIZERS:-0}" != "1" ]; then
   cmake --preset asan
-  setsid nice -n 19 cmake --build --preset asan -j "$jobs" >build/asan.log 2>&1 &
-  asan_build=$!  # a process group of its own (setsid), stopped whole if this script ends early
+  # A process group of its own (job control), stopped whole if this script ends early; the same
+  # session, so that its nice value counts against the tests (a new session, as setsid makes, is a
+  # scheduling group of its own under Linux's autogroup, and would take half of the machine).
+  set -m
+  nice -n 19 cmake --build --preset asan -j "$jobs" >build/asan.log 2>&1 &
+  asan_build=$!
+  set +m
   trap '[ -z "$asan_build" ] || kill -- "-$asan_build" 2>/dev/null' EXIT
 fi
 release_rc=0
