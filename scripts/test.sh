@@ -11,10 +11,11 @@
 #      AddressSanitizer + UndefinedBehaviorSanitizer: every GoogleTest case but the release-only
 #      ones, the bad-input probe and the soak (memory errors and leaks; the release build checks
 #      their time and memory), and `mapless demo`, the main job (newcomer.demo).
-# The sanitizer build compiles at low priority (nice) while step 1's tests run: many of those wait
-# on real time (ROS, the fleet), and the compiler takes the core they leave.
-# Extra arguments go to both ctest runs (e.g. -E Renderer; an -R replaces step 1's selection). MAPLESS_SKIP_SANITIZERS=1 skips step 3
-# and runs every test in step 1 (a quicker local check; CI never sets it).
+# The sanitizer build compiles at low priority (nice 19) while step 1's tests run and takes the CPU
+# time they leave (a third of the build in the run docs/ci.md measured).
+# Extra arguments go to both ctest runs (e.g. -E Renderer; an -R replaces step 1's selection).
+# MAPLESS_SKIP_SANITIZERS=1 skips step 3 and runs every test in step 1 (a quicker local check; CI
+# never sets it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
