@@ -265,7 +265,10 @@ void Lead(const LeadArgs& a) {
           while (true) {
             ThrowIfInterrupted();
             robot::LinkEvent e = link->Next();
-            if (e.type == robot::LinkEventType::kClosed) throw RunFailed("lead: " + e.reason);
+            if (e.type == robot::LinkEventType::kClosed) {
+              ThrowIfInterrupted();  // the link heard the interrupt first
+              throw RunFailed("lead: " + e.reason);
+            }
             if (e.type != robot::LinkEventType::kFrame) continue;
             teacher.Frame(e.observation.image, e.observation.t_ns, e.observation.odometry);
           }

@@ -7,6 +7,8 @@
 #include <cstring>
 #include <ctime>
 
+#include "mapless/core/interrupt.h"
+
 namespace mapless::app {
 namespace {
 
@@ -30,6 +32,7 @@ extern "C" void OnSignal(int signal) {
   const long long now = MonotonicNs();
   const bool first = g_signal.exchange(signal) == 0;
   if (first) g_first_ns.store(now);
+  RequestInterrupt();                         // every wait at the edges returns
   if (first && g_cooperative.load()) return;  // the run stops at its next frame
   // A repeat within a second is the same interrupt delivered twice (`timeout` sends its signal to
   // the command and to the command's process group), not the user insisting: a robot must still

@@ -217,7 +217,10 @@ void Teach(const TeachArgs& t) {
       while (true) {
         ThrowIfInterrupted();
         robot::LinkEvent e = link->Next();
-        if (e.type == robot::LinkEventType::kClosed) throw RunFailed("teach: " + e.reason);
+        if (e.type == robot::LinkEventType::kClosed) {
+          ThrowIfInterrupted();  // the link heard the interrupt first
+          throw RunFailed("teach: " + e.reason);
+        }
         if (e.type != robot::LinkEventType::kFrame) continue;
         frame_in(e.observation.image, e.observation.t_ns, e.observation.odometry);
       }

@@ -3,12 +3,13 @@
 // zero Twist:
 //   kill PID    SIGKILL to the camera publisher (the watchdog)
 //   int PID     SIGINT to the method (Ctrl-C)
-//   estop       true on /mapless/estop; then false, and the robot must be driven again within 2 s
+//   estop       true on /mapless/estop, held 1.2 s (commands meanwhile at most MAX_STOP_PER_S a
+//               second); then false, and the robot must be driven again within 2 s
 //   topics      (no action) the status topic carries one JSON object per frame naming the method,
 //               and the debug image topic bgr8 pictures at least 320 wide
 // Prints one JSON line; exit 0 when the zero came within the limit, 1 when it came late, was not
 // zero, or never came (or, for estop, driving did not resume).
-//   safety_probe kill|int|estop PID LIMIT_S [NONZERO_COMMANDS]
+//   safety_probe kill|int|estop PID LIMIT_S [NONZERO_COMMANDS [MAX_STOP_PER_S]]
 #include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
@@ -37,6 +38,7 @@ double g_after_s = 0.0;
 bool g_released = false;
 int g_nonzero_after_release = 0;
 int g_nonzero_during_stop = 0;  // must stay 0 while the e-stop is on
+int g_during_stop = 0;          // every command while the e-stop is on (its rate is bounded)
 
 void OnTwist(const geometry_msgs::TwistConstPtr& msg) {
   std::lock_guard<std::mutex> lock(g_mutex);
@@ -47,6 +49,7 @@ void OnTwist(const geometry_msgs::TwistConstPtr& msg) {
   }
   if (g_released && !zero) ++g_nonzero_after_release;
   if (!g_released && !zero) ++g_nonzero_during_stop;
+  if (!g_released) ++g_during_stop;
   if (g_after) return;
   g_after = true;
   g_after_zero = zero;
@@ -64,6 +67,9 @@ int main(int argc, char** argv) {
   const int pid = std::atoi(argv[2]);
   const double limit = std::atof(argv[3]);
   const int wanted = argc > 4 ? std::atoi(argv[4]) : 10;
+  // estop: commands per second allowed while it is held (the camera rate plus the watchdog).
+  const double max_stop_hz = argc > 5 ? std::atof(argv[5]) : 15.0;
+  double stop_hz = 0.0;
   ros::init(argc, argv, "safety_probe", ros::init_options::NoSigintHandler);
   ros::NodeHandle nh;
   ros::Subscriber sub = nh.subscribe("/cmd_vel", 100, OnTwist, ros::TransportHints().tcpNoDelay());
@@ -160,10 +166,19 @@ int main(int argc, char** argv) {
   }
   bool resumed = true;
   if (mode == "estop") {
-    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    // Held for a second: the commands meanwhile are counted (zero Twists at most at the camera
+    // rate plus the watchdog's, never as fast as the loop turns).
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    int held_from = 0;
+    {
+      std::lock_guard<std::mutex> lock(g_mutex);
+      held_from = g_during_stop;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1000));
     {
       std::lock_guard<std::mutex> lock(g_mutex);
       g_released = true;
+      stop_hz = g_during_stop - held_from;
       // Stopped all the while: every command since the e-stop was zero.
       if (g_nonzero_during_stop > 0) resumed = false;
     }
@@ -179,8 +194,10 @@ int main(int argc, char** argv) {
     std::printf("{\"mode\": \"%s\", \"error\": \"no command within 3 s\"}\n", mode.c_str());
     return 1;
   }
-  std::printf("{\"mode\": \"%s\", \"zero\": %s, \"after_s\": %.4f, \"limit_s\": %.3f%s}\n",
-              mode.c_str(), g_after_zero ? "true" : "false", g_after_s, limit,
-              mode == "estop" ? (resumed ? ", \"resumed\": true" : ", \"resumed\": false") : "");
-  return g_after_zero && g_after_s <= limit && resumed ? 0 : 1;
+  std::printf(
+      "{\"mode\": \"%s\", \"zero\": %s, \"after_s\": %.4f, \"limit_s\": %.3f, "
+      "\"stop_per_s\": %.0f%s}\n",
+      mode.c_str(), g_after_zero ? "true" : "false", g_after_s, limit, stop_hz,
+      mode == "estop" ? (resumed ? ", \"resumed\": true" : ", \"resumed\": false") : "");
+  return g_after_zero && g_after_s <= limit && resumed && stop_hz <= max_stop_hz ? 0 : 1;
 }

@@ -3,11 +3,12 @@
 // thing and measures the time until the method publishes a zero Twist:
 //   kill PID    SIGKILL to the camera publisher (the watchdog)
 //   int PID     SIGINT to the method (Ctrl-C)
-//   estop       true on /mapless/estop; then false, and the robot must be driven again within 2 s
+//   estop       true on /mapless/estop, held 1.2 s (commands meanwhile at most MAX_STOP_PER_S a
+//               second); then false, and the robot must be driven again within 2 s
 //   topics      (no action) the status topic carries one JSON object per frame naming the method,
 //               and the debug image topic bgr8 pictures at least 320 wide
 // Prints one JSON line; exit 0 when the zero came within the limit, 1 otherwise.
-//   safety_probe kill|int|estop|topics PID LIMIT_S [NONZERO_COMMANDS]
+//   safety_probe kill|int|estop|topics PID LIMIT_S [NONZERO_COMMANDS [MAX_STOP_PER_S]]
 #include <signal.h>
 
 #include <chrono>
@@ -35,6 +36,7 @@ double g_after_s = 0.0;
 bool g_released = false;
 int g_nonzero_after_release = 0;
 int g_nonzero_during_stop = 0;  // must stay 0 while the e-stop is on
+int g_during_stop = 0;          // every command while the e-stop is on (its rate is bounded)
 int g_statuses = 0, g_good_statuses = 0, g_images = 0, g_good_images = 0;
 
 void OnTwist(dds_entity_t reader, void*) {
@@ -47,6 +49,7 @@ void OnTwist(dds_entity_t reader, void*) {
     }
     if (g_released && !zero) ++g_nonzero_after_release;
     if (!g_released && !zero) ++g_nonzero_during_stop;
+    if (!g_released) ++g_during_stop;
     if (g_after) return;
     g_after = true;
     g_after_zero = zero;
@@ -86,6 +89,9 @@ int main(int argc, char** argv) {
   const int pid = std::atoi(argv[2]);
   const double limit = std::atof(argv[3]);
   const int wanted = argc > 4 ? std::atoi(argv[4]) : 10;
+  // estop: commands per second allowed while it is held (the camera rate plus the watchdog).
+  const double max_stop_hz = argc > 5 ? std::atof(argv[5]) : 15.0;
+  double stop_hz = 0.0;
   dds_listener_t* listener = dds_create_listener(nullptr);
   dds_lset_data_available(listener, OnTwist);
   MakeReader(&geometry_msgs_msg_dds__Twist__desc, "/cmd_vel", "geometry_msgs/msg/Twist",
@@ -151,10 +157,19 @@ int main(int argc, char** argv) {
   }
   bool resumed = true;
   if (mode == "estop") {
-    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    // Held for a second: the commands meanwhile are counted (zero Twists at most at the camera
+    // rate plus the watchdog's, never as fast as the loop turns).
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    int held_from = 0;
+    {
+      std::lock_guard<std::mutex> lock(g_mutex);
+      held_from = g_during_stop;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1000));
     {
       std::lock_guard<std::mutex> lock(g_mutex);
       g_released = true;
+      stop_hz = g_during_stop - held_from;
       if (g_nonzero_during_stop > 0) resumed = false;
     }
     WriteBool(estop, false);
@@ -168,9 +183,11 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
     std::_Exit(1);
   }
-  std::printf("{\"mode\": \"%s\", \"zero\": %s, \"after_s\": %.4f, \"limit_s\": %.3f%s}\n",
-              mode.c_str(), g_after_zero ? "true" : "false", g_after_s, limit,
-              mode == "estop" ? (resumed ? ", \"resumed\": true" : ", \"resumed\": false") : "");
+  std::printf(
+      "{\"mode\": \"%s\", \"zero\": %s, \"after_s\": %.4f, \"limit_s\": %.3f, "
+      "\"stop_per_s\": %.0f%s}\n",
+      mode.c_str(), g_after_zero ? "true" : "false", g_after_s, limit, stop_hz,
+      mode == "estop" ? (resumed ? ", \"resumed\": true" : ", \"resumed\": false") : "");
   std::fflush(stdout);
-  std::_Exit(g_after_zero && g_after_s <= limit && resumed ? 0 : 1);
+  std::_Exit(g_after_zero && g_after_s <= limit && resumed && stop_hz <= max_stop_hz ? 0 : 1);
 }

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdlib>
 
+#include "mapless/core/interrupt.h"
 #include "mapless/robot/camera_image.h"
 
 namespace mapless::robot {
@@ -56,6 +57,7 @@ void FrameInbox::AddOdometry(Timestamp t_ns, const Pose2& pose) {
 
 void FrameInbox::SetEStop(bool engaged, const std::string& topic) {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (engaged != estop_) estop_said_ = false;  // a new e-stop is said at once
   estop_ = engaged;
   estop_topic_ = topic;
   cv_.notify_all();
@@ -79,7 +81,22 @@ LinkEvent FrameInbox::Next() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {
     if (clock_.ok && !clock_.ok()) return {LinkEventType::kClosed, {}, "the middleware shut down"};
-    if (estop_) return {LinkEventType::kEStop, {}, "emergency stop (" + estop_topic_ + ")"};
+    if (InterruptRequested()) return {LinkEventType::kClosed, {}, "interrupted"};
+    if (estop_) {
+      // Said when it engages, then once per camera frame (each frame taken in is dropped and
+      // answered with a stop, as a lockstep simulator expects an answer per frame) and, without
+      // frames, once per camera_timeout_s: never as fast as the loop can turn (issue 40).
+      const std::int64_t steady = SteadyNs();
+      const double since_s = ToSeconds(steady - estop_said_ns_);
+      if (!estop_said_ || have_frame_ || since_s >= std::max(robot_.camera_timeout_s, 0.05)) {
+        have_frame_ = false;
+        estop_said_ = true;
+        estop_said_ns_ = steady;
+        return {LinkEventType::kEStop, {}, "emergency stop (" + estop_topic_ + ")"};
+      }
+      cv_.wait_for(lock, std::chrono::milliseconds(5));
+      continue;
+    }
     if (have_frame_) {
       have_frame_ = false;
       got_frame_ = true;

@@ -52,7 +52,11 @@ class FrameInbox {
   // Bad input: said once per kind (to the logger), and named in the next stop's reason.
   void Warn(const std::string& kind, const std::string& message);
 
-  // The newest frame, or why there is none (the link's Next()).
+  // The newest frame, or why there is none (the link's Next()). Waits for one, hearing an
+  // interrupt (core/interrupt.h: kClosed, "interrupted") within a few milliseconds. While the
+  // e-stop is engaged, kEStop comes at once, then once per frame taken in (the frame dropped) or
+  // per camera_timeout_s without frames: the stop it asks for goes out at most at the camera rate
+  // plus the watchdog's.
   LinkEvent Next();
   // When the frame last returned by Next() was received (steady clock).
   std::int64_t received_steady_ns() const { return received_steady_ns_; }
@@ -77,6 +81,8 @@ class FrameInbox {
   std::int64_t received_steady_ns_ = 0;
   std::deque<std::pair<Timestamp, Pose2>> odometry_;
   bool estop_ = false;
+  bool estop_said_ = false;         // since it engaged
+  std::int64_t estop_said_ns_ = 0;  // steady clock
   std::string estop_topic_;
   std::string bad_input_;
   std::set<std::string> warned_;

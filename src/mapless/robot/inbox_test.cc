@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
+#include <thread>
 
+#include "mapless/core/interrupt.h"
 #include "mapless/robot/sim_serve.h"
 
 namespace mapless::robot {
@@ -53,7 +56,69 @@ TEST(FrameInbox, EStopWinsOverFramesUntilReleased) {
   EXPECT_EQ(e.type, LinkEventType::kEStop);
   EXPECT_NE(e.reason.find("/mapless/estop"), std::string::npos);
   inbox.SetEStop(false, "/mapless/estop");
-  EXPECT_EQ(inbox.Next().type, LinkEventType::kFrame);
+  // The frame from before the e-stop was answered with it; the next one is acted on.
+  inbox.Deliver(cv::Mat(24, 32, CV_8UC1, cv::Scalar(2)), 10, 0);
+  e = inbox.Next();
+  ASSERT_EQ(e.type, LinkEventType::kFrame);
+  EXPECT_EQ(e.observation.t_ns, 10);
+}
+
+// Issue 40: during an e-stop the loop turned as fast as it could, publishing tens of thousands of
+// zero Twists a second. Now the stop is said once per frame, or once per camera_timeout_s.
+TEST(FrameInbox, EStopIsSaidAtMostOncePerFrameOrWatchdogPeriod) {
+  FakeClock clock;
+  RobotFile robot = Robot();
+  robot.camera_timeout_s = 0.1;
+  FrameInbox inbox(robot, {}, "/camera", {}, clock.clock());
+  inbox.Start();
+  inbox.SetEStop(true, "/estop");
+  std::atomic<bool> done{false};
+  std::thread camera([&] {  // 20 frames at 50 Hz
+    for (int i = 1; i <= 20; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      inbox.Deliver(cv::Mat(24, 32, CV_8UC1, cv::Scalar(i)), i * 20'000'000, 0);
+    }
+    done = true;
+  });
+  int stops = 0;
+  const std::int64_t start = SteadyNs();
+  while (!done) {
+    EXPECT_EQ(inbox.Next().type, LinkEventType::kEStop);
+    ++stops;
+  }
+  camera.join();
+  const double seconds = ToSeconds(SteadyNs() - start);
+  // One at engagement, one per frame (20), and watchdog repeats only where frames were late.
+  EXPECT_GE(stops, 10);
+  EXPECT_LE(stops, 1 + 20 + static_cast<int>(seconds / 0.1) + 1) << seconds << " s";
+  // Without frames: about one per camera_timeout_s.
+  const std::int64_t quiet = SteadyNs();
+  int quiet_stops = 0;
+  while (ToSeconds(SteadyNs() - quiet) < 0.35) {
+    EXPECT_EQ(inbox.Next().type, LinkEventType::kEStop);
+    ++quiet_stops;
+  }
+  EXPECT_GE(quiet_stops, 2);
+  EXPECT_LE(quiet_stops, 5);
+}
+
+TEST(FrameInbox, AnInterruptEndsTheWaitEvenWhenTheClockStopped) {
+  FakeClock clock;  // never advances: a simulated clock that stopped
+  RobotFile robot = Robot();
+  robot.give_up_without_frames_s = 30;
+  FrameInbox inbox(robot, {}, "/camera", {}, clock.clock());
+  inbox.Start();
+  std::thread ctrl_c([] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    RequestInterrupt();
+  });
+  const std::int64_t start = SteadyNs();
+  const LinkEvent e = inbox.Next();
+  ctrl_c.join();
+  ClearInterrupt();
+  EXPECT_EQ(e.type, LinkEventType::kClosed);
+  EXPECT_EQ(e.reason, "interrupted");
+  EXPECT_LT(ToSeconds(SteadyNs() - start), 5.0);
 }
 
 TEST(FrameInbox, BadInputIsSaidOnceAndNamedInTheStop) {

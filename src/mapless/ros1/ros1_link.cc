@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "mapless/core/check.h"
+#include "mapless/core/interrupt.h"
 #include "mapless/robot/camera_image.h"
 #include "mapless/robot/inbox.h"
 #include "mapless/robot/status.h"
@@ -38,6 +39,8 @@ void StartNode(const robot::RobotFile& robot, const std::string& node_name) {
   ros::init(remappings, node_name, ros::init_options::NoSigintHandler);
   const auto deadline = SteadyClock::now() + std::chrono::duration<double>(robot.connect_timeout_s);
   while (!ros::master::check()) {
+    if (InterruptRequested())
+      throw std::runtime_error("interrupted while waiting for the ROS master");
     if (SteadyClock::now() > deadline) {
       throw std::runtime_error("no ROS master at " + ros::master::getURI() + " after " +
                                std::to_string(static_cast<int>(robot.connect_timeout_s)) +
