@@ -1,11 +1,13 @@
 #include "mapless/fleet/server.h"
 
 #include <sys/eventfd.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <deque>
 #include <map>
 #include <mutex>
 #include <zmq.hpp>
@@ -22,7 +24,36 @@ struct LeaderServer::Impl {
     Clock::time_point last_heard;
     Clock::time_point last_sent;
     std::string address;
+    // The sizes of the last peer_queue + 1 messages sent: what its queue (and ZeroMQ's message
+    // being written) can hold at most, since older messages leave first.
+    std::deque<std::size_t> window;
+    std::size_t window_bytes = 0;
+    int fd = -1;                     // its connection's socket (ZMQ_SRCFD of its last message)
+    Clock::time_point full_since{};  // its queue full since then (epoch: not full)
   };
+  std::size_t queued_bytes = 0;  // the sum of every peer's window_bytes
+
+  // Whether a message of `bytes` to `peer` keeps all queues together within total_queue_bytes
+  // (else the peer is served in a later round); Account() books it once sent.
+  bool Affordable(const Peer& peer, std::size_t bytes) const {
+    const std::size_t leaving =
+        peer.window.size() > static_cast<std::size_t>(options.peer_queue) ? peer.window.front() : 0;
+    return bytes <= leaving || queued_bytes - leaving + bytes <= options.total_queue_bytes;
+  }
+  void Account(Peer& peer, std::size_t bytes) {
+    if (peer.window.size() > static_cast<std::size_t>(options.peer_queue)) {
+      peer.window_bytes -= peer.window.front();
+      queued_bytes -= peer.window.front();
+      peer.window.pop_front();
+    }
+    peer.window.push_back(bytes);
+    peer.window_bytes += bytes;
+    queued_bytes += bytes;
+  }
+  std::map<std::string, Peer>::iterator Forget(std::map<std::string, Peer>::iterator it) {
+    queued_bytes -= it->second.window_bytes;
+    return peers.erase(it);
+  }
 
   const RouteCopy& log;
   ServerOptions options;
@@ -46,27 +77,32 @@ struct LeaderServer::Impl {
     if (log_line) log_line(line);
   }
 
-  // Bad input is logged, but at most one line a second (a peer sending garbage cannot flood the
-  // log): the lines held back are counted in the next one.
-  Clock::time_point last_reject_log;
-  int held_back = 0;
-  void LogRejection(const std::string& line) {
+  // Bad input and followers coming and going are logged, but at most one line a second (a peer
+  // sending garbage, or 200 peers connecting, cannot flood the log): the lines held back are
+  // counted by kind in the next one.
+  Clock::time_point last_limited_log;
+  std::map<std::string, int> held_back;  // by kind ("joined", "rejected", ...)
+  std::string HeldBack() {
+    std::string text;
+    for (const auto& [kind, n] : held_back)
+      text += (text.empty() ? "" : ", ") + std::to_string(n) + " " + kind;
+    held_back.clear();
+    return text;
+  }
+  void LogLimited(const std::string& kind, const std::string& line) {
     const auto now = Clock::now();
-    if (now - last_reject_log < std::chrono::seconds(1)) {
-      ++held_back;
+    if (now - last_limited_log < std::chrono::seconds(1)) {
+      ++held_back[kind];
       return;
     }
-    Log(line +
-        (held_back > 0 ? " (and " + std::to_string(held_back) + " more since the last)" : ""));
-    held_back = 0;
-    last_reject_log = now;
+    const std::string held = HeldBack();
+    Log(line + (held.empty() ? "" : " (held back since the last line: " + held + ")"));
+    last_limited_log = now;
   }
-  void FlushRejections() {
-    if (held_back == 0 || Clock::now() - last_reject_log < std::chrono::seconds(1)) return;
-    Log("fleet: refused or rejected " + std::to_string(held_back) +
-        " more connections or messages in the last second");
-    held_back = 0;
-    last_reject_log = Clock::now();
+  void FlushLimited() {
+    if (held_back.empty() || Clock::now() - last_limited_log < std::chrono::seconds(1)) return;
+    Log("fleet: in the last second also " + HeldBack());
+    last_limited_log = Clock::now();
   }
 
   void Count(std::uint64_t ServerStats::*field) {
@@ -92,8 +128,8 @@ struct LeaderServer::Impl {
         (allowed.empty() || std::find(allowed.begin(), allowed.end(), client_key) != allowed.end());
     if (!ok) {
       Count(&ServerStats::refused);
-      Log("fleet: refused a follower from " + address + ": its key " + client_key +
-          " is not admitted (--curve-allow)");
+      LogLimited("keys refused", "fleet: refused a follower from " + address + ": its key " +
+                                     client_key + " is not admitted (--curve-allow)");
     }
     std::vector<std::string> reply = {
         "1.0", request[1].to_string(), ok ? "200" : "400", ok ? "OK" : "key not admitted", "", ""};
@@ -126,9 +162,10 @@ struct LeaderServer::Impl {
                (id == ZMQ_EVENT_DISCONNECTED && pending_handshakes.count(fd))) {
       pending_handshakes.erase(fd);
       Count(&ServerStats::refused);
-      LogRejection("fleet: refused a connection on " + where +
-                   ": the handshake failed (not a mapless follower, or one without the "
-                   "leader's CURVE key)");
+      LogLimited("connections refused",
+                 "fleet: refused a connection on " + where +
+                     ": the handshake failed (not a mapless follower, or one without the "
+                     "leader's CURVE key)");
     }
   }
 
@@ -138,7 +175,8 @@ struct LeaderServer::Impl {
       if (!RecvAll(router, &msg, /*wait=*/false)) return;
       if (msg.size() != 2) {
         Count(&ServerStats::rejected);
-        LogRejection("fleet: rejected a message of " + std::to_string(msg.size()) + " frames");
+        LogLimited("messages rejected",
+                   "fleet: rejected a message of " + std::to_string(msg.size()) + " frames");
         continue;
       }
       const std::string id = msg[0].to_string();
@@ -147,18 +185,28 @@ struct LeaderServer::Impl {
         from = DecodeSubscribe(msg[1].to_string_view());
       } catch (const InputError& e) {
         Count(&ServerStats::rejected);
-        LogRejection(std::string("fleet: rejected a message from a follower: ") + e.what());
+        LogLimited("messages rejected",
+                   std::string("fleet: rejected a message from a follower: ") + e.what());
         continue;
       }
       Count(&ServerStats::subscriptions);
       const bool known = peers.count(id) > 0;
+      if (!known && static_cast<int>(peers.size()) >= options.max_followers) {
+        Count(&ServerStats::turned_away);
+        LogLimited("followers turned away",
+                   "fleet: turned a follower away: " + std::to_string(peers.size()) +
+                       " are served already (the leader's limit)");
+        continue;
+      }
       Peer& peer = peers[id];
       if (!known) {
         const char* address = msg[1].gets("Peer-Address");
         peer.address = address ? address : "?";
-        Log("fleet: a follower at " + peer.address + " asks for the route from record " +
-            std::to_string(from));
+        LogLimited("followers joined", "fleet: a follower at " + peer.address +
+                                           " asks for the route from record " +
+                                           std::to_string(from));
       }
+      peer.fd = msg[1].get(ZMQ_SRCFD);
       peer.next = from;
       peer.last_heard = Clock::now();
     }
@@ -172,7 +220,7 @@ struct LeaderServer::Impl {
     for (auto it = peers.begin(); it != peers.end();) {
       Peer& peer = it->second;
       if (now - peer.last_heard > std::chrono::duration<double>(options.forget_after_s)) {
-        it = peers.erase(it);
+        it = Forget(it);
         continue;
       }
       // Records are taken from the log one at a time while the follower's pipe takes them: a full
@@ -182,8 +230,15 @@ struct LeaderServer::Impl {
       while (peer.next < size && sent < options.batch) {
         const std::vector<Record> next = log.RecordsFrom(peer.next, 1);
         if (next.empty()) break;
-        result = SendTo(router, it->first, EncodeRecord(next.front()));
+        const std::string bytes = EncodeRecord(next.front());
+        if (!Affordable(peer, bytes.size())) {
+          result = SendResult::kFull;  // the queues together are full: later
+          break;
+        }
+        result = SendTo(router, it->first, bytes);
         if (result != SendResult::kSent) break;
+        Account(peer, bytes.size());
+        peer.full_since = {};
         ++peer.next;
         ++sent;
         peer.last_sent = now;
@@ -198,19 +253,51 @@ struct LeaderServer::Impl {
         beat.type = RecordType::kHeartbeat;
         beat.sequence = size;
         beat.parts = {log.complete() ? "1" : "0"};
-        result = SendTo(router, it->first, EncodeRecord(beat));
-        if (result == SendResult::kSent) peer.last_sent = now;
+        const std::string bytes = EncodeRecord(beat);
+        if (Affordable(peer, bytes.size())) {
+          result = SendTo(router, it->first, bytes);
+          if (result == SendResult::kSent) {
+            peer.last_sent = now;
+            Account(peer, bytes.size());
+          }
+        }
+      }
+      if (result == SendResult::kFull && peer.full_since == Clock::time_point{} &&
+          peer.window.size() > static_cast<std::size_t>(options.peer_queue))
+        peer.full_since = now;  // its own queue is full (not the total)
+      if (peer.full_since != Clock::time_point{} &&
+          now - peer.full_since > std::chrono::duration<double>(options.stall_drop_s)) {
+        // It has not taken a record for stall_drop_s: it stopped reading. Its connection is
+        // closed (ZeroMQ's ROUTER has no call for that, so its socket is shut down: ZeroMQ then
+        // closes the session and frees the queue); it may connect and ask again.
+        Count(&ServerStats::dropped);
+        LogLimited("followers dropped", "fleet: dropped the follower at " + peer.address +
+                                            " at record " + std::to_string(peer.next) + " of " +
+                                            std::to_string(size) + ": it read nothing for " +
+                                            std::to_string(static_cast<int>(options.stall_drop_s)) +
+                                            " s");
+        if (peer.fd >= 0) ::shutdown(peer.fd, SHUT_RDWR);
+        it = Forget(it);
+        continue;
       }
       blocked = blocked || result == SendResult::kFull;
-      const bool gone = result == SendResult::kGone;
-      if (gone) {
-        it = peers.erase(it);
+      if (result == SendResult::kGone) {
+        // Its connection closed: it left, or stopped reading and missed the heartbeats.
+        if (peer.next < size) {
+          Count(&ServerStats::dropped);
+          LogLimited("followers dropped",
+                     "fleet: dropped the follower at " + peer.address + " at record " +
+                         std::to_string(peer.next) + " of " + std::to_string(size) +
+                         ": its connection closed (it left, or stopped reading)");
+        }
+        it = Forget(it);
         continue;
       }
       ++it;
     }
     std::lock_guard<std::mutex> lock(stats_mutex);
     stats.followers = static_cast<int>(peers.size());
+    stats.queued_bytes = queued_bytes;
     return blocked;
   }
 
@@ -231,7 +318,7 @@ struct LeaderServer::Impl {
       if (items[2].revents & ZMQ_POLLIN) HandleMonitor();
       if (items.size() > 3 && (items[3].revents & ZMQ_POLLIN)) HandleZap();
       blocked = SendRound();
-      FlushRejections();
+      FlushLimited();
     }
   }
 };
@@ -253,7 +340,9 @@ LeaderServer::LeaderServer(const RouteCopy& log, ServerOptions options, FleetLog
     // Subscriptions are 16 bytes: a larger message still reaches the decoder (and its log line) up
     // to 64 KiB; beyond that ZeroMQ drops the connection.
     s.router.set(zmq::sockopt::maxmsgsize, static_cast<std::int64_t>(64 << 10));
-    s.router.set(zmq::sockopt::sndhwm, 256);
+    MAPLESS_CHECK(s.options.peer_queue >= 1 && s.options.max_followers >= 1,
+                  "fleet: peer_queue and max_followers must be >= 1");
+    s.router.set(zmq::sockopt::sndhwm, s.options.peer_queue);
     s.router.set(zmq::sockopt::linger, 200);
     SetHeartbeats(s.router);
     zmq_socket_monitor(s.router.handle(), "inproc://mapless-fleet-monitor",

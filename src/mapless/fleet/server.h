@@ -14,6 +14,7 @@
 #pragma once
 
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -27,20 +28,33 @@ namespace mapless::fleet {
 
 using FleetLogger = std::function<void(const std::string&)>;
 
+// The bounds on what the network can make the leader hold (docs/hardening.md). A follower that
+// does not read fills its queue (peer_queue messages): after stall_drop_s it is dropped (its
+// connection closed) with a line; all queues together are held under
+// total_queue_bytes (a follower is served later rather than memory grown), and at most
+// max_followers are served at once (one more is told nothing and logged).
 struct ServerOptions {
   std::string bind = "tcp://127.0.0.1:5600";
   LeaderSecurity security;
   std::size_t batch = 256;       // records per follower per round
   double heartbeat_s = 1.0;      // to an up-to-date follower
   double forget_after_s = 60.0;  // a follower silent this long is forgotten (it resubscribes)
+  int peer_queue = 8;            // messages queued to one follower (ZMQ_SNDHWM)
+  std::size_t total_queue_bytes = std::size_t{96} << 20;  // queued to all followers together
+  int max_followers = 256;
+  double stall_drop_s = 10.0;  // a follower whose queue stayed full this long is dropped
 };
 
 struct ServerStats {
   std::uint64_t subscriptions = 0;  // "from n" messages taken
   std::uint64_t records_sent = 0;
-  std::uint64_t refused = 0;   // handshakes failed or keys not admitted
-  std::uint64_t rejected = 0;  // malformed messages
-  int followers = 0;           // known now
+  std::uint64_t refused = 0;      // handshakes failed or keys not admitted
+  std::uint64_t rejected = 0;     // malformed messages
+  std::uint64_t dropped = 0;      // followers that stopped reading (or left) while records were due
+  std::uint64_t turned_away = 0;  // subscriptions beyond max_followers
+  int followers = 0;              // known now
+  std::size_t queued_bytes =
+      0;  // the bound on what the queues hold now (at most total_queue_bytes)
 };
 
 class LeaderServer {
