@@ -84,6 +84,19 @@ CLI::Validator FiniteIn(double lo, double hi) {
       "", "FiniteIn");
 }
 
+CLI::Validator ZeroOrIn(double lo, double hi) {
+  const CLI::Validator in = FiniteIn(lo, hi);
+  return CLI::Validator(
+      [in, lo, hi](std::string& text) -> std::string {
+        if (FiniteIn(0.0, 0.0)(text).empty()) return "";
+        if (in(text).empty()) return "";
+        std::ostringstream out;
+        out << "'" << text << "' is neither 0 nor a number in [" << lo << ", " << hi << "]";
+        return out.str();
+      },
+      "", "ZeroOrIn");
+}
+
 void RefuseOutputOverInputs(const std::string& output, const std::string& option,
                             const std::vector<std::string>& inputs) {
   namespace fs = std::filesystem;

@@ -64,6 +64,9 @@ sim::DriveSummary DriveToDirectory(const sim::Scenario& scenario, const sim::Dri
 CLI::Validator SeedCheck();
 // A CLI11 check: a finite number in [lo, hi] (CLI::Range lets nan through).
 CLI::Validator FiniteIn(double lo, double hi);
+// 0 (a rate's "as fast as it can"), or a finite number in [lo, hi] (a rate of 1e-300 would
+// overflow the pacing).
+CLI::Validator ZeroOrIn(double lo, double hi);
 
 // Throws InputError naming both unless `output` is a different file from every input and lies
 // outside every input directory. `option` names the output's option ("--log").

@@ -273,12 +273,15 @@ void AddEvalCommand(CLI::App* app) {
                   "every run, the error along the path; the first run's commands over time, its "
                   "method's plots and chosen frames) and PNG plots into this directory");
   cmd->callback([args, fleet] {
-    if (!args->report.empty()) RefuseOutputOverInputs(args->report, "--report", {});
+    if (args->suite == "fleet" && !args->report.empty())
+      throw InputError(
+          "--report: not for the fleet suite (its runs are processes; --keep "
+          "keeps their routes and logs)");
+    if (!args->report.empty()) {
+      RefuseOutputOverInputs(args->report, "--report", {});
+      CheckReportDir(args->report, "--report");
+    }
     if (args->suite == "fleet") {
-      if (!args->report.empty())
-        throw InputError(
-            "--report: not for the fleet suite (its runs are processes; --keep "
-            "keeps their routes and logs)");
       FleetEvalArgs f = *fleet;
       f.seed = args->seed;
       RunFleetEval(f, args->json);

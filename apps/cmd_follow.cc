@@ -100,7 +100,7 @@ void AddFollowCommand(CLI::App* app) {
   cmd->add_option("--rate", a->fleet.rate,
                   "With --connect on the simulator: simulated seconds per wall-clock second")
       ->capture_default_str()
-      ->check(FiniteIn(0.0, 100.0));
+      ->check(ZeroOrIn(0.01, 100.0));
   cmd->add_option("--summary", a->fleet.summary, "With --connect on the simulator: a JSON summary");
   cmd->add_option("--curve-key", a->fleet.curve_key, "CURVE: this follower's key file");
   cmd->add_option("--curve-leader", a->fleet.curve_leader, "CURVE: the leader's public key file");

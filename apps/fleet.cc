@@ -290,6 +290,18 @@ void Lead(const LeadArgs& a) {
   }
 }
 
+// The route a follower's method asks for; a route the leader completed too short to follow ends
+// the run with the reason (waiting for more cannot help).
+template <typename RoutePtr>
+RoutePtr NotTooShort(const fleet::RouteCopy& copy, RoutePtr route, const char* unit, int minimum) {
+  if (route == nullptr && copy.complete()) {
+    const std::uint64_t n = copy.next_sequence() >= 2 ? copy.next_sequence() - 2 : 0;
+    throw RunFailed("follow: the leader completed its route with " + std::to_string(n) + " " +
+                    unit + "; a route to follow needs at least " + std::to_string(minimum));
+  }
+  return route;
+}
+
 }  // namespace
 
 void FollowConnected(const FollowConnectArgs& a) {
@@ -317,9 +329,17 @@ void FollowConnected(const FollowConnectArgs& a) {
   // for a copy resumed from disk, until the leader has confirmed it is the same route.
   if (copy.next_sequence() > 0)
     spdlog::info("follow: waiting for the leader to confirm the copy in {}", a.route);
+  // Said every 5 s while nothing comes: what it waits for (no connection, a handshake failing).
+  auto next_word = std::chrono::steady_clock::now() + std::chrono::seconds(5);
   while (!copy.header() || !client.Verified()) {
     ThrowIfInterrupted();
-    if (!client.Refusal().empty()) throw InputError("follow: " + client.Refusal());
+    if (!client.Refusal().empty()) throw RunFailed("follow: " + client.Refusal());
+    if (std::chrono::steady_clock::now() > next_word) {
+      const fleet::ClientStats stats = client.stats();
+      spdlog::info("follow: still waiting for the leader's route: {}",
+                   stats.link_state.empty() ? "nothing heard from " + a.connect : stats.link_state);
+      next_word += std::chrono::seconds(5);
+    }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   const fleet::RouteHeader header = *copy.header();
@@ -336,14 +356,15 @@ void FollowConnected(const FollowConnectArgs& a) {
       repeat.sloped.max_speed_mps = speed;
       repeat.standard.forward_speed_mps = speed;
     }
-    method =
-        std::make_unique<robot::RepeatMethod>([&copy] { return copy.FunnelRoute(); }, repeat, size);
+    method = std::make_unique<robot::RepeatMethod>(
+        [&copy] { return NotTooShort(copy, copy.FunnelRoute(), "keyframes", 2); }, repeat, size);
   } else {
     navigation::AppearanceFollowerOptions follower;
     follower.obstacle = ObstacleWatchFor(a.robot, a.on_obstacle, follower.obstacle, false);
     SetFollowerRecovery(a.carry_on_m, &follower);
-    method = std::make_unique<robot::FollowMethod>([&copy] { return copy.AppearanceRoute(); },
-                                                   follower, size);
+    method = std::make_unique<robot::FollowMethod>(
+        [&copy] { return NotTooShort(copy, copy.AppearanceRoute(), "route images", 1); }, follower,
+        size);
   }
   spdlog::info("follow: a {} route from {}", fleet::RouteKindName(header.kind), a.connect);
   if (!scenario) {
@@ -465,7 +486,7 @@ void AddLeadCommand(CLI::App* app) {
   cmd->add_option("--rate", a->rate,
                   "Simulator: simulated seconds per second of wall clock (0: as fast as it can)")
       ->capture_default_str()
-      ->check(FiniteIn(0.0, 100.0));
+      ->check(ZeroOrIn(0.01, 100.0));
   cmd->add_option("--curve-key", a->curve_key, "CURVE: the leader's key file (fleet keygen)");
   cmd->add_option("--curve-allow", a->curve_allow,
                   "CURVE: public key files of the followers admitted (default: any that has the "

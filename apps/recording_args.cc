@@ -38,7 +38,7 @@ void AddPlaybackOptions(CLI::App* cmd, recording::PlaybackOptions* options, bool
                     "Play the source at this multiple of its recorded speed (0: each frame as "
                     "soon as the previous one is used)")
         ->capture_default_str()
-        ->check(FiniteIn(0.0, 1000.0));
+        ->check(ZeroOrIn(0.001, 1000.0));
   }
   cmd->add_option("--start", options->start_s, "Begin this many seconds into the source")
       ->capture_default_str()

@@ -1,9 +1,13 @@
 #include "run_report.h"
 
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 
+#include "mapless/core/check.h"
 #include "mapless/eval/potential.h"
 #include "mapless/io/atomic_file.h"
 #include "mapless/report/pictures.h"
@@ -54,6 +58,31 @@ void AddRunSection(report::HtmlReport* html, const RunSection& section) {
                "the starts, bars the final headings, stars the destinations.");
   for (const report::PlotSpec& plot : section.plots) html->Figure(report::LinePlotSvg(plot), "");
   if (!section.pictures.empty()) html->Images(section.pictures, section.pictures_caption);
+}
+
+void CheckReportDir(const std::string& dir, const std::string& option) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status status = fs::status(dir, ec);
+  if (fs::exists(status) && !fs::is_directory(status))
+    throw InputError(option + " " + dir +
+                     ": is not a directory (a report is a directory: index.html and PNG plots)");
+  const fs::path index = fs::path(dir) / "index.html";
+  if (fs::exists(index, ec)) {
+    std::ifstream in(index);
+    std::string head(4096, '\0');
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(in.gcount()));
+    const bool ours =
+        head.find("<meta name=\"generator\" content=\"mapless\">") != std::string::npos ||
+        head.find("<title>mapless ") != std::string::npos;
+    if (!ours)
+      throw InputError(option + " " + dir + ": " + index.string() +
+                       " exists and is not a mapless report; choose another directory");
+  }
+  io::MakeDirectories(dir);
+  if (::access(dir.c_str(), W_OK | X_OK) != 0)
+    throw InputError(option + " " + dir + ": not writable");
 }
 
 std::string WriteReport(const std::string& dir, const report::HtmlReport& html,

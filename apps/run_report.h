@@ -32,6 +32,11 @@ struct RunSection {
   std::string pictures_caption;
 };
 
+// Checks, before any work, that a report can go to `dir` without losing anything: it must be a
+// new or empty directory or one holding a report mapless wrote (its index.html says so), and
+// writable; throws InputError naming `option` and `dir` otherwise. Creates the directory.
+void CheckReportDir(const std::string& dir, const std::string& option);
+
 // The reference path's signed distance (m, left positive) of each pose of `path`, against the
 // distance driven along it (m): the "error along the path" plot's series.
 // A number with `digits` decimals, for the report's text and tables.

@@ -3,12 +3,15 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstdint>
+#include <cstring>
 #include <deque>
 #include <mutex>
 #include <thread>
 #include <zmq.hpp>
 
 #include "mapless/core/check.h"
+#include "mapless/fleet/limited_log.h"
 #include "mapless/fleet/zmq_util.h"
 
 namespace mapless::fleet {
@@ -18,6 +21,12 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr std::size_t kMaxLatencySamples = 100000;
+// Records received and not yet applied: beyond this the follower takes no more until the copy
+// has caught up (the leader sends them again when asked), so a leader cannot fill its memory.
+constexpr std::size_t kMaxQueuedRecords = 1024;
+// Handshakes failed in a row before the follower gives up on a leader: the two disagree on CURVE
+// (a key on one side only, the wrong leader key) or the endpoint is not a mapless leader.
+constexpr int kMaxHandshakeFailures = 3;
 
 }  // namespace
 
@@ -30,6 +39,7 @@ struct FollowerClient::Impl {
   FleetLogger log_line;
   zmq::context_t context{1};
   zmq::socket_t dealer{context, zmq::socket_type::dealer};
+  zmq::socket_t monitor{context, zmq::socket_type::pair};
   std::atomic<bool> stop{false};
   mutable std::mutex stats_mutex;
   ClientStats stats;
@@ -46,8 +56,9 @@ struct FollowerClient::Impl {
   std::mutex queue_mutex;
   std::condition_variable queue_ready;
   std::deque<Record> queue;
-  std::atomic<bool> resync{false};  // a record was refused: drop the queue, ask from the copy
-  std::string refusal;              // under stats_mutex: why this follower takes nothing more
+  std::atomic<std::size_t> queued{0};  // queue.size()
+  std::atomic<bool> resync{false};     // a record was refused: drop the queue, ask from the copy
+  std::string refusal;                 // under stats_mutex: why this follower takes nothing more
   std::string refused() {
     std::lock_guard<std::mutex> lock(stats_mutex);
     return refusal;
@@ -62,6 +73,61 @@ struct FollowerClient::Impl {
 
   void Log(const std::string& line) {
     if (log_line) log_line(line);
+  }
+  LimitedLog limited{[this](const std::string& line) { Log(line); }};  // network thread
+
+  // The connection as ZeroMQ's monitor tells it (network thread): what the follower waits for.
+  int handshake_failures = 0;
+  void Refuse(const std::string& why) {
+    std::lock_guard<std::mutex> lock(stats_mutex);
+    if (!refusal.empty()) return;
+    refusal = why;
+    Log("fleet: " + why);
+  }
+  void SetLinkState(const std::string& state) {
+    std::lock_guard<std::mutex> lock(stats_mutex);
+    stats.link_state = state;
+  }
+  void HandleMonitor() {
+    std::vector<zmq::message_t> event;
+    if (!RecvAll(monitor, &event, /*wait=*/false) || event.size() < 2 || event[0].size() < 6)
+      return;
+    std::uint16_t id = 0;
+    std::uint32_t value = 0;
+    std::memcpy(&id, event[0].data(), 2);
+    std::memcpy(&value, static_cast<const char*>(event[0].data()) + 2, 4);
+    const std::string& at = options.connect;
+    switch (id) {
+      case ZMQ_EVENT_CONNECT_RETRIED:
+        SetLinkState("no connection to " + at + " (nothing listens there yet?)");
+        break;
+      case ZMQ_EVENT_CONNECTED:
+        SetLinkState("connected to " + at + ", handshake under way");
+        break;
+      case ZMQ_EVENT_HANDSHAKE_SUCCEEDED:
+        handshake_failures = 0;
+        SetLinkState("connected to " + at);
+        break;
+      case ZMQ_EVENT_HANDSHAKE_FAILED_AUTH:
+        Refuse("the leader at " + at + " refused this follower's CURVE key (status " +
+               std::to_string(value) + "; is its public key among the leader's --curve-allow?)");
+        break;
+      case ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL:
+      case ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL:
+        if (++handshake_failures >= kMaxHandshakeFailures) {
+          Refuse("the handshake with " + at + " failed " + std::to_string(handshake_failures) +
+                 " times: the leader and this follower disagree on CURVE (--curve-key on one "
+                 "side only, or not the leader's public key in --curve-leader), or no mapless "
+                 "leader listens there");
+        }
+        SetLinkState("the handshake with " + at + " failed");
+        break;
+      case ZMQ_EVENT_DISCONNECTED:
+        SetLinkState("disconnected from " + at + ", reconnecting");
+        break;
+      default:
+        break;
+    }
   }
 
   // With ZMQ_IMMEDIATE a message is not queued while there is no connection: nothing was sent,
@@ -95,9 +161,12 @@ struct FollowerClient::Impl {
       try {
         r = DecodeRecord(msg.to_string_view());
       } catch (const InputError& e) {
-        std::lock_guard<std::mutex> lock(stats_mutex);
-        ++stats.rejected;
-        Log(std::string("fleet: rejected a message from the leader: ") + e.what());
+        {
+          std::lock_guard<std::mutex> lock(stats_mutex);
+          ++stats.rejected;
+        }
+        limited.Say("messages rejected",
+                    std::string("fleet: rejected a message from the leader: ") + e.what());
         continue;
       }
       std::lock_guard<std::mutex> lock(stats_mutex);
@@ -126,8 +195,8 @@ struct FollowerClient::Impl {
         ++stats.duplicates_dropped;
         continue;
       }
-      if (r.sequence > expected) {
-        ++stats.ahead_dropped;
+      if (r.sequence > expected || queued + taken.size() >= kMaxQueuedRecords) {
+        ++stats.ahead_dropped;  // a gap, or the copy is behind: asked again later
         gap = true;
         continue;
       }
@@ -139,6 +208,7 @@ struct FollowerClient::Impl {
     if (!taken.empty()) {
       std::lock_guard<std::mutex> lock(queue_mutex);
       for (Record& r : taken) queue.push_back(std::move(r));
+      queued = queue.size();
       queue_ready.notify_one();
     }
     return gap;
@@ -157,13 +227,18 @@ struct FollowerClient::Impl {
         std::this_thread::sleep_for(std::chrono::milliseconds(100));
         continue;
       }
-      zmq::pollitem_t item{dealer.handle(), 0, ZMQ_POLLIN, 0};
-      zmq::poll(&item, 1, std::chrono::milliseconds(unsent ? 20 : 100));
+      zmq::pollitem_t items[2] = {{dealer.handle(), 0, ZMQ_POLLIN, 0},
+                                  {monitor.handle(), 0, ZMQ_POLLIN, 0}};
+      zmq::poll(items, 2, std::chrono::milliseconds(unsent ? 20 : 100));
       if (stop) break;
+      if (items[1].revents & ZMQ_POLLIN) HandleMonitor();
+      limited.Flush();
+      const zmq::pollitem_t& item = items[0];
       const auto now = Clock::now();
       if (resync.exchange(false)) {
         std::lock_guard<std::mutex> lock(queue_mutex);
         queue.clear();
+        queued = 0;
         expected = copy.next_sequence();
         hold_until = now + std::chrono::duration_cast<Clock::duration>(
                                std::chrono::duration<double>(options.resubscribe_s));
@@ -197,6 +272,7 @@ struct FollowerClient::Impl {
           batch.push_back(std::move(queue.front()));
           queue.pop_front();
         }
+        queued = queue.size();
       }
       const std::uint64_t before = copy.next_sequence();
       try {
@@ -219,6 +295,7 @@ struct FollowerClient::Impl {
 FollowerClient::FollowerClient(RouteCopy& copy, ClientOptions options, FleetLogger log_line)
     : impl_(std::make_unique<Impl>(copy, std::move(options), std::move(log_line))) {
   Impl& c = *impl_;
+  CheckEndpoint(c.options.connect, "--connect", /*bind=*/false);
   try {
     if (c.options.security.enabled()) {
       MAPLESS_CHECK(CurveAvailable(), "fleet: this libzmq was built without CURVE (libsodium)");
@@ -227,11 +304,21 @@ FollowerClient::FollowerClient(RouteCopy& copy, ClientOptions options, FleetLogg
       c.dealer.set(zmq::sockopt::curve_secretkey, c.options.security.key.secret_key);
     }
     c.dealer.set(zmq::sockopt::maxmsgsize, static_cast<std::int64_t>(kMaxMessageBytes));
+    // At most 32 messages wait in ZeroMQ's queue (1,000 by default: 32 GB of maximal records).
+    c.dealer.set(zmq::sockopt::rcvhwm, 32);
     c.dealer.set(zmq::sockopt::immediate, 1);
     c.dealer.set(zmq::sockopt::linger, 0);
     c.dealer.set(zmq::sockopt::reconnect_ivl, 200);
     c.dealer.set(zmq::sockopt::reconnect_ivl_max, 1000);
     SetHeartbeats(c.dealer);
+    const std::string monitor_endpoint =
+        "inproc://mapless-follower-monitor-" + std::to_string(reinterpret_cast<std::uintptr_t>(&c));
+    zmq_socket_monitor(c.dealer.handle(), monitor_endpoint.c_str(),
+                       ZMQ_EVENT_CONNECTED | ZMQ_EVENT_CONNECT_RETRIED |
+                           ZMQ_EVENT_HANDSHAKE_SUCCEEDED | ZMQ_EVENT_HANDSHAKE_FAILED_AUTH |
+                           ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL |
+                           ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL | ZMQ_EVENT_DISCONNECTED);
+    c.monitor.connect(monitor_endpoint);
     c.dealer.connect(c.options.connect);
   } catch (const zmq::error_t& e) {
     throw InputError("--connect " + c.options.connect + ": " + e.what());
@@ -240,14 +327,14 @@ FollowerClient::FollowerClient(RouteCopy& copy, ClientOptions options, FleetLogg
     try {
       c.RunNetwork();
     } catch (const std::exception& e) {
-      c.Log(std::string("fleet: the link to the leader stopped: ") + e.what());
+      c.Refuse(std::string("the link to the leader stopped: ") + e.what());
     }
   });
   c.applier = std::thread([&c] {
     try {
       c.RunApplier();
     } catch (const std::exception& e) {
-      c.Log(std::string("fleet: the copy of the route stopped: ") + e.what());
+      c.Refuse(std::string("the copy of the route stopped: ") + e.what());
     }
   });
 }

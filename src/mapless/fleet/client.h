@@ -8,7 +8,9 @@
 // heartbeat every second), the follower asks again: after a link outage, a leader restart or a
 // follower restart, the copy goes on from its last whole record.
 //
-// Runs its own thread. A malformed record is rejected with one log line and changes nothing.
+// Runs its own threads. A malformed record is rejected with one log line (at most one a second,
+// with counts) and changes nothing. What it holds is bounded: 32 messages in ZeroMQ's queue, 1,024
+// records waiting to be applied.
 #pragma once
 
 #include <cstdint>
@@ -39,6 +41,7 @@ struct ClientStats {
   std::uint64_t leader_records = 0;      // the leader's log size at its last heartbeat
   bool leader_complete = false;
   double silent_s = 0.0;           // since the last message from the leader
+  std::string link_state;          // what the connection is doing ("no connection to ...")
   std::vector<double> latency_ms;  // live records: leader's write to this receive
 };
 
@@ -48,8 +51,9 @@ class FollowerClient {
   FollowerClient(RouteCopy& copy, ClientOptions options, FleetLogger log_line);
   ~FollowerClient();
   ClientStats stats() const;
-  // Not empty when this follower refuses the leader's route: its copy (resumed from disk) is of
-  // another route. It then takes nothing more.
+  // Not empty when this follower cannot go on with this leader, and why: its copy (resumed from
+  // disk) is of another route, the leader refused its CURVE key, the handshake failed three times
+  // in a row, or the link's thread stopped. It then takes nothing more.
   std::string Refusal() const;
   // True once the copy is known to be the leader's route: at once for a new copy; for one resumed
   // from disk, when the leader's copy of its last record matched.

@@ -46,7 +46,13 @@ CurveKey LoadCurveKey(const std::string& path, bool need_secret) {
 
 CurveKey GenerateCurveKey(const std::string& path) {
   if (!CurveAvailable()) throw InputError("this libzmq was built without CURVE (libsodium)");
-  if (std::filesystem::exists(path)) throw InputError(path + ": exists; choose another name");
+  // Neither file may be there already (a public key handed out, or a dangling link, is never
+  // replaced): both are checked before either is written.
+  for (const std::string& file : {path, path + ".pub"}) {
+    std::error_code ec;
+    if (std::filesystem::symlink_status(file, ec).type() != std::filesystem::file_type::not_found)
+      throw InputError(file + ": exists; choose another name (keys are never overwritten)");
+  }
   char pub[41];
   char sec[41];
   if (zmq_curve_keypair(pub, sec) != 0) throw InputError("cannot make a CURVE key pair");

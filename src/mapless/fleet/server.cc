@@ -13,6 +13,7 @@
 #include <zmq.hpp>
 
 #include "mapless/core/check.h"
+#include "mapless/fleet/limited_log.h"
 #include "mapless/fleet/zmq_util.h"
 
 namespace mapless::fleet {
@@ -77,33 +78,8 @@ struct LeaderServer::Impl {
     if (log_line) log_line(line);
   }
 
-  // Bad input and followers coming and going are logged, but at most one line a second (a peer
-  // sending garbage, or 200 peers connecting, cannot flood the log): the lines held back are
-  // counted by kind in the next one.
-  Clock::time_point last_limited_log;
-  std::map<std::string, int> held_back;  // by kind ("joined", "rejected", ...)
-  std::string HeldBack() {
-    std::string text;
-    for (const auto& [kind, n] : held_back)
-      text += (text.empty() ? "" : ", ") + std::to_string(n) + " " + kind;
-    held_back.clear();
-    return text;
-  }
-  void LogLimited(const std::string& kind, const std::string& line) {
-    const auto now = Clock::now();
-    if (now - last_limited_log < std::chrono::seconds(1)) {
-      ++held_back[kind];
-      return;
-    }
-    const std::string held = HeldBack();
-    Log(line + (held.empty() ? "" : " (held back since the last line: " + held + ")"));
-    last_limited_log = now;
-  }
-  void FlushLimited() {
-    if (held_back.empty() || Clock::now() - last_limited_log < std::chrono::seconds(1)) return;
-    Log("fleet: in the last second also " + HeldBack());
-    last_limited_log = Clock::now();
-  }
+  LimitedLog limited{[this](const std::string& line) { Log(line); }};
+  void LogLimited(const std::string& kind, const std::string& line) { limited.Say(kind, line); }
 
   void Count(std::uint64_t ServerStats::*field) {
     std::lock_guard<std::mutex> lock(stats_mutex);
@@ -318,7 +294,7 @@ struct LeaderServer::Impl {
       if (items[2].revents & ZMQ_POLLIN) HandleMonitor();
       if (items.size() > 3 && (items[3].revents & ZMQ_POLLIN)) HandleZap();
       blocked = SendRound();
-      FlushLimited();
+      limited.Flush();
     }
   }
 };
@@ -326,6 +302,7 @@ struct LeaderServer::Impl {
 LeaderServer::LeaderServer(const RouteCopy& log, ServerOptions options, FleetLogger log_line)
     : impl_(std::make_unique<Impl>(log, std::move(options), std::move(log_line))) {
   Impl& s = *impl_;
+  CheckEndpoint(s.options.bind, "--bind", /*bind=*/true);
   s.wake_fd = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   MAPLESS_CHECK(s.wake_fd >= 0, "fleet: cannot create an eventfd");
   try {

@@ -6,6 +6,8 @@
 #include <vector>
 #include <zmq.hpp>
 
+#include "mapless/core/check.h"
+
 namespace mapless::fleet {
 
 // Receives one whole multipart message; false when none is waiting (wait = false) or on EINTR.
@@ -35,6 +37,33 @@ inline SendResult SendTo(zmq::socket_t& router, const std::string& id, std::stri
     if (e.num() == EHOSTUNREACH) return SendResult::kGone;
     throw;
   }
+}
+
+// Refuses an endpoint ZeroMQ would take wrongly or silently (a port of 99999 wraps to another
+// port): tcp://HOST:PORT with PORT 1-65535 (or * when binding), or ipc://PATH. Throws InputError
+// naming `option`.
+inline void CheckEndpoint(const std::string& endpoint, const std::string& option, bool bind) {
+  const auto fail = [&](const std::string& why) {
+    throw InputError(option + " " + endpoint + ": " + why);
+  };
+  if (endpoint.rfind("ipc://", 0) == 0) {
+    if (endpoint.size() == 6) fail("ipc:// needs a path");
+    return;
+  }
+  if (endpoint.rfind("tcp://", 0) != 0) fail("expected tcp://HOST:PORT or ipc://PATH");
+  const std::size_t colon = endpoint.rfind(':');
+  if (colon < 6 || colon == 5) fail("expected tcp://HOST:PORT");
+  const std::string host = endpoint.substr(6, colon - 6);
+  const std::string port = endpoint.substr(colon + 1);
+  if (host.empty()) fail("no host (tcp://127.0.0.1:PORT, or tcp://*:PORT to bind every interface)");
+  if (port == "*" || port == "0") {
+    if (!bind) fail("a follower needs the leader's port, not " + port);
+    return;
+  }
+  if (port.empty() || port.size() > 5 || port.find_first_not_of("0123456789") != std::string::npos)
+    fail("port '" + port + "' is not a number from 1 to 65535");
+  const long value = std::stol(port);
+  if (value < 1 || value > 65535) fail("port " + port + " is not from 1 to 65535");
 }
 
 // ZMTP heartbeats: a connection that stops answering is dropped within seconds and re-dialled by

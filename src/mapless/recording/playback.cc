@@ -85,8 +85,9 @@ class PlaybackSource : public io::FrameSource {
 }  // namespace
 
 void PlaybackOptions::Validate() const {
-  if (!std::isfinite(rate) || rate < 0.0 || rate > 1000.0)
-    throw InputError("--rate " + std::to_string(rate) + ": expected 0 (as fast as used) to 1000");
+  if (!std::isfinite(rate) || (rate != 0.0 && (rate < 0.001 || rate > 1000.0)))
+    throw InputError("--rate " + std::to_string(rate) +
+                     ": expected 0 (as fast as used) or 0.001 to 1000");
   if (!std::isfinite(start_s) || start_s < 0.0)
     throw InputError("--start " + std::to_string(start_s) + ": expected seconds >= 0");
   if (!std::isfinite(fps) || fps < io::kMinFolderFps || fps > io::kMaxFolderFps)
