@@ -102,7 +102,8 @@ void HtmlReport::Images(const std::vector<std::pair<cv::Mat, std::string>>& imag
 }
 
 std::string HtmlReport::Html() const {
-  return "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<meta name=\"generator\" "
+  return "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<meta "
+         "name=\"generator\" "
          "content=\"mapless\">\n<link "
          "rel=\"icon\" href=\"data:,\">\n<title>" +
          Escape(title_) + "</title>\n<style>" + kStyle + "</style>\n</head>\n<body>\n<h1>" +
