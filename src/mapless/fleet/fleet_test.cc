@@ -351,3 +351,36 @@ TEST(FleetLink, WithCurveAFollowerWithoutTheRightKeyReceivesNothing) {
 
 }  // namespace
 }  // namespace mapless::fleet
+
+namespace mapless::fleet {
+namespace {
+
+// Issue 40: ZeroMQ takes a port of 99999 as another port; such endpoints are refused by name.
+std::string FreshDirForEndpoints() {
+  const std::string dir = ::testing::TempDir() + "mapless_fleet_endpoints";
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove_all(dir + "_copy");
+  return dir;
+}
+
+TEST(FleetLink, EndpointsOutsideThePortRangeAreRefused) {
+  RouteCopy log(FreshDirForEndpoints());
+  for (const std::string bad : {"tcp://127.0.0.1:99999", "tcp://127.0.0.1:", "tcp://:5600",
+                                "udp://127.0.0.1:5600", "tcp://127.0.0.1:56x", "ipc://"}) {
+    ServerOptions options;
+    options.bind = bad;
+    try {
+      LeaderServer server(log, options, nullptr);
+      ADD_FAILURE() << "bound " << bad;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("--bind " + bad), std::string::npos) << e.what();
+    }
+  }
+  RouteCopy copy(FreshDirForEndpoints() + "_copy");
+  ClientOptions client;
+  client.connect = "tcp://127.0.0.1:0";
+  EXPECT_THROW(FollowerClient(copy, client, nullptr), InputError);
+}
+
+}  // namespace
+}  // namespace mapless::fleet

@@ -19,6 +19,30 @@ std::string ShortValue(const YAML::Node& node) {
   return "nothing";
 }
 
+// A mapping that names a key twice is refused (yaml-cpp keeps both and a lookup finds one: a robot
+// file's second `cmd_vel` would be silently ignored, or used). Walks the whole document.
+void RefuseDuplicateKeys(const YAML::Node& node, const std::string& name, int depth = 0) {
+  if (depth > 64) return;  // yaml-cpp refuses deeper documents itself
+  if (node.IsSequence()) {
+    for (const auto& item : node) RefuseDuplicateKeys(item, name, depth + 1);
+  } else if (node.IsMap()) {
+    std::vector<std::string> keys;
+    for (const auto& kv : node) {
+      if (kv.first.IsScalar()) {
+        const std::string& key = kv.first.Scalar();
+        if (std::find(keys.begin(), keys.end(), key) != keys.end()) {
+          std::ostringstream out;
+          out << name << ":" << kv.first.Mark().line + 1 << ":" << kv.first.Mark().column + 1
+              << ": duplicate key '" << key << "'";
+          throw InputError(out.str());
+        }
+        keys.push_back(key);
+      }
+      RefuseDuplicateKeys(kv.second, name, depth + 1);
+    }
+  }
+}
+
 }  // namespace
 
 YamlMap YamlMap::LoadFile(const std::string& path) {
@@ -36,6 +60,7 @@ YamlMap YamlMap::LoadString(const std::string& text, const std::string& name) {
     throw InputError(out.str());
   }
   if (!root.IsMap()) throw InputError(name + ":1:1: expected a YAML mapping at the top level");
+  RefuseDuplicateKeys(root, name);
   return YamlMap(root, name, "");
 }
 

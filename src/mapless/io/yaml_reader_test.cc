@@ -19,6 +19,16 @@ TEST(YamlMap, ReadsTypedFieldsAndDefaults) {
   EXPECT_DOUBLE_EQ(m.GetDouble("missing", 7.0), 7.0);
 }
 
+TEST(YamlMap, ADuplicateKeyIsRefusedAtAnyDepth) {
+  std::string err =
+      testing::InputErrorOf([] { YamlMap::LoadString("a: 1\nb: 2\na: 3\n", "d.yaml"); });
+  EXPECT_NE(err.find("d.yaml:3:1: duplicate key 'a'"), std::string::npos) << err;
+  err = testing::InputErrorOf(
+      [] { YamlMap::LoadString("list:\n  - {x: 1, y: 2, x: 1}\n", "d.yaml"); });
+  EXPECT_NE(err.find("duplicate key 'x'"), std::string::npos) << err;
+  EXPECT_NO_THROW(YamlMap::LoadString("a: {x: 1}\nb: {x: 1}\n", "ok.yaml"));
+}
+
 TEST(YamlMap, MalformedYamlNamesFileAndLine) {
   const std::string err =
       testing::InputErrorOf([] { YamlMap::LoadString("a: 1\nb: [1, 2\n", "bad.yaml"); });

@@ -117,6 +117,22 @@ RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
       get("status", &r.topics.status, false);
       get("debug_image", &r.topics.debug_image, true);
       get("estop", &r.topics.estop, true);
+      // One topic for two roles (cmd_vel on the camera topic, say) would feed mapless its own
+      // messages or drive the robot with them: every topic it uses must be another.
+      const std::pair<const char*, const std::string*> roles[] = {
+          {"image", &r.topics.image},       {"compressed_image", &r.topics.compressed_image},
+          {"odometry", &r.topics.odometry}, {"cmd_vel", &r.topics.cmd_vel},
+          {"status", &r.topics.status},     {"debug_image", &r.topics.debug_image},
+          {"estop", &r.topics.estop}};
+      for (std::size_t i = 0; i < std::size(roles); ++i) {
+        for (std::size_t j = 0; j < i; ++j) {
+          if (roles[i].second->empty() ||
+              r.Resolve(*roles[i].second) != r.Resolve(*roles[j].second))
+            continue;
+          t.Fail(roles[i].first, "'" + *roles[i].second + "' is also the " + roles[j].first +
+                                     " topic; each role needs a topic of its own");
+        }
+      }
     }
     if (map.Has("limits")) {
       const io::YamlMap l = map.GetMap("limits");

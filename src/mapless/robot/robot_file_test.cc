@@ -52,6 +52,10 @@ TEST(RobotFile, BadFieldsAreNamed) {
   ExpectError("obstacles: {on_obstacle: swerve}\n", "on_obstacle");
   ExpectError("obstacles: {region_width: 0}\n", "obstacles.region_width");
   ExpectError("obstacles: {horizon: 0.8}\n", "obstacles.horizon");  // below region_top
+  // Issue 40: a key named twice, and one topic for two roles.
+  ExpectError("middleware: ros2\nmiddleware: ros1\n", "duplicate key 'middleware'");
+  ExpectError("topics: {cmd_vel: camera/image_raw}\n", "topics.cmd_vel");
+  ExpectError("namespace: r1\ntopics: {image: /r1/cam, status: cam}\n", "also the image topic");
 }
 
 TEST(RobotFile, ObstacleWatchSettings) {

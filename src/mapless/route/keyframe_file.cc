@@ -80,6 +80,13 @@ class CanonicalReader {
     *v = std::strtod(token.c_str(), &end);
     return end == token.c_str() + token.size() && std::isfinite(*v);
   }
+  // True when a whole number (an optional '-' and digits only) starts here; reads nothing.
+  bool Digits() const {
+    std::size_t i = pos_ + (pos_ < s_.size() && s_[pos_] == '-' ? 1 : 0);
+    const std::size_t first = i;
+    while (i < s_.size() && std::isdigit(static_cast<unsigned char>(s_[i]))) ++i;
+    return i > first && i < s_.size() && s_[i] == '"';
+  }
   bool Integer(long long lo, long long hi, long long* v) {
     double d = 0.0;
     if (!Number(&d) || d != std::floor(d) || d < static_cast<double>(lo) ||
@@ -127,7 +134,7 @@ std::optional<Keyframe> ParseCanonicalKeyframe(const std::string& text) {
   kf.index = static_cast<int>(v);
   if (!in.Literal("\nt_ns: \"")) return std::nullopt;
   double t = 0.0;
-  if (!in.Number(&t) || !in.Literal("\"\nkeypoints:\n")) return std::nullopt;
+  if (!in.Digits() || !in.Number(&t) || !in.Literal("\"\nkeypoints:\n")) return std::nullopt;
   // t_ns is written as a decimal string of a 64-bit integer: a double cannot hold every one, so
   // anything above 2^53 ns (104 days) goes to the general reader.
   if (t != std::floor(t) || std::abs(t) > 9007199254740992.0) return std::nullopt;
@@ -254,11 +261,12 @@ Keyframe ParseKeyframe(const std::string& text, const std::string& name) {
     Keyframe kf;
     kf.index = root.GetInt("index");
     if (kf.index < 0) root.Fail("index", "must be >= 0");
-    try {
-      kf.t_ns = std::stoll(root.GetString("t_ns"));
-    } catch (const std::logic_error&) {  // invalid_argument, out_of_range
-      root.Fail("t_ns", "expected a whole number of nanoseconds");
-    }
+    // The whole string, digits only (std::stoll took "0.5" as 0 and "12abc" as 12).
+    const std::string t_text = root.GetString("t_ns");
+    const std::from_chars_result t_read =
+        std::from_chars(t_text.data(), t_text.data() + t_text.size(), kf.t_ns);
+    if (t_text.empty() || t_read.ec != std::errc() || t_read.ptr != t_text.data() + t_text.size())
+      root.Fail("t_ns", "expected a whole number of nanoseconds, got '" + t_text + "'");
     if (root.Has("keypoints")) {
       const std::vector<io::YamlMap> keypoints = root.GetList("keypoints");
       if (keypoints.size() > static_cast<std::size_t>(io::kMaxKeypoints)) {

@@ -198,6 +198,23 @@ TEST(RouteStore, LoadingCatchesWhatARepeatWouldTripOn) {
 namespace mapless::route {
 namespace {
 
+// Issue 40: t_ns is a whole number, all of it ("0.5" was read as 0 and "12abc" as 12).
+TEST(RouteStore, AKeyframeTimeThatIsNotAWholeNumberIsRefused) {
+  const std::string text = SerializeKeyframe(MakeKeyframe(1));
+  const std::size_t at = text.find("t_ns: \"");
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t end = text.find('"', at + 7);
+  for (const std::string bad : {"0.5", "12abc", "1e3", "", " 7", "99999999999999999999"}) {
+    const std::string edited = text.substr(0, at + 7) + bad + text.substr(end);
+    try {
+      ParseKeyframe(edited, "kf.yml");
+      ADD_FAILURE() << "accepted t_ns '" << bad << "'";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("t_ns"), std::string::npos) << e.what();
+    }
+  }
+}
+
 // ParseKeyframe reads a file as the route store writes it with a fast reader, and anything else
 // with yaml-cpp: both must give the same keyframe (a comment line makes the file non-canonical).
 TEST(RouteStore, TheFastKeyframeReaderAgreesWithYamlCpp) {
