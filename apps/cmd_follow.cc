@@ -57,10 +57,15 @@ void ReplayOnRecording(robot::Method& method, const std::string& source,
   JsonLines log(log_path);
   StopCleanlyOnInterrupt();
   int frame = 0;
+  int decided = 0;  // frames on which the method could decide (it drove, or chose to wait)
+  std::string why_not;
   const robot::LoopResult result = robot::RunLoop(
       method, link, robot::LoopOptions{},
       [&](const robot::Observation& obs, const robot::Decision& decision) {
         log.Write(robot::StatusJson(method.name(), frame++, obs, decision));
+        if (decision.state == robot::MethodState::kDriving) ++decided;
+        if (decision.state != robot::MethodState::kDriving && !decision.reason.empty())
+          why_not = decision.reason;
         return true;
       },
       [] { return InterruptSignal() != 0; });
@@ -69,6 +74,12 @@ void ReplayOnRecording(robot::Method& method, const std::string& source,
                result.reason);
   if (!result.finished && result.reason != recording::kEndOfRecording)
     throw RunFailed(std::string(method.name()) + " stopped: " + result.reason);
+  // A replay on which the method never once drove answered nothing (issue 40: exit 0 with every
+  // decision "stopped: needs odometry").
+  if (!result.finished && result.frames > 0 && decided == 0)
+    throw RunFailed(std::string(method.name()) + " on " + source + ": stopped on all " +
+                    std::to_string(result.frames) + " frames" +
+                    (why_not.empty() ? "" : ", the last time: " + why_not));
 }
 
 void AddFollowCommand(CLI::App* app) {

@@ -15,6 +15,7 @@
 #include "fleet.h"
 #include "interrupt.h"
 #include "mapless/core/check.h"
+#include "mapless/core/warning.h"
 
 namespace {
 
@@ -67,6 +68,7 @@ int main(int argc, char** argv) {
   // failure reaches the user as mapless's own message instead.
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
   mapless::app::InstallInterruptHandlers();
+  mapless::SetWarningSink([](const std::string& line) { spdlog::warn("{}", line); });
   mapless::app::AddDemoCommand(&app);
   mapless::app::AddSimCommands(&app);
   mapless::app::AddTeachRepeatCommands(&app);

@@ -229,13 +229,25 @@ void Teach(const TeachArgs& t) {
       while (source->Next(&frame)) frame_in(frame.image, frame.t_ns, frame.odometry);
     }
   } catch (const Interrupted&) {
-    if (frames == 0 || !(io::IsLiveCamera(t.source) || robot_file)) throw;
+    if (frames == 0 || !(io::IsLiveCamera(t.source) || robot_file)) {
+      if (teacher->stored() < teacher->minimum()) out.Discard();
+      throw;
+    }
     interrupted = true;  // the end of a camera or robot teach
+  } catch (...) {
+    // Bad input, a full disk, a camera gone: a route too short to use is not left behind (it
+    // would block the same command's rerun); a longer one stays, and loads as incomplete.
+    if (teacher->stored() < teacher->minimum()) out.Discard();
+    throw;
   }
-  if (frames == 0) throw InputError((robot_file ? t.robot : t.source) + ": no frames");
+  if (frames == 0) {
+    out.Discard();
+    throw InputError((robot_file ? t.robot : t.source) + ": no frames");
+  }
   teacher->Finish();
   spdlog::info("teach: {} frames, {} {}", frames, teacher->stored(), teacher->unit());
   if (teacher->stored() < teacher->minimum()) {
+    out.Discard();  // a route too short to use is not left behind to block the next teach
     throw RunFailed("teach: " + std::to_string(teacher->stored()) + " " + teacher->unit() +
                     " (too few features in the images?); a route needs at least " +
                     std::to_string(teacher->minimum()) + ", so none was " +

@@ -354,7 +354,11 @@ code=$?
 bad=$(while IFS= read -r l; do case "$l" in '{'*'}') ;; *) echo x ;; esac; done <"$NEW/old.jsonl" | wc -l)
 [ "$bad" -eq 0 ]; check "SIGTERM: every log line is whole ($bad cut)" $?
 
+# shellcheck source=round3.sh
+source "$(dirname "$0")/round3.sh"
+
 echo "probe: $cases bad-input cases"
 [ "$cases" -ge 60 ]; check "at least 60 bad-input cases ($cases)" $?
+[ "$ROUND3_CASES" -ge 80 ]; check "at least 80 cases of round 3 ($ROUND3_CASES)" $?
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

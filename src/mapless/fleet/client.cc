@@ -78,6 +78,15 @@ struct FollowerClient::Impl {
 
   // The connection as ZeroMQ's monitor tells it (network thread): what the follower waits for.
   int handshake_failures = 0;
+  bool handshaking = false;  // connected, handshake not yet succeeded or failed
+  void CountHandshakeFailure() {
+    handshaking = false;
+    if (++handshake_failures < kMaxHandshakeFailures) return;
+    Refuse("the handshake with " + options.connect + " failed " +
+           std::to_string(handshake_failures) +
+           " times: the leader and this follower disagree on CURVE (--curve-key on one side only, "
+           "or not the leader's public key in --curve-leader), or no mapless leader listens there");
+  }
   void Refuse(const std::string& why) {
     std::lock_guard<std::mutex> lock(stats_mutex);
     if (!refusal.empty()) return;
@@ -102,27 +111,28 @@ struct FollowerClient::Impl {
         SetLinkState("no connection to " + at + " (nothing listens there yet?)");
         break;
       case ZMQ_EVENT_CONNECTED:
+        handshaking = true;
         SetLinkState("connected to " + at + ", handshake under way");
         break;
       case ZMQ_EVENT_HANDSHAKE_SUCCEEDED:
+        handshaking = false;
         handshake_failures = 0;
         SetLinkState("connected to " + at);
         break;
       case ZMQ_EVENT_HANDSHAKE_FAILED_AUTH:
+        handshaking = false;
         Refuse("the leader at " + at + " refused this follower's CURVE key (status " +
                std::to_string(value) + "; is its public key among the leader's --curve-allow?)");
         break;
       case ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL:
       case ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL:
-        if (++handshake_failures >= kMaxHandshakeFailures) {
-          Refuse("the handshake with " + at + " failed " + std::to_string(handshake_failures) +
-                 " times: the leader and this follower disagree on CURVE (--curve-key on one "
-                 "side only, or not the leader's public key in --curve-leader), or no mapless "
-                 "leader listens there");
-        }
+        CountHandshakeFailure();
         SetLinkState("the handshake with " + at + " failed");
         break;
       case ZMQ_EVENT_DISCONNECTED:
+        // Closed before the handshake succeeded: the leader refused it (CURVE on one side only
+        // shows so, or as a protocol failure).
+        if (handshaking) CountHandshakeFailure();
         SetLinkState("disconnected from " + at + ", reconnecting");
         break;
       default:

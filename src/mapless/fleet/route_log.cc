@@ -14,6 +14,7 @@
 #include "mapless/io/atomic_file.h"
 #include "mapless/io/image_file.h"
 #include "mapless/io/limits.h"
+#include "mapless/io/output_dir.h"
 
 namespace mapless::fleet {
 
@@ -152,7 +153,15 @@ Record EndRecord() {
   return r;
 }
 
-RouteCopy::RouteCopy(std::string dir) : dir_(std::move(dir)) { Load(); }
+RouteCopy::RouteCopy(std::string dir) : dir_(std::move(dir)) {
+  std::error_code ec;
+  if (fs::exists(dir_, ec) && !fs::is_directory(dir_, ec))
+    throw InputError(dir_ + ": is a file, not a directory; choose a directory for the route");
+  fs::create_directories(dir_, ec);
+  if (ec) throw InputError(dir_ + ": cannot create directory: " + ec.message());
+  lock_ = std::make_unique<io::DirectoryLock>(dir_);
+  Load();
+}
 RouteCopy::~RouteCopy() = default;
 
 void RouteCopy::Load() {

@@ -25,6 +25,10 @@
 #include "mapless/route/route.h"
 #include "mapless/route/route_store.h"
 
+namespace mapless::io {
+class DirectoryLock;
+}
+
 namespace mapless::fleet {
 
 enum class RouteKind { kFunnel, kEigenspace };
@@ -51,7 +55,9 @@ Record EndRecord();
 class RouteCopy {
  public:
   // Opens DIR: the copy a previous run left there (resumed after its last whole record), or a new
-  // one when DIR is empty or missing. Throws InputError when DIR holds something else.
+  // one when DIR is empty or missing (created). Throws InputError when DIR holds something else,
+  // or when another process writes it (a teach, a leader, a follower: DIR is locked while the
+  // RouteCopy lives).
   explicit RouteCopy(std::string dir);
   ~RouteCopy();
 
@@ -83,6 +89,7 @@ class RouteCopy {
   void Load();
 
   std::string dir_;
+  std::unique_ptr<io::DirectoryLock> lock_;
   mutable std::mutex mutex_;
   std::optional<RouteHeader> header_;
   bool complete_ = false;

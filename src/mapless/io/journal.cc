@@ -1,6 +1,7 @@
 #include "mapless/io/journal.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -17,8 +18,22 @@ JournalFile::JournalFile(const std::string& path, Mode mode) : path_(path), writ
   if (mode == Mode::kReplaceAtClose && KindOfOutput(path) == OutputKind::kNewOrRegular) {
     write_path_ = path + ".partial";
   }
-  fd_ = ::open(write_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0644);
+  // Opened without truncating, locked, then emptied: a second run writing the same file is
+  // refused before it destroys what the first has written.
+  fd_ = ::open(write_path_.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   if (fd_ < 0) throw InputError(path + ": cannot write: " + std::strerror(errno));
+  const bool regular = KindOfOutput(write_path_) == OutputKind::kNewOrRegular;
+  if (regular && ::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    ::close(fd_);
+    fd_ = -1;
+    throw InputError(path + ": another mapless process is writing this file (locked)");
+  }
+  if (regular && ::ftruncate(fd_, 0) != 0) {
+    const std::string why = std::strerror(errno);
+    ::close(fd_);
+    fd_ = -1;
+    throw InputError(path + ": cannot write: " + why);
+  }
 }
 
 JournalFile::~JournalFile() {

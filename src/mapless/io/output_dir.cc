@@ -45,6 +45,7 @@ OutputDirectory::OutputDirectory(std::string target, bool replace, std::string w
     throw InputError(target_ + ": is a file, not a directory; choose a directory for the " + what);
   }
   if (IsEmptyOrMissing(target_)) {
+    created_ = !fs::exists(target_, ec);
     std::error_code mk;
     fs::create_directories(target_, mk);
     if (mk) throw InputError(target_ + ": cannot create directory: " + mk.message());
@@ -69,6 +70,18 @@ OutputDirectory::OutputDirectory(std::string target, bool replace, std::string w
   fs::remove_all(path_, ec);
   fs::create_directories(path_, ec);
   if (ec) throw InputError(path_ + ": cannot create directory: " + ec.message());
+}
+
+void OutputDirectory::Discard() {
+  if (committed_) return;
+  std::error_code ec;
+  if (staged()) {
+    fs::remove_all(path_, ec);
+    return;
+  }
+  // Written in place: the directory was new or empty, so all in it is this run's.
+  for (const fs::directory_entry& e : fs::directory_iterator(target_, ec)) fs::remove_all(e, ec);
+  if (created_) fs::remove(target_, ec);
 }
 
 OutputDirectory::~OutputDirectory() {

@@ -50,11 +50,16 @@ class OutputDirectory {
   // Puts the written directory in place (a no-op when written in place). The old one is renamed
   // aside first and removed after the swap, so that a kill leaves one of the two whole.
   void Commit();
+  // Undoes a run that failed before it made anything usable: written in place, the directory is
+  // emptied again (removed when the run created it); staged, the staging directory goes (as on
+  // destruction). The target is never touched when it held something before.
+  void Discard();
 
  private:
   std::string target_;
   std::string path_;
   bool committed_ = false;
+  bool created_ = false;  // the target did not exist before
   std::unique_ptr<DirectoryLock> lock_;
 };
 

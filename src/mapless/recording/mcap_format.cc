@@ -398,6 +398,13 @@ bool McapRecordCursor::Next(std::uint8_t* op, std::string_view* body) {
   *op = prefix.U8("opcode");
   const std::uint64_t length = prefix.U64("length");
   if (length > bytes_.size() - pos_ - kPrefix) {
+    // A recording whose writer stopped ends inside its last record, whose length is what the
+    // writer meant to write: a length beyond any record's (4 GiB) is a corrupt file, not a cut.
+    if (length > kMaxPlausibleRecordBytes) {
+      throw InputError(std::string("MCAP: ") + McapOpName(*op) + " record at byte " +
+                       std::to_string(offset()) + " says " + std::to_string(length) +
+                       " bytes: not a record length (the file is corrupt)");
+    }
     if (tolerate_cut_) {
       cut_ = true;
       return false;

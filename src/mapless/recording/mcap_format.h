@@ -172,8 +172,11 @@ std::string McapBody(const McapSummaryOffset& r);
 std::string McapBody(const McapDataEnd& r);
 
 // One record of a byte range: its opcode and body. `Next` returns false at the end of the range;
-// a record cut short (its length runs past the end) throws InputError unless `tolerate_cut`, when
-// it ends the range too (cut() then says so).
+// a record longer than kMaxPlausibleRecordBytes always throws InputError (a corrupt length, not a
+// cut); a record cut short (its length runs past the end) throws InputError unless `tolerate_cut`,
+// when it ends the range too (cut() then says so).
+inline constexpr std::uint64_t kMaxPlausibleRecordBytes = std::uint64_t{1} << 32;
+
 class McapRecordCursor {
  public:
   McapRecordCursor(std::string_view bytes, std::uint64_t base_offset, bool tolerate_cut = false)

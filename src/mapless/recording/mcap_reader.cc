@@ -1,39 +1,26 @@
 #include "mapless/recording/mcap_reader.h"
 
-#include <fcntl.h>
-#include <sys/mman.h>
-#include <unistd.h>
-
 #include <cerrno>
 #include <cstring>
 
 #include "mapless/core/check.h"
+#include "mapless/core/warning.h"
 #include "mapless/io/atomic_file.h"
 #include "mapless/recording/compression.h"
 
 namespace mapless::recording {
 
-McapReader::McapReader(const std::string& path) : path_(path) {
-  std::uint64_t size = 0;
-  const int fd = io::OpenRegularFile(path, &size);
-  map_size_ = static_cast<std::size_t>(size);
-  if (map_size_ > 0) {
-    map_ = ::mmap(nullptr, map_size_, PROT_READ, MAP_PRIVATE, fd, 0);
-    if (map_ == MAP_FAILED) {
-      map_ = nullptr;
-      const std::string why = std::strerror(errno);
-      ::close(fd);
-      throw InputError(path + ": cannot map file: " + why);
-    }
-    bytes_ = std::string_view(static_cast<const char*>(map_), map_size_);
-  }
-  ::close(fd);
-  try {
-    CheckMagic();
-  } catch (...) {
-    if (map_) ::munmap(map_, map_size_);
-    throw;
-  }
+McapReader::McapReader(const std::string& path)
+    : path_(path), file_(std::make_unique<io::MappedFile>(path)) {
+  bytes_ = file_->bytes();
+  CheckMagic();
+}
+
+void McapReader::ThrowIfChanged() const {
+  if (file_ && file_->changed())
+    throw InputError(path_ +
+                     ": the file changed while it was read (cut, or another file copied over "
+                     "it); stopped there");
 }
 
 std::unique_ptr<McapReader> McapReader::FromBytes(std::string bytes, const std::string& name) {
@@ -50,9 +37,7 @@ void McapReader::CheckMagic() {
     throw InputError(path_ + ": not an MCAP file (it does not start with the MCAP magic)");
 }
 
-McapReader::~McapReader() {
-  if (map_) ::munmap(map_, map_size_);
-}
+McapReader::~McapReader() = default;
 
 void McapReader::Walk(const RecordFn& fn, std::uint64_t skip_chunks_before_ns) {
   cut_ = false;
@@ -64,7 +49,9 @@ void McapReader::Walk(const RecordFn& fn, std::uint64_t skip_chunks_before_ns) {
   try {
     while (true) {
       const std::uint64_t offset = cursor.offset();
-      if (!cursor.Next(&op, &body)) break;
+      const bool more = cursor.Next(&op, &body);
+      ThrowIfChanged();
+      if (!more) break;
       if (op == static_cast<std::uint8_t>(McapOp::kChunk)) {
         const McapChunk chunk = ParseMcapChunk(body);
         if (chunk.message_end_time < skip_chunks_before_ns) continue;
@@ -78,6 +65,7 @@ void McapReader::Walk(const RecordFn& fn, std::uint64_t skip_chunks_before_ns) {
         std::uint8_t inner_op = 0;
         std::string_view inner_body;
         while (inner.Next(&inner_op, &inner_body)) fn(inner_op, inner_body, offset);
+        ThrowIfChanged();
         continue;
       }
       fn(op, body, offset);
@@ -87,6 +75,7 @@ void McapReader::Walk(const RecordFn& fn, std::uint64_t skip_chunks_before_ns) {
       }
     }
   } catch (const InputError& e) {
+    ThrowIfChanged();  // zeros read after a cut: that is the error to name
     throw InputError(path_ + ": " + e.what());
   }
   if (!footer) {
@@ -127,10 +116,16 @@ bool McapMessageStream::Next(Item* item) {
       }
       if (done_) return false;
       const std::uint64_t offset = outer_.offset();
-      if (!outer_.Next(&op, &body)) {
+      const bool more = outer_.Next(&op, &body);
+      reader_.ThrowIfChanged();
+      if (!more) {
         done_ = true;
-        reader_.set_cut(
-            true);  // killed before it closed: every whole record up to the cut was read
+        // Killed before it closed: every whole record up to the cut was read; said, since the
+        // frames after it are missing.
+        reader_.set_cut(true);
+        Warn(reader_.path() + ": ends at byte " + std::to_string(outer_.offset()) +
+             " inside a record, before its footer (the recording's writer stopped, or the file "
+             "was cut): every frame before was played");
         return false;
       }
       if (op == static_cast<std::uint8_t>(McapOp::kChunk)) {
@@ -142,6 +137,7 @@ bool McapMessageStream::Next(Item* item) {
         if (chunk.uncompressed_crc != 0)
           MAPLESS_CHECK(McapCrc32(chunk_records_) == chunk.uncompressed_crc,
                         what << ": its records do not match their CRC");
+        reader_.ThrowIfChanged();  // the chunk was read whole before it was cut
         inner_ = std::make_unique<McapRecordCursor>(chunk_records_, 0);
         chunk_offset_ = offset;
         continue;
@@ -159,6 +155,8 @@ bool McapMessageStream::Next(Item* item) {
   } catch (const InputError& e) {
     done_ = true;
     inner_.reset();
+    if (std::string(e.what()).rfind(reader_.path() + ": ", 0) == 0) throw;
+    reader_.ThrowIfChanged();  // zeros read after a cut: that is the error to name
     throw InputError(reader_.path() + ": " + e.what());
   }
 }

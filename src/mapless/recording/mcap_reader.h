@@ -1,7 +1,8 @@
 // Reading MCAP files (mcap_format.h): every record in file order, with chunks opened (the
 // conformance "streamed" order), or the messages with their channels and schemas. A file cut short
 // (a recording killed before it closed) is read up to its last whole record, and cut() says so.
-// The file is mapped read-only; nothing in it is trusted (bounded sizes, checked CRCs).
+// The file is mapped read-only (io::MappedFile: a file cut while it is read is an error naming it,
+// not a SIGBUS); nothing in it is trusted (bounded sizes, checked CRCs).
 #pragma once
 
 #include <cstdint>
@@ -11,6 +12,7 @@
 #include <string>
 #include <string_view>
 
+#include "mapless/io/mapped_file.h"
 #include "mapless/recording/mcap_format.h"
 
 namespace mapless::recording {
@@ -42,6 +44,9 @@ class McapReader {
   void set_cut(bool cut) { cut_ = cut; }
   const std::string& path() const { return path_; }
   std::string_view bytes() const { return bytes_; }
+  // Throws InputError when the file shrank under the mapping while it was read (another file
+  // copied over it): what was read from the cut on is zeros, not the recording.
+  void ThrowIfChanged() const;
 
  private:
   McapReader() = default;
@@ -51,8 +56,7 @@ class McapReader {
   std::string path_;
   std::string_view bytes_;
   std::string owned_;  // FromBytes
-  void* map_ = nullptr;
-  std::size_t map_size_ = 0;
+  std::unique_ptr<io::MappedFile> file_;
   bool cut_ = false;
 };
 

@@ -120,6 +120,58 @@ TEST(Mcap, ReadingFromAStartTimeSkipsEarlierMessages) {
   EXPECT_EQ(times.size(), 150u);
 }
 
+// Issue 40: a recording truncated while it is read (a new file copied over it) was a SIGBUS; it is
+// an error naming the file.
+TEST(Mcap, AFileCutWhileItIsReadIsAnErrorNotACrash) {
+  const std::string path = FreshPath("cut_under_reader");
+  McapWriterOptions options;
+  options.chunk_ns = 200'000'000;
+  options.compression = "";  // 300 KB: the cut leaves most of it unread
+  WriteRun(path, options, true);
+  ASSERT_GT(fs::file_size(path), 64u * 1024u);
+  McapReader reader(path);
+  McapMessageStream stream(reader);
+  McapMessageStream::Item item;
+  for (int i = 0; i < 5; ++i) ASSERT_TRUE(stream.Next(&item));
+  fs::resize_file(path, 4096);  // what `cp new.mcap old.mcap` does first
+  try {
+    while (stream.Next(&item)) {
+    }
+    FAIL() << "read to the end of a file cut under it";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(path + ": the file changed while it was read"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// Issue 40: a record length corrupted to 2^62 was taken as the end of a cut recording (exit 0,
+// half the frames); it is an error.
+TEST(Mcap, ARecordLengthBeyondAnyRecordIsCorruptNotACut) {
+  const std::string whole = FreshPath("length_whole");
+  McapWriterOptions options;
+  options.chunk_ns = 200'000'000;
+  WriteRun(whole, options, true);
+  std::string bytes = io::ReadFile(whole, 1 << 26);
+  // The second record after the magic (the first chunk; the first record is the header).
+  McapRecordCursor cursor(std::string_view(bytes).substr(kMcapMagic.size()), kMcapMagic.size());
+  std::uint8_t op = 0;
+  std::string_view body;
+  ASSERT_TRUE(cursor.Next(&op, &body));
+  const std::size_t at = static_cast<std::size_t>(cursor.offset());
+  const std::uint64_t huge = std::uint64_t{1} << 62;
+  for (int b = 0; b < 8; ++b) bytes[at + 1 + b] = static_cast<char>((huge >> (8 * b)) & 0xff);
+  const std::string path = FreshPath("length_corrupt");
+  std::ofstream(path, std::ios::binary) << bytes;
+  McapReader reader(path);
+  try {
+    ReadRun(reader);
+    FAIL() << "a length of 2^62 was read as a cut";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not a record length"), std::string::npos) << e.what();
+  }
+}
+
 // A recording killed mid-way: every whole chunk up to the cut is read, and cut() says so.
 TEST(Mcap, ARecordingCutAnywhereKeepsEveryWholeChunkBeforeTheCut) {
   const std::string whole = FreshPath("whole");
