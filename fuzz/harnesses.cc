@@ -232,6 +232,41 @@ void FleetRecord(const std::string& input) {
   });
 }
 
+void FleetFollower(const std::string& input) {
+  static const std::filesystem::path dir = [] {
+    const std::filesystem::path shm("/dev/shm");
+    return (std::filesystem::is_directory(shm) ? shm : std::filesystem::temp_directory_path()) /
+           ("mapless-fuzz-follower-" + std::to_string(::getpid()));
+  }();
+  std::error_code ec;
+  std::filesystem::remove_all(dir, ec);
+  std::vector<std::string> messages;
+  std::size_t from = 0;
+  while (messages.size() < 8) {
+    const std::size_t at = input.find("\xffNXT", from);
+    messages.push_back(input.substr(from, at == std::string::npos ? std::string::npos : at - from));
+    if (at == std::string::npos) break;
+    from = at + 4;
+  }
+  AcceptInputError([&] {
+    fleet::RouteCopy copy(dir.string());
+    for (const std::string& m : messages) {
+      AcceptInputError([&] {
+        const fleet::Record r = fleet::DecodeRecord(m);
+        if (r.type == fleet::RecordType::kHeartbeat || r.sequence != copy.next_sequence()) return;
+        copy.Apply({r});
+      });
+    }
+    AcceptInputError([&] { copy.FunnelRoute(); });
+    AcceptInputError([&] { copy.AppearanceRoute(); });
+  });
+  std::filesystem::remove_all(dir, ec);
+}
+
+#ifndef MAPLESS_FUZZ_ROS2
+void Ros2Message(const std::string&) {}  // built without the ROS 2 link
+#endif
+
 // Every message of a recording through the reader of its type (ROS 1 or ROS 2 wire).
 void DecodeEveryMessage(std::unique_ptr<recording::MessageStream> messages) {
   recording::RecordedMessage m;
@@ -360,6 +395,8 @@ const std::vector<NamedHarness>& Harnesses() {
                                                       {"appearance_manifest", AppearanceManifest},
                                                       {"camera_message", CameraMessage},
                                                       {"fleet_record", FleetRecord},
+                                                      {"fleet_follower", FleetFollower},
+                                                      {"ros2_message", Ros2Message},
                                                       {"mcap", McapFile},
                                                       {"rosbag", RosBag},
                                                       {"camera_info", CameraInfo}};

@@ -52,6 +52,17 @@ void CameraMessage(const std::string& input);
 // eigenspace route image and its entry, a keyframe's YAML and PNG against a 320x240 ORB route).
 void FleetRecord(const std::string& input);
 
+// The follower's side of the fleet link: the input as up to 8 messages from a leader (split at
+// "\xffNXT"), each decoded and, when it continues the copy, applied to a fresh RouteCopy (in
+// /dev/shm: the files are written, as a follower writes them), then the route built from the copy
+// as the follower's method asks for it.
+void FleetFollower(const std::string& input);
+// A ROS 2 sample from the network (issue 40): the first byte chooses the type mapless reads
+// (Image, CompressedImage, Odometry, Bool, Clock, Twist, String); the rest is the serialized data
+// with its encapsulation header, decoded by Cyclone DDS as a received sample is and used as the
+// robot link uses it. Nothing without the ROS 2 link.
+void Ros2Message(const std::string& input);
+
 // An MCAP file (recording/mcap_reader.h): every record, chunks opened and every record type
 // parsed, then the messages with their channels and schemas.
 void McapFile(const std::string& input);
