@@ -51,6 +51,11 @@ if [ "$WITH_TEST" = "1" ]; then
     clang-format           # the style check (scripts/check_format.sh)
     dpkg-dev               # dpkg-shlibdeps: the Depends of the .deb (cpack)
   )
+  if [ "$WITH_ROS" = "1" ]; then
+    # A real ROS 2 middleware on the other end (tests/ros2/fastdds): eProsima Fast DDS, the default
+    # of ROS 2 Humble and Jazzy, and its type generator (Java).
+    PACKAGES+=(libfastrtps-dev fastddsgen)
+  fi
 fi
 
 missing=()
