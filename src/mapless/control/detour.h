@@ -140,7 +140,6 @@ class Detour {
   double other_side_offset_m_ = 0.0;  // the first step's on the other side
   bool tried_other_side_ = false;
   bool look_after_step_ = true;
-  double look_from_m_ = 0.0;
   Pose2 look_start_;
   DetourPhase phase_ = DetourPhase::kBackOff;
 };

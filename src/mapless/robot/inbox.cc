@@ -80,7 +80,10 @@ std::string FrameInbox::WhyNoFrame(const std::string& what) const {
 LinkEvent FrameInbox::Next() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {
-    if (clock_.ok && !clock_.ok()) return {LinkEventType::kClosed, {}, "the middleware shut down"};
+    if (clock_.ok && !clock_.ok())
+      return {LinkEventType::kClosed,
+              {},
+              clock_.closed_reason ? clock_.closed_reason() : "the middleware shut down"};
     if (InterruptRequested()) return {LinkEventType::kClosed, {}, "interrupted"};
     if (estop_) {
       // Said when it engages, then once per camera frame (each frame taken in is dropped and

@@ -31,6 +31,8 @@ struct InboxClock {
   std::function<Timestamp()> now;          // the ROS clock
   std::function<bool()> ok;                // false once the middleware shut down
   std::function<bool()> camera_published;  // false when no one publishes the camera
+  // Why the middleware shut down, when ok() turned false (empty: "the middleware shut down").
+  std::function<std::string()> closed_reason = {};
 };
 
 class FrameInbox {

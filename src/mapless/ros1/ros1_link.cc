@@ -2,6 +2,8 @@
 
 #include <geometry_msgs/Twist.h>
 #include <nav_msgs/Odometry.h>
+#include <ros/console.h>
+#include <ros/console_backend.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
@@ -12,6 +14,8 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <mutex>
+#include <set>
 #include <thread>
 
 #include "mapless/core/check.h"
@@ -30,6 +34,36 @@ Timestamp ToNs(const ros::Time& t) { return static_cast<Timestamp>(t.toNSec()); 
 
 double Yaw(const geometry_msgs::Quaternion& q) { return YawFromQuaternion(q.x, q.y, q.z, q.w); }
 
+// roscpp's own log lines (rosconsole) are not printed: they came colour-coded between mapless's
+// lines (two nodes of one name: "Shutdown request received. Reason: [...]"). Its warnings and
+// errors are kept, the last one given as the reason when the middleware shuts down, and each
+// handed once to the link's logger.
+std::mutex g_console_mutex;
+std::string g_console_last;  // the last warning or error
+Logger g_console_logger;
+std::set<std::string> g_console_said;
+
+void CapturePrint(void*, ros::console::Level level, const char* text, const char*, const char*,
+                  int) {
+  if (level < ros::console::levels::Warn || text == nullptr) return;
+  std::string line(text);
+  while (!line.empty() && (line.back() == '\n' || line.back() == ' ')) line.pop_back();
+  Logger logger;
+  {
+    std::lock_guard<std::mutex> lock(g_console_mutex);
+    g_console_last = line;
+    if (!g_console_said.insert(line).second) return;
+    logger = g_console_logger;
+  }
+  if (logger) logger("ROS 1: " + line);
+}
+
+std::string ShutdownReason() {
+  std::lock_guard<std::mutex> lock(g_console_mutex);
+  return g_console_last.empty() ? "the middleware shut down"
+                                : "the middleware shut down: " + g_console_last;
+}
+
 }  // namespace
 
 void StartNode(const robot::RobotFile& robot, const std::string& node_name) {
@@ -37,6 +71,8 @@ void StartNode(const robot::RobotFile& robot, const std::string& node_name) {
   std::map<std::string, std::string> remappings;
   if (!robot.ns.empty()) remappings["__ns"] = robot.ns;
   ros::init(remappings, node_name, ros::init_options::NoSigintHandler);
+  ros::console::initialize();
+  ros::console::backend::function_print = CapturePrint;
   const auto deadline = SteadyClock::now() + std::chrono::duration<double>(robot.connect_timeout_s);
   while (!ros::master::check()) {
     if (InterruptRequested())
@@ -57,10 +93,14 @@ class Ros1Link::Impl {
   Impl(const robot::RobotFile& robot, cv::Size size, std::string method, Logger warn)
       : robot_(robot),
         method_(std::move(method)),
-        inbox_(robot, size, CameraTopic(robot), std::move(warn),
+        inbox_(robot, size, CameraTopic(robot), warn,
                {[] { return ToNs(ros::Time::now()); }, [] { return ros::ok(); },
-                [this] { return image_sub_.getNumPublishers() > 0; }}),
+                [this] { return image_sub_.getNumPublishers() > 0; }, ShutdownReason}),
         spinner_(1) {
+    {
+      std::lock_guard<std::mutex> lock(g_console_mutex);
+      g_console_logger = warn;
+    }
     ros::NodeHandle nh;
     camera_topic_ = CameraTopic(robot);
     const ros::TransportHints hints = ros::TransportHints().tcpNoDelay();
