@@ -2,7 +2,10 @@
 
 #include <chrono>
 #include <filesystem>
+#include <iterator>
+#include <mutex>
 #include <thread>
+#include <zmq_addon.hpp>
 
 #include "mapless/core/check.h"
 #include "mapless/core/rng.h"
@@ -380,6 +383,48 @@ TEST(FleetLink, EndpointsOutsideThePortRangeAreRefused) {
   ClientOptions client;
   client.connect = "tcp://127.0.0.1:0";
   EXPECT_THROW(FollowerClient(copy, client, nullptr), InputError);
+}
+
+}  // namespace
+}  // namespace mapless::fleet
+
+namespace mapless::fleet {
+namespace {
+
+// Issue 40: 20,000 garbage messages from a fake leader gave 20,000 lines on the follower's stderr.
+// They are rejected (counted) and said at most once a second.
+TEST(FleetLink, AFollowerUnderGarbageSaysItOnceASecond) {
+  zmq::context_t context(1);
+  zmq::socket_t fake(context, zmq::socket_type::router);
+  fake.set(zmq::sockopt::router_mandatory, 1);  // a full queue waits: every message arrives
+  fake.bind("tcp://127.0.0.1:*");
+  const std::string endpoint = fake.get(zmq::sockopt::last_endpoint);
+  const std::string dir = ::testing::TempDir() + "mapless_fleet_garbage";
+  std::filesystem::remove_all(dir);
+  RouteCopy copy(dir);
+  ClientOptions options;
+  options.connect = endpoint;
+  std::mutex mutex;
+  int lines = 0;
+  FollowerClient client(copy, options, [&](const std::string&) {
+    std::lock_guard<std::mutex> lock(mutex);
+    ++lines;
+  });
+  std::vector<zmq::message_t> hello;
+  ASSERT_TRUE(zmq::recv_multipart(fake, std::back_inserter(hello)));  // its "from 0"
+  const std::string id = hello[0].to_string();
+  constexpr int kGarbage = 20000;
+  for (int i = 0; i < kGarbage; ++i) {
+    fake.send(zmq::buffer(id), zmq::send_flags::sndmore);
+    fake.send(zmq::buffer("not a record " + std::to_string(i)), zmq::send_flags::none);
+  }
+  ASSERT_TRUE(WaitFor([&] { return client.stats().rejected >= kGarbage; }, 30.0))
+      << client.stats().rejected;
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));  // the held-back count is said
+  std::lock_guard<std::mutex> lock(mutex);
+  EXPECT_GE(lines, 1);
+  EXPECT_LE(lines, 40);  // one a second at most, and the line with the count
+  EXPECT_EQ(copy.next_sequence(), 0u);
 }
 
 }  // namespace
