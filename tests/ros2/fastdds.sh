@@ -5,7 +5,8 @@
 # DDS participant with types from the ROS 2 message definitions, joins after them and relays the
 # robot's camera and odometry to the method and its commands back, presses the e-stop and checks
 # discovery within 2 s, every message type, the command rate and the e-stop's rate
-# (tests/ros2/fastdds/fastdds_robot.cc).
+# (tests/ros2/fastdds/fastdds_robot.cc). Then the same in lockstep under use_sim_time with a JPEG
+# camera: the clock and CompressedImages relayed by the Fast DDS node.
 #   tests/ros2/fastdds.sh MAPLESS FASTDDS_ROBOT
 # The Fast DDS node discovers as rmw_fastrtps does on loopback (multicast, which mapless does not
 # hear there): mapless finds it by its own announcements, once a second (src/mapless/ros2/dds.cc).
@@ -31,6 +32,35 @@ echo "fastdds: $RESULT"
 if [ "$RC" != 0 ]; then
   echo "fastdds.sh: FAILED (exit $RC)"
   for f in serve repeat; do echo "== $f.log"; tail -5 "$OUT/$f.log"; done
+  exit 1
+fi
+for p in "${PIDS[@]}"; do kill -INT "$p" 2>/dev/null; done
+wait 2>/dev/null
+PIDS=()
+# Lockstep under use_sim_time, the camera as JPEG CompressedImages: the clock and the compressed
+# frames come to the method from the Fast DDS node.
+printf 'middleware: ros2
+name: simulated robot
+namespace: sim
+use_sim_time: true
+topics: {compressed_image: camera/image_raw/compressed}
+' >"$OUT/sim2.yaml"
+printf 'middleware: ros2
+name: robot behind Fast DDS
+use_sim_time: true
+topics: {compressed_image: camera/image_raw/compressed}
+' >"$OUT/robot2.yaml"
+"$BIN" sim serve --scenario table1_almost_straight --robot "$OUT/sim2.yaml" --like repeat   --encoding jpeg >"$OUT/serve2.log" 2>&1 &
+PIDS+=($!)
+timeout 120 "$BIN" repeat --route "$OUT/route" --robot "$OUT/robot2.yaml" >"$OUT/repeat2.log" 2>&1 &
+PIDS+=($!)
+sleep 1
+RESULT=$(timeout 90 "$PEER" lockstep 60)
+RC=$?
+echo "fastdds: $RESULT"
+if [ "$RC" != 0 ]; then
+  echo "fastdds.sh: FAILED in lockstep (exit $RC)"
+  for f in serve2 repeat2; do echo "== $f.log"; tail -5 "$OUT/$f.log"; done
   exit 1
 fi
 echo "fastdds.sh: passed"

@@ -19,14 +19,14 @@ std::string Env(const char* name) {
 // Discovery and data on loopback only, as rmw_cyclonedds does for ROS_LOCALHOST_ONLY: unicast to
 // the local participant ports (no multicast on `lo`). A node that starts later and announces
 // itself only by multicast (Fast DDS's default) hears of mapless when mapless next announces
-// itself to those ports: every second here (Cyclone's default waited 6-9 s; issue 40), 33 small
+// itself to those ports: twice a second here (Cyclone's default waited 6-9 s; issue 40), 66 small
 // packets a second on loopback.
 constexpr const char* kLocalhostConfig =
     "<CycloneDDS><Domain><General><Interfaces><NetworkInterface address=\"127.0.0.1\"/>"
     "</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery>"
     "<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>32"
     "</MaxAutoParticipantIndex><Peers><Peer address=\"127.0.0.1\"/></Peers>"
-    "<SPDPInterval>1s</SPDPInterval></Discovery></Domain></CycloneDDS>";
+    "<SPDPInterval>500ms</SPDPInterval></Discovery></Domain></CycloneDDS>";
 
 // Input from the network is bounded: a sample larger than this (a 4096x4096 rgb8 image is 48 MiB)
 // is dropped by Cyclone before it is delivered.

@@ -13,6 +13,8 @@
 //   - cmd_vel at most the camera rate while driving; during a 1 s e-stop only zeros and at most
 //     MAX_STOP_PER_S of them; driving again after the release.
 //   fastdds_robot SECONDS MAX_DISCOVERY_S MAX_STOP_PER_S     (ROS_DOMAIN_ID from the environment)
+// A second mode, `fastdds_robot lockstep SECONDS`, relays a lockstep simulation under
+// use_sim_time: the clock and JPEG CompressedImages (see Lockstep()).
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
 
@@ -162,9 +164,99 @@ bool Wait(double seconds, const std::function<bool()>& done) {
 
 }  // namespace
 
+// Lockstep under use_sim_time: sim serve publishes /clock and JPEG frames
+// (/sim/camera/image_raw/compressed) and waits for each frame's command; the node relays the
+// compressed frames and the odometry to the method (use_sim_time, compressed camera), and the
+// commands and the status back (sim serve starts when a method's status and commands reach it).
+// It reads the clock as the method does (one /clock for all: relaying it would echo). Checks the
+// clock (mapless writes, Fast DDS reads) and the compressed frames both ways, and that the robot
+// was driven and moved.
+int Lockstep(double seconds) {
+  const char* domain_text = std::getenv("ROS_DOMAIN_ID");
+  Node node(domain_text ? std::atoi(domain_text) : 0);
+  using Compressed = sensor_msgs::msg::dds_::CompressedImage_;
+  using RosClock = rosgraph_msgs::msg::dds_::Clock_;
+  DataWriter* camera = node.Writer("/camera/image_raw/compressed",
+                                   new sensor_msgs::msg::dds_::CompressedImage_PubSubType, false);
+  DataWriter* sim_status =
+      node.Writer("/sim/mapless/status", new std_msgs::msg::dds_::String_PubSubType, true);
+  DataWriter* odom = node.Writer("/odom", new nav_msgs::msg::dds_::Odometry_PubSubType, false);
+  DataWriter* sim_cmd =
+      node.Writer("/sim/cmd_vel", new geometry_msgs::msg::dds_::Twist_PubSubType, true);
+  int frames = 0, bad_frames = 0, clocks = 0, clock_backwards = 0;
+  double last_clock = -1;
+  Listener<Compressed> on_frame([&](const Compressed& m) {
+    {
+      std::lock_guard<std::mutex> lock(g_mutex);
+      ++frames;
+      const auto& d = m.data();
+      const bool jpeg = d.size() > 4 && d[0] == 0xff && d[1] == 0xd8;
+      if (m.format().find("jpeg") == std::string::npos || !jpeg) ++bad_frames;
+    }
+    Compressed copy = m;
+    camera->write(&copy);
+  });
+  Listener<RosClock> on_clock([&](const RosClock& c) {
+    {
+      std::lock_guard<std::mutex> lock(g_mutex);
+      ++clocks;
+      const double t = c.clock().sec() + 1e-9 * c.clock().nanosec();
+      if (t < last_clock) ++clock_backwards;
+      last_clock = t;
+    }
+  });
+  Listener<Odometry> on_odom([&](const Odometry& m) {
+    {
+      std::lock_guard<std::mutex> lock(g_mutex);
+      const double x = m.pose().pose().position().x(), y = m.pose().pose().position().y();
+      if (std::isnan(g.first_x)) g.first_x = x, g.first_y = y;
+      g.last_x = x;
+      g.last_y = y;
+    }
+    Odometry copy = m;
+    odom->write(&copy);
+  });
+  Listener<Twist> on_command([&](const Twist& t) {
+    {
+      std::lock_guard<std::mutex> lock(g_mutex);
+      ++g.commands;
+      if (t.linear().x() != 0.0 || t.angular().z() != 0.0) ++g.nonzero;
+    }
+    Twist copy = t;
+    sim_cmd->write(&copy);
+  });
+  node.Reader("/sim/camera/image_raw/compressed",
+              new sensor_msgs::msg::dds_::CompressedImage_PubSubType, false, &on_frame);
+  // The clock is one topic for all (/clock): read here from sim serve, as the method reads it.
+  node.Reader("/clock", new rosgraph_msgs::msg::dds_::Clock_PubSubType, false, &on_clock);
+  Listener<RosString> on_status([&](const RosString& m) {
+    RosString copy = m;
+    sim_status->write(&copy);
+  });
+  node.Reader("/mapless/status", new std_msgs::msg::dds_::String_PubSubType, true, &on_status);
+  node.Reader("/sim/odom", new nav_msgs::msg::dds_::Odometry_PubSubType, false, &on_odom);
+  node.Reader("/cmd_vel", new geometry_msgs::msg::dds_::Twist_PubSubType, true, &on_command);
+  const bool driven = Wait(seconds, [] { return g.nonzero >= 30; });
+  std::lock_guard<std::mutex> lock(g_mutex);
+  const double moved = std::hypot(g.last_x - g.first_x, g.last_y - g.first_y);
+  const bool ok = driven && frames >= 30 && bad_frames == 0 && clocks >= 30 &&
+                  clock_backwards == 0 && moved > 0.1;
+  std::printf(
+      "{\"mode\": \"lockstep\", \"compressed_frames\": %d, \"bad_frames\": %d, \"clocks\": %d, "
+      "\"clock_backwards\": %d, \"commands\": %d, \"nonzero\": %d, \"moved_m\": %.2f, \"ok\": "
+      "%s}\n",
+      frames, bad_frames, clocks, clock_backwards, g.commands, g.nonzero, moved,
+      ok ? "true" : "false");
+  std::fflush(stdout);
+  std::_Exit(ok ? 0 : 1);
+}
+
 int main(int argc, char** argv) {
+  if (argc == 3 && std::string(argv[1]) == "lockstep") return Lockstep(std::atof(argv[2]));
   if (argc != 4) {
-    std::fprintf(stderr, "usage: fastdds_robot SECONDS MAX_DISCOVERY_S MAX_STOP_PER_S\n");
+    std::fprintf(stderr,
+                 "usage: fastdds_robot SECONDS MAX_DISCOVERY_S MAX_STOP_PER_S\n"
+                 "       fastdds_robot lockstep SECONDS\n");
     return 2;
   }
   const double seconds = std::atof(argv[1]);
