@@ -177,14 +177,23 @@ grep -q "still waiting for the leader's route: no connection to tcp://127.0.0.1:
 
 # ---------------------------------------------------------------------------------------------
 echo "# round 3: a crash"
+cut_when_mapped() {  # cut_when_mapped FILE: once a process has FILE mapped and plays it, copy a
+  # short file over it (what `cp new.mcap FILE` does: truncate, then write)
+  for _ in $(seq 1 600); do
+    grep -qs "$1" /proc/[0-9]*/maps && break
+    sleep 0.05
+  done
+  sleep 0.5
+  cp "$TMP/r3small.mcap" "$1"
+}
 cp "$FX/r3_odom.mcap" "$NEW/r3play.mcap"
 head -c 20000 "$FX/r3_odom.mcap" >"$TMP/r3small.mcap"
-(sleep 1.5; cp "$TMP/r3small.mcap" "$NEW/r3play.mcap") &
+cut_when_mapped "$NEW/r3play.mcap" &
 probe "a recording cut while it plays" 2 "r3play.mcap: the file changed while it was read" -- "$MAPLESS" teach --source "$NEW/r3play.mcap" --out "$NEW/r3t6" --rate 1
 wait
 [ ! -e "$NEW/r3t6" ]; check "the failed teach left no route behind" $?
 cp "$FX/r3_odom.mcap" "$NEW/r3play2.mcap"
-(sleep 1.5; cp "$TMP/r3small.mcap" "$NEW/r3play2.mcap") &
+cut_when_mapped "$NEW/r3play2.mcap" &
 probe "a recording cut while a repeat plays it" 2 "r3play2.mcap: the file changed while it was read" -- "$MAPLESS" repeat --route "$TMP/r3route" --source "$NEW/r3play2.mcap" --rate 1
 wait
 
