@@ -167,10 +167,10 @@ for _ in $(seq 1 200); do [ -n "$(endpoint "$TMP/r3curve.err")" ] && [ -n "$(end
 curve_at=$(endpoint "$TMP/r3curve.err")
 plain_at=$(endpoint "$TMP/r3plain.err")
 [ -n "$curve_at" ] && [ -n "$plain_at" ]; check "round 3 fixture: two leaders ($curve_at, $plain_at)" $?
-probe "follower without a key, leader with CURVE" 1 "failed 3 times" -- "$MAPLESS" follow --connect "$curve_at" --source sim:table1_almost_straight --route "$NEW/r3k1"
-probe "follower with the wrong leader key" 1 "failed 3 times" -- "$MAPLESS" follow --connect "$curve_at" --source sim:table1_almost_straight --route "$NEW/r3k2" --curve-key "$FX/fleet.key" --curve-leader "$FX/r3_other.key.pub"
+probe "follower without a key, leader with CURVE" 1 "the handshake with $curve_at failed" -- "$MAPLESS" follow --connect "$curve_at" --source sim:table1_almost_straight --route "$NEW/r3k1"
+probe "follower with the wrong leader key" 1 "the handshake with $curve_at failed" -- "$MAPLESS" follow --connect "$curve_at" --source sim:table1_almost_straight --route "$NEW/r3k2" --curve-key "$FX/fleet.key" --curve-leader "$FX/r3_other.key.pub"
 probe "follower whose key the leader does not admit" 1 "refused this follower's CURVE key" -- "$MAPLESS" follow --connect "$curve_at" --source sim:table1_almost_straight --route "$NEW/r3k3" --curve-key "$FX/fleet.key" --curve-leader "$FX/r3_leader.key.pub"
-probe "follower with a key, leader without" 1 "failed 3 times" -- "$MAPLESS" follow --connect "$plain_at" --source sim:table1_almost_straight --route "$NEW/r3k4" --curve-key "$FX/fleet.key" --curve-leader "$FX/r3_leader.key.pub"
+probe "follower with a key, leader without" 1 "the handshake with $plain_at failed" -- "$MAPLESS" follow --connect "$plain_at" --source sim:table1_almost_straight --route "$NEW/r3k4" --curve-key "$FX/fleet.key" --curve-leader "$FX/r3_leader.key.pub"
 kill -INT "$r3curve" "$r3plain"; wait "$r3curve" "$r3plain" 2>/dev/null
 timeout -s INT 7 "$MAPLESS" follow --connect tcp://127.0.0.1:1 --source sim:table1_almost_straight --route "$NEW/r3k5" >/dev/null 2>"$TMP/r3wait.err"
 grep -q "still waiting for the leader's route: no connection to tcp://127.0.0.1:1" "$TMP/r3wait.err"; check "a follower with no leader says what it waits for ($(head -c 200 "$TMP/r3wait.err"))" $?

@@ -125,8 +125,18 @@ struct FollowerClient::Impl {
                std::to_string(value) + "; is its public key among the leader's --curve-allow?)");
         break;
       case ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL:
+        // Not transient (ZeroMQ may not even dial again): the two speak different protocols, a
+        // CURVE key on one side only being the usual reason.
+        handshaking = false;
+        Refuse(
+            "the handshake with " + at + " failed: " +
+            (value == ZMQ_PROTOCOL_ERROR_ZMTP_MECHANISM_MISMATCH
+                 ? std::string("one side uses CURVE keys and the other does not (give "
+                               "--curve-key and --curve-leader to both, or to neither)")
+                 : "protocol error " + std::to_string(value) + " (not a mapless leader there?)"));
+        break;
       case ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL:
-        CountHandshakeFailure();
+        if (handshaking) CountHandshakeFailure();
         SetLinkState("the handshake with " + at + " failed");
         break;
       case ZMQ_EVENT_DISCONNECTED:
