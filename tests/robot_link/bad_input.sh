@@ -79,5 +79,24 @@ else
   echo "FAIL rgb8 and mono8 decisions differ"; FAILS=$((FAILS + 1))
 fi
 
+# 6. Two robots with one node name (ROS 1; issue 40): the master shuts the first down; it says why
+# in mapless's own error line, and no raw roscpp line (colour codes and all) reaches the terminal.
+if [ "$MW" = ros1 ]; then
+  printf 'middleware: ros1\nuse_sim_time: false\nsafety: {give_up_without_frames_s: 0}\n' >"$OUT/twin.yaml"
+  timeout 30 "$BIN" teach --robot "$OUT/twin.yaml" --out "$OUT/twin1" 2>"$OUT/e6" >/dev/null &
+  T1=$!; PIDS+=("$T1")
+  sleep 2
+  timeout 10 "$BIN" teach --robot "$OUT/twin.yaml" --out "$OUT/twin2" 2>"$OUT/e6b" >/dev/null &
+  T2=$!; PIDS+=("$T2")
+  wait "$T1"
+  check "two robots with one node name" 1 $? "$OUT/e6" "new node registered with same name"
+  if grep -v -E '^(\[info\]|\[warning\]|mapless:) ' "$OUT/e6" | grep -q .; then
+    echo "FAIL two robots with one node name: lines not mapless's own:"
+    grep -v -E '^(\[info\]|\[warning\]|mapless:) ' "$OUT/e6" | head -3 | cat -v | sed 's/^/     /'
+    FAILS=$((FAILS + 1))
+  fi
+  kill -INT "$T2" 2>/dev/null; wait "$T2" 2>/dev/null
+fi
+
 echo "bad_input.sh: $FAILS failures"
 [ "$FAILS" = 0 ]
