@@ -40,8 +40,13 @@ class LimitedLog {
   using Clock = std::chrono::steady_clock;
   std::string Held() {
     std::string text;
-    for (const auto& [kind, n] : held_)
-      text += (text.empty() ? "" : ", ") + std::to_string(n) + " " + kind;
+    for (const auto& [kind, n] : held_) {
+      std::string what = kind;  // "followers joined"; one: "follower joined"
+      const std::size_t space = what.find(' ');
+      if (n == 1 && space != std::string::npos && space > 0 && what[space - 1] == 's')
+        what.erase(space - 1, 1);
+      text += (text.empty() ? "" : ", ") + std::to_string(n) + " " + what;
+    }
     held_.clear();
     return text;
   }
