@@ -18,6 +18,12 @@ BIN=$1; PEER=$2
 source "$(dirname "$0")/../robot_link/env.sh" fastdds.sh ros2
 printf 'middleware: ros2\nname: simulated robot\nnamespace: sim\nuse_sim_time: false\n' >"$OUT/sim.yaml"
 printf 'middleware: ros2\nname: robot behind Fast DDS\nuse_sim_time: false\n' >"$OUT/robot.yaml"
+failed() {  # failed WHERE LOG...: says so with the end of each log, and exits 1
+  echo "fastdds.sh: FAILED$1 (exit $RC)"
+  shift
+  for f in "$@"; do echo "== $f.log"; tail -5 "$OUT/$f.log"; done
+  exit 1
+}
 "$BIN" teach --source sim:table1_almost_straight --out "$OUT/route" >"$OUT/teach.log" 2>&1 ||
   { echo "fastdds.sh: teach failed"; exit 1; }
 "$BIN" sim serve --scenario table1_almost_straight --robot "$OUT/sim.yaml" --like repeat \
@@ -29,11 +35,7 @@ sleep 2  # both are up and have announced themselves: the Fast DDS node is the n
 RESULT=$(timeout 90 "$PEER" 40 2.0 15)
 RC=$?
 echo "fastdds: $RESULT"
-if [ "$RC" != 0 ]; then
-  echo "fastdds.sh: FAILED (exit $RC)"
-  for f in serve repeat; do echo "== $f.log"; tail -5 "$OUT/$f.log"; done
-  exit 1
-fi
+[ "$RC" = 0 ] || failed "" serve repeat
 for p in "${PIDS[@]}"; do kill -INT "$p" 2>/dev/null; done
 wait 2>/dev/null
 PIDS=()
@@ -58,9 +60,5 @@ sleep 1
 RESULT=$(timeout 90 "$PEER" lockstep 60)
 RC=$?
 echo "fastdds: $RESULT"
-if [ "$RC" != 0 ]; then
-  echo "fastdds.sh: FAILED in lockstep (exit $RC)"
-  for f in serve2 repeat2; do echo "== $f.log"; tail -5 "$OUT/$f.log"; done
-  exit 1
-fi
+[ "$RC" = 0 ] || failed " in lockstep" serve2 repeat2
 echo "fastdds.sh: passed"

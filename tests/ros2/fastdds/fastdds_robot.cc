@@ -151,6 +151,21 @@ bool WellFormed(const Image& m, const char* encoding, int channels) {
          m.data().size() == static_cast<std::size_t>(m.step()) * m.height();
 }
 
+// The simulated robot's odometry: counted, its first and last positions kept (how far it moved),
+// and passed on to the method.
+void RelayOdometry(const Odometry& m, DataWriter* to) {
+  {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    ++g.sim_odometry;
+    const double x = m.pose().pose().position().x(), y = m.pose().pose().position().y();
+    if (std::isnan(g.first_x)) g.first_x = x, g.first_y = y;
+    g.last_x = x;
+    g.last_y = y;
+  }
+  Odometry copy = m;
+  to->write(&copy);
+}
+
 bool Wait(double seconds, const std::function<bool()>& done) {
   const auto until = Clock::now() + std::chrono::duration<double>(seconds);
   while (Clock::now() < until) {
@@ -207,17 +222,7 @@ int Lockstep(double seconds) {
       last_clock = t;
     }
   });
-  Listener<Odometry> on_odom([&](const Odometry& m) {
-    {
-      std::lock_guard<std::mutex> lock(g_mutex);
-      const double x = m.pose().pose().position().x(), y = m.pose().pose().position().y();
-      if (std::isnan(g.first_x)) g.first_x = x, g.first_y = y;
-      g.last_x = x;
-      g.last_y = y;
-    }
-    Odometry copy = m;
-    odom->write(&copy);
-  });
+  Listener<Odometry> on_odom([&](const Odometry& m) { RelayOdometry(m, odom); });
   Listener<Twist> on_command([&](const Twist& t) {
     {
       std::lock_guard<std::mutex> lock(g_mutex);
@@ -284,18 +289,7 @@ int main(int argc, char** argv) {
     Image copy = m;
     camera->write(&copy);
   });
-  Listener<Odometry> on_sim_odom([&](const Odometry& m) {
-    {
-      std::lock_guard<std::mutex> lock(g_mutex);
-      ++g.sim_odometry;
-      const double x = m.pose().pose().position().x(), y = m.pose().pose().position().y();
-      if (std::isnan(g.first_x)) g.first_x = x, g.first_y = y;
-      g.last_x = x;
-      g.last_y = y;
-    }
-    Odometry copy = m;
-    odom->write(&copy);
-  });
+  Listener<Odometry> on_sim_odom([&](const Odometry& m) { RelayOdometry(m, odom); });
   Listener<Twist> on_command([&](const Twist& t) {
     {
       std::lock_guard<std::mutex> lock(g_mutex);
