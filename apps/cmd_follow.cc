@@ -6,18 +6,12 @@
 #include "fleet.h"
 #include "interrupt.h"
 #include "mapless/core/check.h"
-#include "mapless/eval/eigenspace.h"
 #include "mapless/recording/playback.h"
-#include "mapless/recording/recording_link.h"
-#include "mapless/robot/loop.h"
 #include "mapless/robot/methods.h"
-#include "mapless/robot/sim_link.h"
-#include "mapless/robot/status.h"
 #include "mapless/route/appearance_store.h"
-#include "mapless/sim/driver.h"
+#include "mapless/run/sim_episode.h"
 #include "recording_args.h"
 #include "robot_run.h"
-#include "teach.h"
 
 namespace mapless::app {
 
@@ -50,37 +44,6 @@ std::shared_ptr<const route::AppearanceRoute> RebuildRoute(const std::string& di
 }
 
 }  // namespace
-
-void ReplayOnRecording(robot::Method& method, const std::string& source,
-                       const recording::PlaybackOptions& playback, const std::string& log_path) {
-  recording::PlaybackLink link(recording::OpenSource(source, playback));
-  JsonLines log(log_path);
-  StopCleanlyOnInterrupt();
-  int frame = 0;
-  int decided = 0;  // frames on which the method could decide (it drove, or chose to wait)
-  std::string why_not;
-  const robot::LoopResult result = robot::RunLoop(
-      method, link, robot::LoopOptions{},
-      [&](const robot::Observation& obs, const robot::Decision& decision) {
-        log.Write(robot::StatusJson(method.name(), frame++, obs, decision));
-        if (decision.state == robot::MethodState::kDriving) ++decided;
-        if (decision.state != robot::MethodState::kDriving && !decision.reason.empty())
-          why_not = decision.reason;
-        return true;
-      },
-      [] { return InterruptSignal() != 0; });
-  ThrowIfInterrupted();
-  spdlog::info("{} (open loop on {}): {} frames, {}", method.name(), source, result.frames,
-               result.reason);
-  if (!result.finished && result.reason != recording::kEndOfRecording)
-    throw RunFailed(std::string(method.name()) + " stopped: " + result.reason);
-  // A replay on which the method never once drove answered nothing (issue 40: exit 0 with every
-  // decision "stopped: needs odometry").
-  if (!result.finished && result.frames > 0 && decided == 0)
-    throw RunFailed(std::string(method.name()) + " on " + source + ": stopped on all " +
-                    std::to_string(result.frames) + " frames" +
-                    (why_not.empty() ? "" : ", the last time: " + why_not));
-}
 
 void AddFollowCommand(CLI::App* app) {
   struct Args {
@@ -147,31 +110,29 @@ void AddFollowCommand(CLI::App* app) {
       f.motion_noise = a->motion_noise;
       f.on_obstacle = a->on_obstacle;
       f.carry_on_m = a->carry_on_m;
-      RefuseOutputOverInputs(f.log, "--log", {SourceInput(f.source), f.robot});
+      RefuseOutputOverInputs(f.log, "--log", {run::SourceInput(f.source), f.robot});
       FollowConnected(f);
       return;
     }
     if (a->source.empty() == a->robot.empty())
       throw InputError("follow: give one of --source sim:SCENARIO or --robot");
-    RefuseOutputOverInputs(a->log, "--log", {a->route, SourceInput(a->source), a->robot});
+    RefuseOutputOverInputs(a->log, "--log", {a->route, run::SourceInput(a->source), a->robot});
     RefuseOutputOverInputs(a->record.path, "--record",
-                           {a->route, SourceInput(a->source), a->robot});
+                           {a->route, run::SourceInput(a->source), a->robot});
     cv::Size size;
     const std::shared_ptr<const route::AppearanceRoute> route = RebuildRoute(a->route, &size);
     navigation::AppearanceFollowerOptions follower;
     follower.obstacle = ObstacleWatchFor(a->robot, a->on_obstacle, follower.obstacle, false);
     SetFollowerRecovery(a->carry_on_m, &follower);
     robot::FollowMethod method([route] { return route; }, follower, size);
-    if (!a->robot.empty()) {
-      const auto recorder = OpenRecorder(a->record);
-      RunOnRobot(method, a->robot, a->log, recorder.get());
-      return;
-    }
-    if (!IsSim(a->source)) {
-      if (!a->record.path.empty())
-        throw InputError("--record: records runs on the simulator or a robot; " + a->source +
-                         " is played open loop (its decisions are in --log)");
-      ReplayOnRecording(method, a->source, a->playback, a->log);
+    if (!a->robot.empty() || !run::IsSim(a->source)) {
+      SourceRunArgs args;
+      args.log = a->log;
+      args.playback = a->playback;
+      args.record = &a->record;
+      args.size_needed_by = "the route " + a->route + " was taught at";
+      args.robot = !a->robot.empty();
+      RunOnSource(method, args.robot ? a->robot : a->source, args);
       return;
     }
     const sim::Scenario scenario = sim::LoadScenario(a->source.substr(4));
@@ -180,43 +141,14 @@ void AddFollowCommand(CLI::App* app) {
           a->source + ": the camera is " + std::to_string(scenario.camera.model.width) + "x" +
           std::to_string(scenario.camera.model.height) + ", the route " + a->route +
           " was taught at " + std::to_string(size.width) + "x" + std::to_string(size.height));
-    eval::EigenspaceRunOptions options;
-    options.seed = a->seed;
-    options.motion_noise = a->motion_noise;
-    const eval::SimSetup setup = eval::FollowSimSetup(scenario, options);
-    sim::Simulation sim(setup.world, setup.camera, {}, setup.seed);
-    const int r = sim.AddRobot(setup.start, setup.robot);
-    robot::SimLinkOptions link_options;
-    link_options.period_s = 1.0 / scenario.camera.rate_hz;
-    link_options.timeout_s = eval::FollowTimeoutS(scenario, options);
-    robot::SimLink link(sim, r, link_options);
+    run::SimRun sim(scenario, run::FollowEpisode(scenario, fleet::RouteKind::kEigenspace, a->seed,
+                                                 a->motion_noise, /*live_leader=*/false));
     const auto recorder = OpenRecorder(a->record, recording::CameraInfoOf(scenario.camera.model));
-    const robot::LinkWrapper wrap = RecordingWrapper(recorder.get(), method.name());
-    const std::unique_ptr<robot::RobotLink> wrapped = wrap ? wrap(link) : nullptr;
-    JsonLines log(a->log);
-    StopCleanlyOnInterrupt();
-    int frame = 0;
-    const robot::LoopResult result = robot::RunLoop(
-        method, wrapped ? *wrapped : static_cast<robot::RobotLink&>(link), robot::LoopOptions{},
-        [&](const robot::Observation& obs, const robot::Decision& decision) {
-          ThrowIfInterrupted();
-          nlohmann::json j = robot::StatusJson(method.name(), frame++, obs, decision);
-          j["x_m"] = link.truth().x_m;
-          j["y_m"] = link.truth().y_m;
-          j["theta_rad"] = link.truth().theta_rad;
-          if (!a->log.empty()) log.Write(j);
-          return true;
-        });
-    // The taught path's end (drawn without rendering) is where the follower should arrive.
-    Pose2 end = scenario.teach_start;
-    sim::DriveOptions drive;
-    drive.render_frames = false;
-    sim::DriveTaughtPath(scenario, drive, [&](const sim::DriveFrame& f) { end = f.truth; });
-    const double error = link.truth().DistanceTo(end);
-    spdlog::info("follow: {} ({} frames); {:.2f} m from the route's end", result.reason,
-                 result.frames, error);
-    if (!result.finished || sim.collided(r) || error > options.arrive_tolerance_m)
-      throw RunFailed("follow did not succeed: " + result.reason);
+    const run::RunOutcome outcome = RunOnSim(method, sim, a->log, recorder.get());
+    spdlog::info("follow: {} ({} frames); {:.2f} m from the route's end", outcome.loop.reason,
+                 outcome.loop.frames, sim.error_at_end_m());
+    if (!sim.succeeded(outcome.loop.finished))
+      throw RunFailed("follow did not succeed: " + outcome.loop.reason);
   });
 }
 

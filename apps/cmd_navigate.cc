@@ -72,8 +72,11 @@ void NavigateOnRobot(const NavigateArgs& a, bool by_index) {
   nav.homing = a.homing;
   robot::PotentialMethod method(calibration, nav, destination);
   RefuseOutputOverInputs(a.record.path, "--record", {a.robot, a.calibration});
-  const auto recorder = OpenRecorder(a.record);
-  RunOnRobot(method, a.robot, a.log, recorder.get());
+  SourceRunArgs args;
+  args.log = a.log;
+  args.record = &a.record;
+  args.robot = true;
+  RunOnSource(method, a.robot, args);
 }
 
 }  // namespace

@@ -18,7 +18,8 @@
 #include "mapless/recording/recording_link.h"
 #include "mapless/robot/methods.h"
 #include "mapless/robot/robot_file.h"
-#include "mapless/robot/status.h"
+#include "mapless/run/decision_log.h"
+#include "mapless/run/link_kinds.h"
 #include "mapless/route/appearance_store.h"
 #include "mapless/route/route_store.h"
 #include "recording_args.h"
@@ -28,16 +29,67 @@
 namespace mapless::app {
 namespace {
 
-nlohmann::json StepJson(int frame, Timestamp t_ns, const navigation::RepeatStep& s) {
-  nlohmann::json j;
-  j["frame"] = frame;
-  j["t_s"] = ToSeconds(t_ns);
-  j["status"] = navigation::RepeatStatusName(s.status);
-  robot::RepeatFields(s, &j);
-  j["v_mps"] = s.command.v_mps;
-  j["omega_radps"] = s.command.omega_radps;
-  if (!s.reason.empty()) j["reason"] = s.reason;
-  return j;
+struct RepeatArgs {
+  std::string route;
+  std::string source;
+  std::string controller = "sloped";
+  std::string switching = "stdratio";
+  std::string end = "scale";
+  int redetect_every = navigation::RepeatOptions{}.redetect_every_frames;
+  int recover_keyframes = navigation::RepeatOptions{}.recovery_keyframes;
+  double carry_on_m = navigation::RepeatOptions{}.carry_on.max_distance_m;
+  std::string on_obstacle;  // empty: the robot file's, else stop
+  std::string log;
+  std::uint64_t seed = 1;
+  double motion_noise = 0.1;
+  double image_noise = 2.0;
+  double fps = 10.0;
+  std::string robot;
+  double speed = 0.2;
+  RecordArgs record;
+  recording::PlaybackOptions playback;
+};
+
+// `repeat --source sim:SCENARIO`: one run of the suite's repeat (eval::RepeatOnSimulator) on the
+// route, its decisions logged in the one format of the run layer.
+void RepeatOnSim(const RepeatArgs& r, const std::shared_ptr<route::Route>& route,
+                 const navigation::RepeatOptions& options) {
+  const sim::Scenario scenario = sim::LoadScenario(r.source.substr(4));
+  if (scenario.camera.model.width != route->image_width ||
+      scenario.camera.model.height != route->image_height) {
+    throw InputError(r.source + ": the camera is " + std::to_string(scenario.camera.model.width) +
+                     "x" + std::to_string(scenario.camera.model.height) + ", the route " + r.route +
+                     " was taught at " + std::to_string(route->image_width) + "x" +
+                     std::to_string(route->image_height));
+  }
+  const auto recorder = OpenRecorder(r.record, recording::CameraInfoOf(scenario.camera.model));
+  JsonLines log(r.log);
+  StopCleanlyOnInterrupt();
+  eval::TaughtRoute taught;
+  taught.route = route;
+  sim::DriveOptions drive;
+  drive.render_frames = false;
+  const sim::DriveSummary summary = sim::DriveTaughtPath(
+      scenario, drive, [&](const sim::DriveFrame& f) { taught.path.push_back(f.truth); });
+  taught.duration_s = summary.duration_s;
+  eval::RepeatRunOptions run_options;
+  run_options.repeat = options;
+  run_options.seed = r.seed;
+  run_options.motion_noise_frac = r.motion_noise;
+  run_options.image_noise_sigma = r.image_noise;
+  run_options.wrap_link =
+      run::LogDecisions("repeat", [&log](const nlohmann::json& j) { log.Write(j); },
+                        RecordingWrapper(recorder.get(), "repeat"));
+  const double speed = eval::RepeatSpeedFor(scenario, run_options.max_repeat_speed_mps);
+  run_options.repeat.sloped.max_speed_mps = speed;
+  run_options.repeat.standard.forward_speed_mps = speed;
+  const eval::RepeatRun run = eval::RepeatOnSimulator(
+      scenario, taught, run_options,
+      [&](const Pose2&, const cv::Mat&, const navigation::RepeatStep&) { ThrowIfInterrupted(); });
+  spdlog::info("repeat: {} ({}): {}; final error {:.2f} m, lateral RMS {:.2f} m, {:.1f} s",
+               scenario.name, r.controller, run.status, run.final_error_m, run.lateral_rms_m,
+               run.duration_s);
+  if (!run.success) throw RunFailed("repeat did not succeed: " + run.status);
 }
 
 }  // namespace
@@ -73,26 +125,6 @@ void AddTeachRepeatCommands(CLI::App* app) {
   AddRecordOptions(teach, &t->record);
   teach->callback([t] { Teach(*t); });
 
-  struct RepeatArgs {
-    std::string route;
-    std::string source;
-    std::string controller = "sloped";
-    std::string switching = "stdratio";
-    std::string end = "scale";
-    int redetect_every = navigation::RepeatOptions{}.redetect_every_frames;
-    int recover_keyframes = navigation::RepeatOptions{}.recovery_keyframes;
-    double carry_on_m = navigation::RepeatOptions{}.carry_on.max_distance_m;
-    std::string on_obstacle;  // empty: the robot file's, else stop
-    std::string log;
-    std::uint64_t seed = 1;
-    double motion_noise = 0.1;
-    double image_noise = 2.0;
-    double fps = 10.0;
-    std::string robot;
-    double speed = 0.2;
-    RecordArgs record;
-    recording::PlaybackOptions playback;
-  };
   auto r = std::make_shared<RepeatArgs>();
   CLI::App* repeat = app->add_subcommand(
       "repeat",
@@ -164,10 +196,10 @@ void AddTeachRepeatCommands(CLI::App* app) {
   repeat->callback([r] {
     if (r->source.empty() && r->robot.empty())
       throw InputError("repeat: give --source (simulator, recording, camera) or --robot");
-    RefuseOutputOverInputs(r->log, "--log", {r->route, SourceInput(r->source), r->robot});
+    RefuseOutputOverInputs(r->log, "--log", {r->route, run::SourceInput(r->source), r->robot});
     RefuseOutputOverInputs(r->record.path, "--record",
-                           {r->route, SourceInput(r->source), r->robot});
-    if (!r->record.path.empty() && !r->source.empty() && !IsSim(r->source))
+                           {r->route, run::SourceInput(r->source), r->robot});
+    if (!r->record.path.empty() && !r->source.empty() && !run::IsSim(r->source))
       throw InputError("--record: records runs on the simulator or a robot; " + r->source +
                        " is played open loop (its decisions are in --log)");
     auto route = std::make_shared<route::Route>(route::LoadRoute(r->route));
@@ -183,90 +215,23 @@ void AddTeachRepeatCommands(CLI::App* app) {
     options.carry_on.max_distance_m = r->carry_on_m;
     options.features.type = features::ParseDetectorType(route->detector);
     options.obstacle = ObstacleWatchFor(r->robot, r->on_obstacle, options.obstacle, true);
-    if (!r->robot.empty()) {
-      options.sloped.max_speed_mps = r->speed;
-      options.standard.forward_speed_mps = r->speed;
+    if (!r->robot.empty() || !run::IsSim(r->source)) {
+      if (!r->robot.empty()) {
+        options.sloped.max_speed_mps = r->speed;
+        options.standard.forward_speed_mps = r->speed;
+      }
       robot::RepeatMethod method(route, options);
-      const auto recorder = OpenRecorder(r->record);
-      RunOnRobot(method, r->robot, r->log, recorder.get());
+      SourceRunArgs args;
+      args.log = r->log;
+      args.playback = r->playback;
+      args.playback.fps = r->fps;
+      args.record = &r->record;
+      args.size_needed_by = "the route " + r->route + " was taught at";
+      args.robot = !r->robot.empty();
+      RunOnSource(method, args.robot ? r->robot : r->source, args);
       return;
     }
-    std::unique_ptr<io::FrameSource> source;
-    std::optional<sim::Scenario> scenario;
-    if (IsSim(r->source)) {
-      scenario = sim::LoadScenario(r->source.substr(4));
-    } else {
-      r->playback.fps = r->fps;
-      source = recording::OpenSource(r->source, r->playback);
-    }
-    const auto recorder =
-        scenario ? OpenRecorder(r->record, recording::CameraInfoOf(scenario->camera.model))
-                 : nullptr;
-    JsonLines log(r->log);
-    StopCleanlyOnInterrupt();
-    int frame_index = 0;
-    if (scenario) {
-      if (scenario->camera.model.width != route->image_width ||
-          scenario->camera.model.height != route->image_height) {
-        throw InputError(r->source + ": the camera is " +
-                         std::to_string(scenario->camera.model.width) + "x" +
-                         std::to_string(scenario->camera.model.height) + ", the route " + r->route +
-                         " was taught at " + std::to_string(route->image_width) + "x" +
-                         std::to_string(route->image_height));
-      }
-      eval::TaughtRoute taught;
-      taught.route = route;
-      sim::DriveOptions drive;
-      drive.render_frames = false;
-      const sim::DriveSummary summary = sim::DriveTaughtPath(
-          *scenario, drive, [&](const sim::DriveFrame& f) { taught.path.push_back(f.truth); });
-      taught.duration_s = summary.duration_s;
-      eval::RepeatRunOptions run_options;
-      run_options.repeat = options;
-      run_options.seed = r->seed;
-      run_options.motion_noise_frac = r->motion_noise;
-      run_options.image_noise_sigma = r->image_noise;
-      run_options.wrap_link = RecordingWrapper(recorder.get(), "repeat");
-      const double speed = eval::RepeatSpeedFor(*scenario, run_options.max_repeat_speed_mps);
-      run_options.repeat.sloped.max_speed_mps = speed;
-      run_options.repeat.standard.forward_speed_mps = speed;
-      const eval::RepeatRun run = eval::RepeatOnSimulator(
-          *scenario, taught, run_options,
-          [&](const Pose2& pose, const cv::Mat&, const navigation::RepeatStep& step) {
-            ThrowIfInterrupted();
-            nlohmann::json j =
-                StepJson(frame_index, FromSeconds(frame_index / scenario->camera.rate_hz), step);
-            j["x_m"] = pose.x_m;
-            j["y_m"] = pose.y_m;
-            j["theta_rad"] = pose.theta_rad;
-            log.Write(j);
-            ++frame_index;
-          });
-      spdlog::info("repeat: {} ({}): {}; final error {:.2f} m, lateral RMS {:.2f} m, {:.1f} s",
-                   scenario->name, r->controller, run.status, run.final_error_m, run.lateral_rms_m,
-                   run.duration_s);
-      if (!run.success) throw RunFailed("repeat did not succeed: " + run.status);
-      return;
-    }
-    navigation::RepeatSession session(route, options);
-    io::Frame frame;
-    navigation::RepeatStep last;
-    while (source->Next(&frame)) {
-      ThrowIfInterrupted();
-      if (frame.image.cols != route->image_width || frame.image.rows != route->image_height) {
-        throw InputError(
-            r->source + ": frame " + frame.name + " is " + std::to_string(frame.image.cols) + "x" +
-            std::to_string(frame.image.rows) + ", the route " + r->route + " was taught at " +
-            std::to_string(route->image_width) + "x" + std::to_string(route->image_height));
-      }
-      last = session.Update(frame.image, frame.t_ns, frame.odometry);
-      nlohmann::json j = StepJson(frame_index++, frame.t_ns, last);
-      j["image"] = frame.name;
-      log.Write(j);
-      if (session.finished()) break;
-    }
-    spdlog::info("repeat (open loop): {} frames, last destination keyframe {}, status {}",
-                 frame_index, last.destination, navigation::RepeatStatusName(last.status));
+    RepeatOnSim(*r, route, options);
   });
 
   CLI::App* route_cmd = app->add_subcommand("route", "Inspect a taught route");

@@ -18,68 +18,19 @@
 #include "mapless/fleet/route_log.h"
 #include "mapless/fleet/server.h"
 #include "mapless/io/atomic_file.h"
-#include "mapless/navigation/teach.h"
 #include "mapless/robot/link_bench.h"
-#include "mapless/robot/loop.h"
 #include "mapless/robot/methods.h"
 #include "mapless/robot/robot_file.h"
-#include "mapless/robot/sim_link.h"
-#include "mapless/robot/status.h"
-#include "mapless/sim/simulation.h"
+#include "mapless/run/leader_sink.h"
+#include "mapless/run/sim_episode.h"
+#include "mapless/run/teach.h"
 #include "robot_run.h"
-#include "teach.h"
 
 namespace mapless::app {
 
 namespace {
 
 void FleetLog(const std::string& line) { spdlog::info("{}", line); }
-
-// Keeps a simulation in step with the wall clock: simulated time runs `rate` times as fast.
-class Pacer {
- public:
-  explicit Pacer(double rate) : rate_(rate) {}
-  void At(Timestamp sim_ns) {
-    if (rate_ <= 0.0) return;
-    const auto now = std::chrono::steady_clock::now();
-    if (!started_) {
-      started_ = true;
-      wall0_ = now;
-      sim0_ = sim_ns;
-      return;
-    }
-    const auto due = wall0_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                  std::chrono::duration<double>(ToSeconds(sim_ns - sim0_) / rate_));
-    if (due > now) std::this_thread::sleep_until(due);
-  }
-
- private:
-  double rate_;
-  bool started_ = false;
-  std::chrono::steady_clock::time_point wall0_;
-  Timestamp sim0_ = 0;
-};
-
-// The simulator as a robot link in step with the wall clock (followers of a live leader).
-class PacedLink : public robot::RobotLink {
- public:
-  PacedLink(robot::SimLink& link, double rate) : link_(link), pacer_(rate) {}
-  robot::LinkEvent Next() override {
-    robot::LinkEvent e = link_.Next();
-    pacer_.At(link_.now_ns());
-    return e;
-  }
-  void Send(const Twist2& c, const robot::Observation& o, const robot::Decision& d) override {
-    link_.Send(c, o, d);
-  }
-  void Stop(const std::string& reason) override { link_.Stop(reason); }
-  std::string Halted() override { return link_.Halted(); }
-  Timestamp now_ns() const override { return link_.now_ns(); }
-
- private:
-  robot::SimLink& link_;
-  Pacer pacer_;
-};
 
 fleet::LeaderSecurity LeaderKeys(const std::string& key, const std::vector<std::string>& allow) {
   fleet::LeaderSecurity security;
@@ -93,106 +44,6 @@ fleet::LeaderSecurity LeaderKeys(const std::string& key, const std::vector<std::
   return security;
 }
 
-// What a leader teaches: keyframes (funnel lanes) or route images (eigenspace), as records that
-// its RouteCopy writes and its server serves.
-class LeaderTeacher {
- public:
-  LeaderTeacher(fleet::RouteCopy& copy, fleet::LeaderServer& server, fleet::RouteKind kind,
-                const std::string& detector)
-      : copy_(copy),
-        server_(server),
-        kind_(kind),
-        detector_(detector),
-        resuming_(copy.next_sequence() > 1 && !copy.complete()) {
-    teach_options_.features.type = features::ParseDetectorType(detector);
-    teach_options_.Validate();
-    session_ = std::make_unique<navigation::TeachSession>(teach_options_);
-    if (kind_ == fleet::RouteKind::kEigenspace && resuming_) {
-      // Resume: the model as the interrupted leader had it.
-      const route::StoredAppearanceRoute stored = route::LoadAppearanceRoute(copy_.dir());
-      for (const auto& image : stored.images)
-        leader_.AddStored(image.low, image.distance_m, image.odometry);
-      last_resumed_ = stored.images.back().odometry;
-    }
-    if (kind_ == fleet::RouteKind::kFunnel && resuming_) {
-      // The last stored keyframe's time (read back from its file).
-      const std::vector<fleet::Record> last = copy_.RecordsFrom(copy_.next_sequence() - 1, 1);
-      last_keyframe_t_ns_ = route::ParseKeyframe(last.at(0).parts.at(0), copy_.dir()).t_ns;
-    }
-  }
-  bool resuming() const { return resuming_; }
-  // Simulator resume: frames up to where the interrupted teach stopped are driven, not rendered.
-  bool Skip(const sim::DriveFrame& f) {
-    if (!resuming() || rendering_) return false;
-    if (kind_ == fleet::RouteKind::kFunnel) {
-      rendering_ = f.t_ns >= last_keyframe_t_ns_;
-      drop_first_ = rendering_ && f.t_ns == last_keyframe_t_ns_;
-      return !rendering_;
-    }
-    if (f.odometry.x_m == last_resumed_.x_m && f.odometry.y_m == last_resumed_.y_m &&
-        f.odometry.theta_rad == last_resumed_.theta_rad) {
-      rendering_ = true;  // from the next frame on
-    }
-    return true;
-  }
-  void Frame(const cv::Mat& image, Timestamp t_ns, const std::optional<Pose2>& odometry) {
-    if (copy_.next_sequence() == 0) {
-      fleet::RouteHeader h;
-      h.kind = kind_;
-      h.image_width = image.cols;
-      h.image_height = image.rows;
-      h.detector = detector_;
-      navigation::AppearanceLeaderOptions appearance;
-      h.low_width = appearance.image.width;
-      h.low_height = appearance.image.height;
-      Serve(fleet::HeaderRecord(h));
-    }
-    if (kind_ == fleet::RouteKind::kFunnel) {
-      Keep(session_->Update(image, t_ns, odometry));
-      return;
-    }
-    if (!odometry)
-      throw InputError(
-          "lead --method eigenspace needs wheel odometry (route images are spaced by "
-          "distance): lead on sim:SCENARIO or on a robot with an odometry topic");
-    if (leader_.Update(image, *odometry))
-      Serve(fleet::ImageRecord({leader_.last_low(), leader_.distance_m(), *odometry}));
-  }
-  void Finish() {
-    if (kind_ == fleet::RouteKind::kFunnel) Keep(session_->Finish());
-    Serve(fleet::EndRecord());
-  }
-  int stored() const { return static_cast<int>(copy_.next_sequence()) - 1; }
-
- private:
-  void Keep(std::optional<route::Keyframe> kf) {
-    if (!kf) return;
-    if (drop_first_) {  // the resumed session's first keyframe is the stored last one
-      drop_first_ = false;
-      return;
-    }
-    kf->index = static_cast<int>(copy_.next_sequence()) - 1;
-    Serve(fleet::KeyframeRecord(*kf));
-  }
-  void Serve(fleet::Record record) {
-    record.sequence = copy_.next_sequence();
-    copy_.Apply({record});
-    server_.Notify();
-  }
-  fleet::RouteCopy& copy_;
-  fleet::LeaderServer& server_;
-  fleet::RouteKind kind_;
-  std::string detector_;
-  navigation::TeachOptions teach_options_;
-  std::unique_ptr<navigation::TeachSession> session_;
-  navigation::AppearanceLeader leader_;
-  bool resuming_;  // an interrupted leader's route was reloaded
-  Pose2 last_resumed_;
-  Timestamp last_keyframe_t_ns_ = 0;
-  bool rendering_ = false;
-  bool drop_first_ = false;
-};
-
 struct LeadArgs {
   std::string source;
   std::string robot;
@@ -205,21 +56,50 @@ struct LeadArgs {
   double rate = 1.0;
 };
 
+// A leader restarted on its route goes on where it stopped: the teacher has the route so far, and
+// on the simulator the frames up to there are driven, not rendered (the returned test).
+std::function<bool(const sim::DriveFrame&)> ResumeLeader(const fleet::RouteCopy& copy,
+                                                        fleet::RouteKind kind,
+                                                        run::Teacher* teacher) {
+  if (copy.next_sequence() == 0 || copy.complete()) return {};
+  const int stored = static_cast<int>(copy.next_sequence()) - 1;  // record 0 is the header
+  if (stored == 0) {
+    teacher->Resume(0, nullptr, std::nullopt);
+    return {};
+  }
+  if (kind == fleet::RouteKind::kEigenspace) {
+    // The model as the interrupted leader had it.
+    const route::StoredAppearanceRoute images = route::LoadAppearanceRoute(copy.dir());
+    teacher->Resume(stored, &images, std::nullopt);
+    const Pose2 last = images.images.back().odometry;
+    auto rendering = std::make_shared<bool>(false);
+    return [last, rendering](const sim::DriveFrame& f) {
+      if (*rendering) return false;
+      if (f.odometry.x_m == last.x_m && f.odometry.y_m == last.y_m &&
+          f.odometry.theta_rad == last.theta_rad)
+        *rendering = true;  // from the next frame on
+      return true;
+    };
+  }
+  // The last stored keyframe's time (read back from its file).
+  const std::vector<fleet::Record> last = copy.RecordsFrom(copy.next_sequence() - 1, 1);
+  const Timestamp last_t_ns = route::ParseKeyframe(last.at(0).parts.at(0), copy.dir()).t_ns;
+  teacher->Resume(stored, nullptr, last_t_ns);
+  return [last_t_ns](const sim::DriveFrame& f) { return f.t_ns < last_t_ns; };
+}
+
 void Lead(const LeadArgs& a) {
-  if (a.method != "funnel" && a.method != "eigenspace")
-    throw InputError("--method " + a.method + ": must be funnel or eigenspace");
-  const fleet::RouteKind kind = fleet::ParseRouteKind(a.method);
+  const fleet::RouteKind kind = run::ParseTeachMethod(a.method);
   if (a.source.empty() == a.robot.empty())
     throw InputError("lead: give one of --source sim:SCENARIO or --robot");
-  if (!a.source.empty() && !IsSim(a.source))
+  if (!a.source.empty() && !run::IsSim(a.source))
     throw InputError("--source " + a.source + ": lead runs on sim:SCENARIO or --robot");
   features::ParseDetectorType(a.detector);
   std::optional<sim::Scenario> scenario;
-  std::optional<robot::RobotFile> robot_file;
-  if (IsSim(a.source)) {
+  if (run::IsSim(a.source)) {
     scenario = sim::LoadScenario(a.source.substr(4));
   } else {
-    robot_file = robot::LoadRobotFile(a.robot);
+    robot::LoadRobotFile(a.robot);  // refused before anything is served
   }
   fleet::ServerOptions server_options;
   server_options.bind = a.bind;
@@ -233,55 +113,41 @@ void Lead(const LeadArgs& a) {
   spdlog::info("lead: serving {} on {}{}", a.route, server.endpoint(),
                server_options.security.enabled() ? " (CURVE)" : "");
   StopCleanlyOnInterrupt();
-  LeaderTeacher teacher(copy, server, kind, a.detector);
+  run::LeaderSink sink(copy, server);
+  run::TeacherOptions teacher_options;
+  teacher_options.kind = kind;
+  teacher_options.detector = a.detector;
+  run::Teacher teacher(teacher_options, sink);
   bool robot_teach_ended = false;
   if (copy.complete()) {
     spdlog::info("lead: {} is a complete route of {} records; serving it", a.route,
                  copy.next_sequence());
   } else {
-    if (teacher.resuming())
+    const auto skip = ResumeLeader(copy, kind, &teacher);
+    if (copy.next_sequence() > 1)
       spdlog::info("lead: resuming the route in {} after record {}", a.route,
                    copy.next_sequence() - 1);
-    try {
-      if (scenario) {
-        Pacer pacer(a.rate);
-        sim::DriveOptions drive;
-        drive.skip_render = [&](const sim::DriveFrame& f) { return teacher.Skip(f); };
-        const sim::DriveSummary summary =
-            sim::DriveTaughtPath(*scenario, drive, [&](const sim::DriveFrame& f) {
-              ThrowIfInterrupted();
-              if (f.image.empty()) return;
-              pacer.At(f.t_ns);
-              teacher.Frame(f.image, f.t_ns, f.odometry);
-            });
-        if (!summary.completed)
-          throw RunFailed("lead: the drive of '" + scenario->name +
-                          "' did not complete: " + summary.status);
-        teacher.Finish();
-      } else {
-        std::unique_ptr<robot::RobotLink> link = OpenRobotLink(*robot_file, {}, "teach");
-        spdlog::info("lead: recording; drive the robot, Ctrl-C ends the route");
-        try {
-          while (true) {
-            ThrowIfInterrupted();
-            robot::LinkEvent e = link->Next();
-            if (e.type == robot::LinkEventType::kClosed) {
-              ThrowIfInterrupted();  // the link heard the interrupt first
-              throw RunFailed("lead: " + e.reason);
-            }
-            if (e.type != robot::LinkEventType::kFrame) continue;
-            teacher.Frame(e.observation.image, e.observation.t_ns, e.observation.odometry);
-          }
-        } catch (const Interrupted&) {
-          teacher.Finish();  // on a robot, Ctrl-C ends the route; a second one ends the leader
-          robot_teach_ended = true;
-        }
-      }
-    } catch (const Interrupted&) {
+    run::TeachOutcome outcome;
+    if (scenario) {
+      run::Pacer pacer(a.rate);
+      outcome = run::TeachOnSimulator(*scenario, teacher, {}, skip,
+                                      [&pacer](Timestamp t_ns) { pacer.At(t_ns); });
+    } else {
+      run::LinkRequest request;
+      request.warn = [](const std::string& m) { spdlog::warn("{}", m); };
+      std::unique_ptr<robot::RobotLink> link = Links().Named("robot").open(a.robot, request);
+      spdlog::info("lead: recording; drive the robot, Ctrl-C ends the route");
+      outcome = run::TeachFromLink(*link, teacher);
+      // On a robot, Ctrl-C ends the route; a second one ends the leader.
+      robot_teach_ended = outcome.interrupted;
+    }
+    if (outcome.failed) throw RunFailed("lead: " + outcome.end);
+    if (outcome.interrupted && !robot_teach_ended) {
       spdlog::info("lead: interrupted after record {}; the route is kept for a resume",
                    copy.next_sequence() - 1);
-      throw;
+      ThrowIfInterrupted();
     }
+    teacher.Finish();
     spdlog::info("lead: route complete: {} records; serving it until Ctrl-C", copy.next_sequence());
   }
   while (true) {
@@ -307,12 +173,12 @@ RoutePtr NotTooShort(const fleet::RouteCopy& copy, RoutePtr route, const char* u
 void FollowConnected(const FollowConnectArgs& a) {
   if (a.source.empty() == a.robot.empty())
     throw InputError("follow: give one of --source sim:SCENARIO or --robot");
-  if (!a.source.empty() && !IsSim(a.source))
+  if (!a.source.empty() && !run::IsSim(a.source))
     throw InputError("--source " + a.source + ": follow runs on sim:SCENARIO or --robot");
   if (a.curve_key.empty() != a.curve_leader.empty())
     throw InputError("--curve-key and --curve-leader go together");
   std::optional<sim::Scenario> scenario;
-  if (IsSim(a.source)) scenario = sim::LoadScenario(a.source.substr(4));
+  if (run::IsSim(a.source)) scenario = sim::LoadScenario(a.source.substr(4));
   fleet::ClientOptions options;
   options.connect = a.connect;
   if (!a.curve_key.empty()) {
@@ -357,7 +223,15 @@ void FollowConnected(const FollowConnectArgs& a) {
       repeat.standard.forward_speed_mps = speed;
     }
     method = std::make_unique<robot::RepeatMethod>(
-        [&copy] { return NotTooShort(copy, copy.FunnelRoute(), "keyframes", 2); }, repeat, size);
+        robot::RepeatMethod::RouteUpdates([&copy](route::Route* route) {
+          const bool changed = copy.UpdateFunnel(route);
+          if (route->complete && route->keyframes.size() < 2)
+            throw RunFailed("follow: the leader completed its route with " +
+                            std::to_string(route->keyframes.size()) +
+                            " keyframes; a route to follow needs at least 2");
+          return changed;
+        }),
+        repeat, size);
   } else {
     navigation::AppearanceFollowerOptions follower;
     follower.obstacle = ObstacleWatchFor(a.robot, a.on_obstacle, follower.obstacle, false);
@@ -368,7 +242,10 @@ void FollowConnected(const FollowConnectArgs& a) {
   }
   spdlog::info("follow: a {} route from {}", fleet::RouteKindName(header.kind), a.connect);
   if (!scenario) {
-    RunOnRobot(*method, a.robot, a.log);
+    SourceRunArgs args;
+    args.log = a.log;
+    args.robot = true;
+    RunOnSource(*method, a.robot, args);
     return;
   }
   if (scenario->camera.model.width != size.width || scenario->camera.model.height != size.height)
@@ -376,66 +253,31 @@ void FollowConnected(const FollowConnectArgs& a) {
                      "x" + std::to_string(scenario->camera.model.height) +
                      ", the leader's route is " + std::to_string(size.width) + "x" +
                      std::to_string(size.height));
-  eval::SimSetup setup;
-  double timeout_s = 0.0;
-  std::vector<Pose2> taught;
-  sim::DriveOptions path_only;
-  path_only.render_frames = false;
-  const sim::DriveSummary drive = sim::DriveTaughtPath(
-      *scenario, path_only, [&](const sim::DriveFrame& f) { taught.push_back(f.truth); });
-  if (header.kind == fleet::RouteKind::kFunnel) {
-    eval::RepeatRunOptions run;
-    run.seed = a.seed;
-    run.motion_noise_frac = a.motion_noise;
-    setup = eval::RepeatSimSetup(*scenario, run);
-    timeout_s = 2.0 * run.timeout_factor * std::max(drive.duration_s, 1.0);
-  } else {
-    eval::EigenspaceRunOptions run;
-    run.seed = a.seed;
-    run.motion_noise = a.motion_noise;
-    setup = eval::FollowSimSetup(*scenario, run);
-    timeout_s = 2.0 * eval::FollowTimeoutS(*scenario, run);
-  }
-  sim::Simulation sim(setup.world, setup.camera, {}, setup.seed);
-  const int r = sim.AddRobot(setup.start, setup.robot);
-  robot::SimLinkOptions link_options;
-  link_options.period_s = 1.0 / scenario->camera.rate_hz;
-  link_options.timeout_s = timeout_s;
-  robot::SimLink sim_link(sim, r, link_options);
-  PacedLink link(sim_link, a.rate);
-  JsonLines log(a.log);
-  int frame = 0;
+  run::SimRun sim(*scenario,
+                  run::FollowEpisode(*scenario, header.kind, a.seed, a.motion_noise,
+                                     /*live_leader=*/true),
+                  a.rate);
+  const std::vector<Pose2>& taught = sim.episode().taught;
   double lateral_sq = 0.0;
   int moving = 0;
   int waited = 0;  // frames stopped at the end of the route taught so far
-  const robot::LoopResult result =
-      robot::RunLoop(*method, link, robot::LoopOptions{},
-                     [&](const robot::Observation& obs, const robot::Decision& decision) {
-                       ThrowIfInterrupted();
-                       const Pose2& truth = sim_link.truth();
-                       if (decision.reason.rfind("waiting for the leader", 0) == 0 ||
-                           decision.status == "waiting_for_leader")
-                         ++waited;
-                       if (decision.state == robot::MethodState::kDriving) {
-                         const double d = eval::DistanceToPath(taught, truth.x_m, truth.y_m);
-                         lateral_sq += d * d;
-                         ++moving;
-                       }
-                       if (!a.log.empty()) {
-                         nlohmann::json j = robot::StatusJson(method->name(), frame, obs, decision);
-                         j["x_m"] = truth.x_m;
-                         j["y_m"] = truth.y_m;
-                         j["theta_rad"] = truth.theta_rad;
-                         log.Write(j);
-                       }
-                       ++frame;
-                       return true;
-                     });
-  const double final_error = sim_link.truth().DistanceTo(taught.back());
-  const double tolerance = header.kind == fleet::RouteKind::kFunnel
-                               ? eval::RepeatRunOptions{}.success_radius_m
-                               : eval::EigenspaceRunOptions{}.arrive_tolerance_m;
-  const bool success = result.finished && !sim.collided(r) && final_error <= tolerance;
+  const run::RunOutcome outcome =
+      RunOnSim(*method, sim, a.log, nullptr,
+               [&](const robot::Observation&, const robot::Decision& decision) {
+                 if (decision.reason.rfind("waiting for the leader", 0) == 0 ||
+                     decision.status == "waiting_for_leader")
+                   ++waited;
+                 if (decision.state == robot::MethodState::kDriving) {
+                   const double d =
+                       eval::DistanceToPath(taught, sim.truth().x_m, sim.truth().y_m);
+                   lateral_sq += d * d;
+                   ++moving;
+                 }
+                 return true;
+               });
+  const robot::LoopResult& result = outcome.loop;
+  const double final_error = sim.error_at_end_m();
+  const bool success = sim.succeeded(result.finished);
   const fleet::ClientStats stats = client.stats();
   spdlog::info("follow: {} ({} frames); {:.2f} m from the route's end; {} records applied",
                result.reason, result.frames, final_error, stats.applied);
@@ -447,7 +289,7 @@ void FollowConnected(const FollowConnectArgs& a) {
     nlohmann::json j;
     j["completed"] = success;
     j["reason"] = result.reason;
-    j["collided"] = sim.collided(r);
+    j["collided"] = sim.collided();
     j["final_error_m"] = final_error;
     j["lateral_rms_m"] = moving > 0 ? std::sqrt(lateral_sq / moving) : 0.0;
     j["frames"] = result.frames;

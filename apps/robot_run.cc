@@ -8,16 +8,12 @@
 #include "cli_common.h"
 #include "interrupt.h"
 #include "mapless/core/check.h"
-#include "mapless/recording/recording_link.h"
-#include "mapless/robot/loop.h"
-#include "mapless/robot/status.h"
 
 namespace mapless::app {
 
-std::unique_ptr<robot::RobotLink> OpenRobotLink(const robot::RobotFile& robot, cv::Size image_size,
-                                                const std::string& method) {
-  return BuiltinMiddlewares().For(robot).open_link(
-      robot, image_size, method, [](const std::string& m) { spdlog::warn("{}", m); });
+const run::LinkKinds& Links() {
+  static const run::LinkKinds kinds = run::StandardLinkKinds(BuiltinMiddlewares());
+  return kinds;
 }
 
 void SetFollowerRecovery(double carry_on_m, navigation::AppearanceFollowerOptions* follower) {
@@ -60,39 +56,94 @@ void AddOnObstacleOption(CLI::App* cmd, std::string* on_obstacle) {
       ->check(CLI::IsMember({"stop", "avoid", "off"}));
 }
 
-void RunOnRobot(robot::Method& method, const std::string& robot_path, const std::string& log_path,
-                recording::RunRecorder* recorder) {
-  const robot::RobotFile file = robot::LoadRobotFile(robot_path);
+namespace {
+
+void Say(const std::string& line) { spdlog::info("{}", line); }
+
+// A robot: its robot file's limits, lines when the method holds it, and a failure unless the
+// method finished.
+void RunOnRobot(robot::Method& method, const std::string& path, const SourceRunArgs& args) {
+  const robot::RobotFile file = robot::LoadRobotFile(path);
+  std::unique_ptr<JsonLines> log;
+  if (!args.log.empty()) log = std::make_unique<JsonLines>(args.log);
+  const auto recorder = args.record ? OpenRecorder(*args.record) : nullptr;
+  StopCleanlyOnInterrupt();
+  run::LinkRequest request;
+  request.method = method.name();
+  request.image_size = method.image_size();
+  request.warn = [](const std::string& m) { spdlog::warn("{}", m); };
+  std::unique_ptr<robot::RobotLink> link = Links().Named("robot").open(path, request);
+  spdlog::info("{}: on {} ({}), commands to {}", method.name(), file.name, file.middleware,
+               file.Resolve(file.topics.cmd_vel));
+  run::RunOptions options;
+  options.loop = file.Loop();
+  if (log) options.log = [&log](const nlohmann::json& j) { log->Write(j); };
+  options.say = Say;
+  options.recorder = recorder.get();
+  const run::RunOutcome outcome = run::RunMethod(method, *link, options);
+  link.reset();  // zero velocity published, then off the graph
+  spdlog::info("{}: {} after {} frames: {}", method.name(),
+               outcome.loop.finished ? "finished" : "stopped", outcome.loop.frames,
+               outcome.loop.reason);
+  ThrowIfInterrupted();
+  if (!outcome.loop.finished)
+    throw RunFailed(std::string(method.name()) + " stopped: " + outcome.loop.reason);
+}
+
+// A recording, video, image folder or camera, open loop: the end of the recording is a normal end.
+void RunOnRecording(robot::Method& method, const std::string& source, const SourceRunArgs& args) {
+  if (args.record && !args.record->path.empty())
+    throw InputError("--record: records runs on the simulator or a robot; " + source +
+                     " is played open loop (its decisions are in --log)");
+  run::LinkRequest request;
+  request.method = method.name();
+  request.image_size = method.image_size();
+  request.size_needed_by = args.size_needed_by;
+  request.playback = args.playback;
+  std::unique_ptr<robot::RobotLink> link = Links().Open(source, request);
+  JsonLines log(args.log);
+  StopCleanlyOnInterrupt();
+  run::RunOptions options;
+  options.log = [&log](const nlohmann::json& j) { log.Write(j); };
+  const run::RunOutcome outcome = run::RunMethod(method, *link, options);
+  ThrowIfInterrupted();
+  spdlog::info("{} (open loop on {}): {} frames, {}", method.name(), source, outcome.loop.frames,
+               outcome.loop.reason);
+  if (!outcome.loop.finished && !outcome.end_of_recording)
+    throw RunFailed(std::string(method.name()) + " stopped: " + outcome.loop.reason);
+  // A replay on which the method never once drove answered nothing (issue 40: exit 0 with every
+  // decision "stopped: needs odometry").
+  if (!outcome.loop.finished && outcome.loop.frames > 0 && outcome.driving_frames == 0)
+    throw RunFailed(std::string(method.name()) + " on " + source + ": stopped on all " +
+                    std::to_string(outcome.loop.frames) + " frames" +
+                    (outcome.last_stop_reason.empty()
+                         ? ""
+                         : ", the last time: " + outcome.last_stop_reason));
+}
+
+}  // namespace
+
+void RunOnSource(robot::Method& method, const std::string& source, const SourceRunArgs& args) {
+  if (args.robot || Links().For(source).drives) {
+    RunOnRobot(method, source, args);
+  } else {
+    RunOnRecording(method, source, args);
+  }
+}
+
+run::RunOutcome RunOnSim(robot::Method& method, run::SimRun& sim, const std::string& log_path,
+                         recording::RunRecorder* recorder, const robot::LoopObserver& observer) {
   std::unique_ptr<JsonLines> log;
   if (!log_path.empty()) log = std::make_unique<JsonLines>(log_path);
   StopCleanlyOnInterrupt();
-  std::unique_ptr<robot::RobotLink> link = OpenRobotLink(file, method.image_size(), method.name());
-  std::unique_ptr<robot::RobotLink> recording;
-  if (recorder)
-    recording = std::make_unique<recording::RecordingLink>(*link, *recorder, method.name());
-  spdlog::info("{}: on {} ({}), commands to {}", method.name(), file.name, file.middleware,
-               file.Resolve(file.topics.cmd_vel));
-  int frame = 0;
-  std::string last_state;
-  const robot::LoopResult result = robot::RunLoop(
-      method, recording ? *recording : *link, file.Loop(),
-      [&](const robot::Observation& obs, const robot::Decision& decision) {
-        if (log) log->Write(robot::StatusJson(method.name(), frame, obs, decision));
-        ++frame;
-        const std::string state =
-            decision.status + (decision.reason.empty() ? "" : ": " + decision.reason);
-        if (decision.state != robot::MethodState::kDriving && state != last_state)
-          spdlog::info("{}: {}", method.name(), state);
-        last_state = decision.state == robot::MethodState::kDriving ? "" : state;
-        return true;
-      },
-      [] { return InterruptSignal() != 0; });
-  recording.reset();
-  link.reset();  // zero velocity published, then off the graph
-  spdlog::info("{}: {} after {} frames: {}", method.name(),
-               result.finished ? "finished" : "stopped", result.frames, result.reason);
+  run::RunOptions options;
+  if (log) options.log = [&log](const nlohmann::json& j) { log->Write(j); };
+  options.more_fields = [&sim](nlohmann::json* j) { sim.AddTruth(j); };
+  options.observer = observer;
+  options.recorder = recorder;
+  const run::RunOutcome outcome = run::RunMethod(method, sim.link(), options);
   ThrowIfInterrupted();
-  if (!result.finished) throw RunFailed(std::string(method.name()) + " stopped: " + result.reason);
+  return outcome;
 }
 
 }  // namespace mapless::app

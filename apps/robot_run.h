@@ -1,6 +1,6 @@
-// Running a method on a robot named by a robot file (`--robot ROBOT.yaml`): opens the robot link of
-// the file's middleware, runs the loop (robot/loop.h) until the method is done or the user
-// interrupts, logs each decision, and turns the outcome into the exit code.
+// The commands' side of the run layer (src/mapless/run): a method's run on a robot, a recording or
+// the simulator with the command line's conventions (the log, the lines said, the exit code), and
+// the options that several commands share.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -13,18 +13,40 @@
 #include "mapless/robot/link.h"
 #include "mapless/robot/method.h"
 #include "mapless/robot/robot_file.h"
+#include "mapless/run/link_kinds.h"
+#include "mapless/run/run_method.h"
+#include "mapless/run/sim_episode.h"
+#include "recording_args.h"
 
 namespace mapless::app {
 
-// The robot link of the file's middleware; throws InputError when mapless was built without it.
-// `image_size`: frames are resized to it (0x0: as they come).
-std::unique_ptr<robot::RobotLink> OpenRobotLink(const robot::RobotFile& robot, cv::Size image_size,
-                                                const std::string& method);
+// The link kinds of this build (run/link_kinds.h): robot files over the middlewares built in,
+// cameras and recordings.
+const run::LinkKinds& Links();
 
-// Runs `method` on the robot. Decisions go to `log_path` as JSON lines ("" : none, "-": stdout).
-// Throws RunFailed when the method failed or gave up, Interrupted on SIGINT/SIGTERM (after the
-// robot was stopped).
-// With a recorder, the run is recorded (recording/recording_link.h).
+// How a command runs a method on a source that is not the simulator.
+struct SourceRunArgs {
+  // Decisions as JSON lines to this file; "-": stdout; "": none on a robot, stdout otherwise.
+  std::string log;
+  recording::PlaybackOptions playback;  // a recording, video, folder or camera
+  const RecordArgs* record = nullptr;   // --record: a robot's run is recorded
+  std::string size_needed_by;  // "the route R was taught at": a recording's frames must match
+  bool robot = false;          // the source is a robot file (--robot), whatever its name
+};
+
+// Runs `method` on `source` (a robot file, a camera or a recording; run/link_kinds.h) through the
+// run layer (run/run_method.h). On a robot: the loop limits of its robot file, a line when the
+// method holds the robot and why, RunFailed when the method failed or gave up. On a recording: the
+// end of the recording is a normal end, but a method that never once drove answered nothing
+// (RunFailed). Interrupted on SIGINT/SIGTERM (after the robot was stopped).
+void RunOnSource(robot::Method& method, const std::string& source, const SourceRunArgs& args);
+
+// Runs `method` on the simulator (run/sim_episode.h), decisions with the true pose to `log`
+// ("": none, "-": stdout), recorded with `record`; `observer` sees every decision.
+run::RunOutcome RunOnSim(robot::Method& method, run::SimRun& sim, const std::string& log,
+                         recording::RunRecorder* recorder,
+                         const robot::LoopObserver& observer = {});
+
 // The obstacle watch of `repeat` and `follow`: the method's `defaults` with the robot file's
 // section `obstacles` when a robot file is given (its baseline_m only when the file has one: the
 // methods' defaults differ with their speeds), and `on_obstacle` ("stop" or "off"; empty: as
@@ -38,15 +60,6 @@ navigation::ObstacleWatchOptions ObstacleWatchFor(const std::string& robot_path,
 void SetFollowerRecovery(double carry_on_m, navigation::AppearanceFollowerOptions* follower);
 // `--on-obstacle` of `repeat` and `follow` (stop, avoid, off).
 void AddOnObstacleOption(CLI::App* cmd, std::string* on_obstacle);
-
-void RunOnRobot(robot::Method& method, const std::string& robot_path, const std::string& log_path,
-                recording::RunRecorder* recorder = nullptr);
-
-// Runs `method` open loop on a recording (recording/playback.h) through the same loop as on a
-// robot; decisions to `log_path` as JSON lines (robot/status.h). The end of the recording is a
-// normal end; throws RunFailed when the method failed, Interrupted on SIGINT/SIGTERM.
-void ReplayOnRecording(robot::Method& method, const std::string& source,
-                       const recording::PlaybackOptions& playback, const std::string& log_path);
 
 // `mapless sim serve`.
 void AddSimServeCommand(CLI::App* sim);

@@ -20,10 +20,6 @@ struct TeachArgs {
   RecordArgs record;                    // --record (simulator and robot teaches)
 };
 
-bool IsSim(const std::string& source);
-// The input files of a source ("" for sim built-ins and cameras), for RefuseOutputOverInputs.
-std::string SourceInput(const std::string& source);
-
 void Teach(const TeachArgs& t);
 
 }  // namespace mapless::app

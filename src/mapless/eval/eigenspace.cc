@@ -196,7 +196,7 @@ EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario,
     const robot::LoopResult result = robot::RunLoop(
         method, link, robot::LoopOptions{},
         [&](const robot::Observation& obs, const robot::Decision& decision) {
-          const auto& step = std::get<navigation::FollowerStep>(decision.detail);
+          const auto& step = decision.DetailAs<robot::FollowerDetail>()->step;
           const Pose2 truth = link.truth();
           const sim::World now = sim::WorldAt(added, ToSeconds(obs.t_ns));
           if (step.obstacle.blocked && !was_blocked && !now.objects.empty())

@@ -43,7 +43,8 @@ TEST(LiveRoute, TheRepeatWaitsAtTheLastKeyframeTaughtAndGoesOnWhenMoreArrive) {
         if (d.reason.rfind("waiting for the leader", 0) == 0) {
           ++waiting;
           moved_while_waiting += d.command.v_mps != 0.0 || d.command.omega_radps != 0.0;
-          destination_while_waiting = std::get<navigation::RepeatStep>(d.detail).destination;
+          if (const auto* repeat = d.DetailAs<robot::RepeatDetail>())
+            destination_while_waiting = repeat->step.destination;
           // The leader gets further after the robot has waited 3 s.
           if (waiting == 30) served = taught.route;
         }

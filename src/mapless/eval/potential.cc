@@ -131,7 +131,7 @@ PotentialRun RunPotential(const sim::Scenario& scenario,
   const robot::LoopResult result = robot::RunLoop(
       method, wrapped ? *wrapped : static_cast<robot::RobotLink&>(link), robot::LoopOptions{},
       [&](const robot::Observation& obs, const robot::Decision& decision) {
-        const auto& step = std::get<navigation::PotentialStep>(decision.detail);
+        const auto& step = decision.DetailAs<robot::PotentialDetail>()->step;
         const Pose2 pose = link.truth();
         run.path.push_back(pose);
         if (observer) observer(pose, obs.image, step);

@@ -56,7 +56,7 @@ TEST(Replay, ARecordedRepeatReplaysToTheSameDecisions) {
   const robot::LoopResult result =
       robot::RunLoop(method, link, robot::LoopOptions{},
                      [&](const robot::Observation& obs, const robot::Decision& decision) {
-                       replayed.push_back(std::get<navigation::RepeatStep>(decision.detail));
+                       replayed.push_back(decision.DetailAs<robot::RepeatDetail>()->step);
                        odometry_frames += obs.odometry.has_value() ? 1 : 0;
                        return true;
                      });

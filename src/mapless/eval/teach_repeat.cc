@@ -108,7 +108,7 @@ RepeatRun RepeatOnSimulator(const sim::Scenario& scenario, const TaughtRoute& ta
   const robot::LoopResult result = robot::RunLoop(
       method, wrapped ? *wrapped : static_cast<robot::RobotLink&>(link), robot::LoopOptions{},
       [&](const robot::Observation& obs, const robot::Decision& decision) {
-        const auto& step = std::get<navigation::RepeatStep>(decision.detail);
+        const auto& step = decision.DetailAs<robot::RepeatDetail>()->step;
         run.path.push_back(link.truth());
         if (observer) observer(link.truth(), obs.image, step);
         run.steps.push_back(step);

@@ -289,7 +289,55 @@ void RouteCopy::Apply(const std::vector<Record>& records) {
   stamp();
 }
 
-void RouteCopy::ApplyOne(const Record& record, std::optional<route::Keyframe>* decoded) {
+void RouteCopy::ApplyOwn(const Record& record, std::optional<route::Keyframe> keyframe,
+                         const cv::Mat& image_low) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const std::size_t first = log_.size();
+  try {
+    ApplyOne(record, &keyframe, image_low);
+  } catch (...) {
+    if (keyframe_writer_) keyframe_writer_->Flush();
+    if (image_writer_) image_writer_->Flush();
+    throw;
+  }
+  if (keyframe_writer_) keyframe_writer_->Flush();
+  if (image_writer_) image_writer_->Flush();
+  const std::int64_t now = WallClockNs();
+  for (std::size_t i = first; i < log_.size(); ++i)
+    if (log_[i].written_ns == 0) log_[i].written_ns = now;
+}
+
+std::shared_ptr<const std::string> RouteCopy::Encoded(std::uint64_t sequence) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (sequence >= log_.size()) return nullptr;
+  if (encoded_.size() < log_.size()) encoded_.resize(log_.size());
+  std::shared_ptr<const std::string>& e = encoded_[sequence];
+  if (!e) e = std::make_shared<const std::string>(EncodeRecord(log_[sequence]));
+  return e;
+}
+
+bool RouteCopy::UpdateFunnel(route::Route* route) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!header_ || header_->kind != RouteKind::kFunnel) return false;
+  bool changed = false;
+  if (route->keyframes.empty()) {
+    route->detector = header_->detector;
+    route->image_width = header_->image_width;
+    route->image_height = header_->image_height;
+  }
+  for (std::size_t i = route->keyframes.size(); i < keyframes_.size(); ++i) {
+    route->keyframes.push_back(keyframes_[i]);
+    changed = true;
+  }
+  if (route->complete != complete_) {
+    route->complete = complete_;
+    changed = true;
+  }
+  return changed;
+}
+
+void RouteCopy::ApplyOne(const Record& record, std::optional<route::Keyframe>* decoded,
+                         const cv::Mat& low) {
   const std::string what =
       std::string(RecordTypeName(record.type)) + " record " + std::to_string(record.sequence);
   if (record.sequence != log_.size())
@@ -334,7 +382,9 @@ void RouteCopy::ApplyOne(const Record& record, std::optional<route::Keyframe>* d
     MAPLESS_CHECK(images_ < static_cast<std::size_t>(io::kMaxKeyframes),
                   what << ": more than " << io::kMaxKeyframes << " route images");
     route::StoredAppearanceImage image = route::ParseAppearanceEntry(record.parts[0], what);
-    image.low = io::DecodeImage(record.parts[1], what + " image", cv::IMREAD_GRAYSCALE);
+    image.low = !low.empty() ? low
+                             : io::DecodeImage(record.parts[1], what + " image",
+                                               cv::IMREAD_GRAYSCALE);
     MAPLESS_CHECK(image.low.cols == header_->low_width && image.low.rows == header_->low_height,
                   what << ": image is " << image.low.cols << "x" << image.low.rows
                        << ", the route's are " << header_->low_width << "x" << header_->low_height);

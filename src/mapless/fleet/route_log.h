@@ -73,6 +73,13 @@ class RouteCopy {
   // manifest that lists them is written once at the end (flushed). A record whose sequence is not
   // the next one throws InputError before anything of it is written.
   void Apply(const std::vector<Record>& records);
+  // A leader's own record, with what it was encoded from (a keyframe record's keyframe, an image
+  // record's 8-bit route image): as Apply({record}), without decoding what was just encoded.
+  void ApplyOwn(const Record& record, std::optional<route::Keyframe> keyframe,
+                const cv::Mat& image_low = {});
+  // Record `sequence` as it goes on the wire (EncodeRecord): encoded once, when first asked, and
+  // shared by every follower it is sent to; null when there is no such record yet.
+  std::shared_ptr<const std::string> Encoded(std::uint64_t sequence) const;
 
   // The route as the methods see it (built when asked and cached until the next record): null
   // until there are at least 2 keyframes / 1 route image. The eigenspace is built here, from the
@@ -80,12 +87,19 @@ class RouteCopy {
   // and builds the model once, when its method asks).
   std::shared_ptr<const route::Route> FunnelRoute() const;
   std::shared_ptr<const route::AppearanceRoute> AppearanceRoute() const;
+  // The funnel route read in pieces (a follower's method, on its own thread): appends to `route`
+  // the keyframes it lacks, sets its header fields and completeness, and says whether anything
+  // changed. Its work is the new keyframes', whatever the route's length (FunnelRoute() copies
+  // the whole route each time it changed).
+  bool UpdateFunnel(route::Route* route) const;
 
   const std::string& dir() const { return dir_; }
 
  private:
   // `decoded`: the keyframe of a keyframe record, when it was decoded ahead (or empty).
-  void ApplyOne(const Record& record, std::optional<route::Keyframe>* decoded);
+  // `low`: the image record's image, when it is known (empty: decoded from the record).
+  void ApplyOne(const Record& record, std::optional<route::Keyframe>* decoded,
+                const cv::Mat& low = {});
   void Load();
 
   std::string dir_;
@@ -94,6 +108,7 @@ class RouteCopy {
   std::optional<RouteHeader> header_;
   bool complete_ = false;
   std::vector<Record> log_;  // every record held, in order (sequence = index)
+  mutable std::vector<std::shared_ptr<const std::string>> encoded_;  // log_'s, as first sent
   std::unique_ptr<route::RouteWriter> keyframe_writer_;
   std::unique_ptr<route::AppearanceRouteWriter> image_writer_;
   std::vector<route::Keyframe> keyframes_;

@@ -199,21 +199,20 @@ struct LeaderServer::Impl {
         it = Forget(it);
         continue;
       }
-      // Records are taken from the log one at a time while the follower's pipe takes them: a full
-      // pipe wastes one copy, not a batch (a follower catching up on large keyframes).
+      // Records are taken from the log one at a time while the follower's pipe takes them, each
+      // encoded once (RouteCopy::Encoded) and queued without a copy for every follower.
       SendResult result = SendResult::kSent;
       std::size_t sent = 0;
       while (peer.next < size && sent < options.batch) {
-        const std::vector<Record> next = log.RecordsFrom(peer.next, 1);
-        if (next.empty()) break;
-        const std::string bytes = EncodeRecord(next.front());
-        if (!Affordable(peer, bytes.size())) {
+        const std::shared_ptr<const std::string> bytes = log.Encoded(peer.next);
+        if (!bytes) break;
+        if (!Affordable(peer, bytes->size())) {
           result = SendResult::kFull;  // the queues together are full: later
           break;
         }
         result = SendTo(router, it->first, bytes);
         if (result != SendResult::kSent) break;
-        Account(peer, bytes.size());
+        Account(peer, bytes->size());
         peer.full_since = {};
         ++peer.next;
         ++sent;

@@ -1,6 +1,8 @@
 // Small ZeroMQ helpers shared by the leader's and the follower's sides (internal to fleet/).
 #pragma once
 
+#include <memory>
+
 #include <string>
 #include <string_view>
 #include <vector>
@@ -32,6 +34,26 @@ inline SendResult SendTo(zmq::socket_t& router, const std::string& id, std::stri
     if (!router.send(zmq::buffer(id), zmq::send_flags::sndmore | zmq::send_flags::dontwait))
       return SendResult::kFull;
     router.send(zmq::buffer(bytes.data(), bytes.size()), zmq::send_flags::dontwait);
+    return SendResult::kSent;
+  } catch (const zmq::error_t& e) {
+    if (e.num() == EHOSTUNREACH) return SendResult::kGone;
+    throw;
+  }
+}
+
+// The same for bytes shared with other sends (a record encoded once for every follower): ZeroMQ
+// queues them without a copy, holding `bytes` until the message is gone.
+inline SendResult SendTo(zmq::socket_t& router, const std::string& id,
+                         const std::shared_ptr<const std::string>& bytes) {
+  try {
+    if (!router.send(zmq::buffer(id), zmq::send_flags::sndmore | zmq::send_flags::dontwait))
+      return SendResult::kFull;
+    auto* hold = new std::shared_ptr<const std::string>(bytes);
+    zmq::message_t message(
+        const_cast<char*>(bytes->data()), bytes->size(),
+        [](void*, void* hint) { delete static_cast<std::shared_ptr<const std::string>*>(hint); },
+        hold);
+    router.send(message, zmq::send_flags::dontwait);
     return SendResult::kSent;
   } catch (const zmq::error_t& e) {
     if (e.num() == EHOSTUNREACH) return SendResult::kGone;

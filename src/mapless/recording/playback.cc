@@ -102,6 +102,7 @@ robot::LinkEvent PlaybackLink::Next() {
     event.reason = kEndOfRecording;
     return event;
   }
+  if (check_) check_(frame);
   now_ns_ = frame.t_ns;
   event.type = robot::LinkEventType::kFrame;
   event.observation.image = frame.image;

@@ -4,6 +4,7 @@
 // run on a recording as on a robot.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -43,6 +44,9 @@ std::unique_ptr<io::FrameSource> OpenSource(const std::string& spec,
 class PlaybackLink : public robot::RobotLink {
  public:
   explicit PlaybackLink(std::unique_ptr<io::FrameSource> source) : source_(std::move(source)) {}
+  // Called on every frame before it goes to the loop (with its name, which the observation does
+  // not keep); throws to refuse the recording (a frame of the wrong size, say).
+  void set_frame_check(std::function<void(const io::Frame&)> check) { check_ = std::move(check); }
   robot::LinkEvent Next() override;
   void Send(const Twist2&, const robot::Observation&, const robot::Decision&) override {}
   void Stop(const std::string&) override {}
@@ -50,6 +54,7 @@ class PlaybackLink : public robot::RobotLink {
 
  private:
   std::unique_ptr<io::FrameSource> source_;
+  std::function<void(const io::Frame&)> check_;
   Timestamp now_ns_ = 0;
 };
 inline constexpr const char* kEndOfRecording = "end of the recording";

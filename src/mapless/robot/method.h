@@ -6,15 +6,14 @@
 // visual-potential navigator (Ohnishi & Imiya) and the appearance route follower (Payá et al.).
 #pragma once
 
+#include <memory>
+#include <nlohmann/json_fwd.hpp>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
-#include <variant>
+#include <vector>
 
 #include "mapless/core/pose.h"
-#include "mapless/navigation/appearance.h"
-#include "mapless/navigation/potential.h"
-#include "mapless/navigation/repeat.h"
 
 namespace mapless::robot {
 
@@ -34,17 +33,33 @@ enum class MethodState {
 };
 const char* MethodStateName(MethodState state);
 
-// What the method decided on one frame. `detail` is the method's own step, for the status message
-// and the debug image.
+// What a method shows of one decision, beyond the state, reason and command every method has: its
+// own status fields and its drawing on the debug picture (status.h puts them together). Each
+// method defines its own next to its Step (methods.h), so a new method adds its fields and picture
+// without touching the status, the links or the recordings.
+class DecisionDetail {
+ public:
+  virtual ~DecisionDetail() = default;
+  // The method's fields of the status JSON ("destination", "matches", ...), added to `j`.
+  virtual void Fields(nlohmann::json* j) const = 0;
+  // Draws on `picture` (BGR: the frame, enlarged by `scale` when it was small) and adds short
+  // text lines (at most 40 characters each, so they fit a 320-pixel picture) below the state line.
+  virtual void Draw(cv::Mat* picture, double scale, std::vector<std::string>* lines) const = 0;
+};
+
+// What the method decided on one frame.
 struct Decision {
   MethodState state = MethodState::kStopped;
   Twist2 command;      // zero unless kDriving
   std::string status;  // the method's own state name ("driving", "searching", "waiting", ...)
   std::string reason;  // why it stopped, finished or failed
-  std::variant<std::monostate, navigation::RepeatStep, navigation::PotentialStep,
-               navigation::FollowerStep>
-      detail;
+  std::shared_ptr<const DecisionDetail> detail;  // null: nothing beyond the above
   bool done() const { return state == MethodState::kFinished || state == MethodState::kFailed; }
+  // The detail as the method's own type (null when it is another or none).
+  template <typename T>
+  const T* DetailAs() const {
+    return dynamic_cast<const T*>(detail.get());
+  }
 };
 
 class Method {

@@ -53,7 +53,29 @@ RepeatMethod::RepeatMethod(RouteSource route, navigation::RepeatOptions options,
   options_.wait_for_leader = true;
 }
 
+RepeatMethod::RepeatMethod(RouteUpdates updates, navigation::RepeatOptions options,
+                           cv::Size image_size)
+    : updates_(std::move(updates)),
+      live_(std::make_shared<route::Route>()),
+      options_(options),
+      size_(image_size) {
+  options_.wait_for_leader = true;
+}
+
 Decision RepeatMethod::Step(const Observation& observation) {
+  if (updates_) {
+    if (updates_(live_.get())) {
+      if (session_) {
+        session_->Extend(live_);  // the same route, longer or complete now
+      } else if (live_->keyframes.size() >= 2) {
+        session_.emplace(live_, options_);
+        route_ = live_;
+      }
+    }
+    if (!session_)
+      return Make(MethodState::kStopped, Twist2{}, "waiting",
+                  "waiting for the leader: the route has fewer than 2 keyframes yet");
+  }
   if (source_) {
     std::shared_ptr<const route::Route> latest = source_();
     if (latest && latest != route_) {
@@ -87,7 +109,7 @@ Decision RepeatMethod::Step(const Observation& observation) {
       break;
   }
   Decision d = Make(state, step.command, navigation::RepeatStatusName(step.status), step.reason);
-  d.detail = std::move(step);
+  d.detail = std::make_shared<RepeatDetail>(std::move(step));
   return d;
 }
 
@@ -123,7 +145,7 @@ Decision PotentialMethod::Step(const Observation& observation) {
       break;
   }
   Decision d = Make(state, step.command, navigation::PotentialStatusName(step.status), step.reason);
-  d.detail = std::move(step);
+  d.detail = std::make_shared<PotentialDetail>(std::move(step));
   return d;
 }
 
@@ -158,7 +180,7 @@ Decision FollowMethod::Step(const Observation& observation) {
       break;
   }
   Decision d = Make(state, step.command, navigation::FollowerStateName(step.state), step.reason);
-  d.detail = std::move(step);
+  d.detail = std::make_shared<FollowerDetail>(std::move(step));
   return d;
 }
 

@@ -6,11 +6,35 @@
 #include <memory>
 #include <optional>
 
+#include "mapless/navigation/appearance.h"
+#include "mapless/navigation/potential.h"
+#include "mapless/navigation/repeat.h"
 #include "mapless/robot/method.h"
 #include "mapless/route/appearance_route.h"
 #include "mapless/route/route.h"
 
 namespace mapless::robot {
+
+// Each method's detail of a decision (method.h): its navigation step, its status fields and its
+// debug picture. `Decision::DetailAs<RepeatDetail>()->step` gives the step back.
+struct RepeatDetail : DecisionDetail {
+  explicit RepeatDetail(navigation::RepeatStep s) : step(std::move(s)) {}
+  void Fields(nlohmann::json* j) const override;
+  void Draw(cv::Mat* picture, double scale, std::vector<std::string>* lines) const override;
+  navigation::RepeatStep step;
+};
+struct PotentialDetail : DecisionDetail {
+  explicit PotentialDetail(navigation::PotentialStep s) : step(std::move(s)) {}
+  void Fields(nlohmann::json* j) const override;
+  void Draw(cv::Mat* picture, double scale, std::vector<std::string>* lines) const override;
+  navigation::PotentialStep step;
+};
+struct FollowerDetail : DecisionDetail {
+  explicit FollowerDetail(navigation::FollowerStep s) : step(std::move(s)) {}
+  void Fields(nlohmann::json* j) const override;
+  void Draw(cv::Mat* picture, double scale, std::vector<std::string>* lines) const override;
+  navigation::FollowerStep step;
+};
 
 // Visual teach & repeat with funnel lanes (Algorithm 1 of Kassir et al.).
 class RepeatMethod : public Method {
@@ -21,6 +45,11 @@ class RepeatMethod : public Method {
   // taught so far (RepeatOptions::wait_for_leader is set).
   using RouteSource = std::function<std::shared_ptr<const route::Route>()>;
   RepeatMethod(RouteSource route, navigation::RepeatOptions options, cv::Size image_size);
+  // The same, with the route read in pieces: `updates` appends to the route what is new since the
+  // last call and says whether anything changed (fleet::RouteCopy::UpdateFunnel), so the work per
+  // frame is the new keyframes', whatever the route's length.
+  using RouteUpdates = std::function<bool(route::Route* route)>;
+  RepeatMethod(RouteUpdates updates, navigation::RepeatOptions options, cv::Size image_size);
   const char* name() const override { return "repeat"; }
   bool needs_odometry() const override { return false; }
   cv::Size image_size() const override { return size_; }
@@ -28,6 +57,8 @@ class RepeatMethod : public Method {
 
  private:
   RouteSource source_;
+  RouteUpdates updates_;
+  std::shared_ptr<route::Route> live_;  // the route read in pieces (updates_), this thread's own
   navigation::RepeatOptions options_;
   std::shared_ptr<const route::Route> route_;  // the snapshot the session has
   std::optional<navigation::RepeatSession> session_;

@@ -17,9 +17,8 @@ namespace mapless::robot {
 nlohmann::json StatusJson(const char* method, int frame, const Observation& observation,
                           const Decision& decision);
 
-// The repeat's per-frame fields (destination, matches, switching, slopes, obstacle watch), added
-// to `j`: one definition for the live status and the `repeat` log.
-void RepeatFields(const navigation::RepeatStep& s, nlohmann::json* j);
+// `v` with `digits` decimals, for the debug picture's text.
+std::string FixedText(double v, int digits);
 
 // A status for a stop that no frame decided (no camera, e-stop, interrupted).
 nlohmann::json StopJson(const char* method, Timestamp t_ns, const std::string& reason);

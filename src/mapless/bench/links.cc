@@ -5,10 +5,10 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "builtin_middlewares.h"
 #include "mapless/robot/link_bench.h"
+#include "mapless/robot/middleware.h"
 
-namespace mapless::app {
+namespace mapless::bench {
 
 namespace {
 
@@ -33,8 +33,9 @@ void BenchCameras(const std::string& prefix, Bench bench, nlohmann::json* j) {
 
 }  // namespace
 
-void BenchMiddleware(const std::string& middleware, nlohmann::json* j) {
-  const robot::MiddlewareKind* kind = BuiltinMiddlewares().Find(middleware);
+void BenchMiddleware(const robot::MiddlewareRegistry& middlewares, const std::string& middleware,
+                     nlohmann::json* j) {
+  const robot::MiddlewareKind* kind = middlewares.Find(middleware);
   const std::string key = middleware + "_link";
   if (kind == nullptr) {
     (*j)[key] = "not built (scripts/setup.sh --ros, then build again)";
@@ -47,4 +48,4 @@ void BenchMiddleware(const std::string& middleware, nlohmann::json* j) {
   }
 }
 
-}  // namespace mapless::app
+}  // namespace mapless::bench

@@ -1,4 +1,4 @@
-// Timing helpers of `mapless bench` (cmd_bench.cc, bench_repeat.cc).
+// Timing helpers of `mapless bench` (stages.cc, teach_repeat.cc, fleet.cc).
 #pragma once
 
 #include <algorithm>
@@ -11,7 +11,7 @@
 
 #include "mapless/sim/scenario.h"
 
-namespace mapless::app {
+namespace mapless::bench {
 
 // `mapless bench --size WxH`: the frame size every stage runs at (default 320x240), each
 // scenario's camera keeping its horizontal field of view. The JSON keys keep their "320x240".
@@ -64,4 +64,4 @@ inline double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-}  // namespace mapless::app
+}  // namespace mapless::bench

@@ -17,9 +17,11 @@
 #include "mapless/fleet/client.h"
 #include "mapless/fleet/route_log.h"
 #include "mapless/fleet/server.h"
+#include "mapless/bench/bench.h"
+#include "mapless/bench/timing.h"
 #include "mapless/robot/link_bench.h"
 
-namespace mapless::app {
+namespace mapless::bench {
 
 namespace {
 
@@ -83,6 +85,46 @@ double Percentile(const std::vector<double>& v, double p) {  // -1: nothing meas
   return v.empty() ? -1.0 : robot::Percentile(v, p);
 }
 
+// A follower's work per live record on a 1000-keyframe route: the record applied to its copy, then
+// the route read by its method, one record at a time, as while the leader teaches. The method's
+// read in pieces (RouteCopy::UpdateFunnel) against the whole-route snapshot it used to take
+// (RouteCopy::FunnelRoute); medians over the first and the last 100 records.
+void BenchFollowerPerRecord(const std::string& root, nlohmann::json* j) {
+  constexpr int kRecords = 1000;
+  std::vector<fleet::Record> records = {fleet::HeaderRecord(BenchHeader(fleet::RouteKind::kFunnel))};
+  for (int i = 0; i < kRecords; ++i) records.push_back(BenchRecord(fleet::RouteKind::kFunnel, i));
+  for (std::size_t i = 0; i < records.size(); ++i) records[i].sequence = i;
+  for (const bool pieces : {true, false}) {
+    fleet::RouteCopy copy(root + (pieces ? "/per_record_pieces" : "/per_record_snapshot"));
+    route::Route route;
+    std::vector<double> apply_ms, read_ms;
+    for (const fleet::Record& r : records) {
+      const auto t0 = Clock::now();
+      copy.Apply({r});
+      const auto t1 = Clock::now();
+      const std::size_t n = pieces ? (copy.UpdateFunnel(&route), route.keyframes.size())
+                                   : (copy.FunnelRoute() ? copy.FunnelRoute()->keyframes.size() : 0);
+      const auto t2 = Clock::now();
+      if (n == 0 && r.sequence > 2) throw std::runtime_error("bench: the follower read no route");
+      apply_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+      read_ms.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
+    }
+    const auto first = [](const std::vector<double>& v) {
+      return Median(std::vector<double>(v.begin() + 1, v.begin() + 101));
+    };
+    const auto last = [](const std::vector<double>& v) {
+      return Median(std::vector<double>(v.end() - 100, v.end()));
+    };
+    const std::string name = pieces ? "pieces" : "snapshot";
+    (*j)["fleet_follower_read_" + name + "_first100_ms"] = first(read_ms);
+    (*j)["fleet_follower_read_" + name + "_last100_ms"] = last(read_ms);
+    if (pieces) {
+      (*j)["fleet_follower_apply_first100_ms"] = first(apply_ms);
+      (*j)["fleet_follower_apply_last100_ms"] = last(apply_ms);
+    }
+  }
+}
+
 }  // namespace
 
 void BenchFleet(nlohmann::json* j) {
@@ -139,7 +181,8 @@ void BenchFleet(nlohmann::json* j) {
     (*j)["fleet_latency_" + name + "_median_ms"] = Percentile(latency, 0.5);
     (*j)["fleet_latency_" + name + "_p99_ms"] = Percentile(latency, 0.99);
   }
+  BenchFollowerPerRecord(root, j);
   fs::remove_all(root);
 }
 
-}  // namespace mapless::app
+}  // namespace mapless::bench

@@ -5,7 +5,8 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
-#include "bench_util.h"
+#include "mapless/bench/bench.h"
+#include "mapless/bench/timing.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/features/features.h"
 #include "mapless/navigation/obstacle_watch.h"
@@ -13,7 +14,7 @@
 #include "mapless/navigation/teach.h"
 #include "mapless/sim/driver.h"
 
-namespace mapless::app {
+namespace mapless::bench {
 
 namespace {
 
@@ -210,4 +211,4 @@ void BenchTeachRepeat(nlohmann::json* j) {
   (*j)["segment_start_over_orb"] = (*j)["segment_start_ms"].get<double>() / orb_ms;
 }
 
-}  // namespace mapless::app
+}  // namespace mapless::bench

@@ -1,0 +1,42 @@
+// `mapless bench`: per-stage medians in milliseconds on one thread, next to a stock OpenCV
+// primitive measured in the same run, so that the ratio means the same on any machine; and the
+// links' latencies (the robot middlewares, the fleet). The command (apps/cmd_bench.cc) parses its
+// options, calls these and prints the table.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core/types.hpp>
+#include <string>
+#include <vector>
+
+#include "mapless/robot/middleware.h"
+
+namespace mapless::bench {
+
+struct StageOptions {
+  int repeats = 100;  // timed calls per stage
+  // Views rendered along these scenarios' taught paths; empty: narrow_room_sharp_turn,
+  // outdoor_70m and office_aliasing.
+  std::vector<std::string> scenarios;
+  cv::Size frame;  // every stage's frame size; 0x0: 320x240 (the JSON keys keep "320x240")
+};
+
+// Every method stage; sets OpenCV to one thread.
+nlohmann::json BenchStages(const StageOptions& options);
+// The stages of each method (added to `j`; BenchStages calls them).
+void BenchTeachRepeat(nlohmann::json* j);
+void BenchPotential(int repeats, nlohmann::json* j);
+void BenchEigenspace(int repeats, nlohmann::json* j);
+// A middleware's adapter latency, frame received to command published ("ros1", "ros2"); a row
+// saying why when it is not built or could not be measured.
+void BenchMiddleware(const robot::MiddlewareRegistry& middlewares, const std::string& middleware,
+                     nlohmann::json* j);
+// The fleet link on loopback: record latency, a late follower's catch-up, a follower's work per
+// live record.
+void BenchFleet(nlohmann::json* j);
+
+// The tables, to stdout.
+void PrintStageTable(const nlohmann::json& j);  // the stages and then the links
+void PrintLinkTable(const nlohmann::json& j);
+
+}  // namespace mapless::bench

@@ -1,0 +1,130 @@
+// The table `mapless bench` prints (bench.h): each stage's median and the ratios with the targets
+// of the issues that set them.
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "mapless/bench/bench.h"
+
+namespace mapless::bench {
+
+namespace {
+
+// The robot-link rows of the table (issues 17, 18), for the middlewares that were measured.
+void PrintLinkRows(const nlohmann::json& j) {
+  for (const char* kind : {"eigenspace", "funnel"}) {
+    const std::string k = std::string("fleet_latency_") + kind;
+    if (!j.contains(k + "_median_ms")) continue;
+    std::printf("%-34s %10.3f  p99 %.3f  (issue 19: p99 <= 5)\n",
+                ("fleet record latency " + std::string(kind)).c_str(),
+                j[k + "_median_ms"].get<double>(), j[k + "_p99_ms"].get<double>());
+    std::printf("%-34s %10.3f  s (issue 19: <= 1 s; %d-byte records)\n",
+                ("fleet catch-up 1000 " + std::string(kind)).c_str(),
+                j[std::string("fleet_catch_up_1000_") + kind + "_s"].get<double>(),
+                j[std::string("fleet_record_bytes_") + kind].get<int>());
+    if (j.contains("fleet_model_rebuild_1000_s") && std::string(kind) == "eigenspace")
+      std::printf("%-34s %10.3f  s (the eigenspace of 1000 images, once caught up)\n",
+                  "fleet model rebuild 1000", j["fleet_model_rebuild_1000_s"].get<double>());
+  }
+  if (j.contains("fleet_follower_read_pieces_first100_ms")) {
+    std::printf("%-34s %10.3f  last 100: %.3f ms (issue 41: flat; whole snapshot %.3f -> %.3f)\n",
+                "fleet follower read/record, first 100",
+                j["fleet_follower_read_pieces_first100_ms"].get<double>(),
+                j["fleet_follower_read_pieces_last100_ms"].get<double>(),
+                j["fleet_follower_read_snapshot_first100_ms"].get<double>(),
+                j["fleet_follower_read_snapshot_last100_ms"].get<double>());
+    std::printf("%-34s %10.3f  last 100: %.3f ms (files flushed, manifest rewritten)\n",
+                "fleet follower apply/record, first 100",
+                j["fleet_follower_apply_first100_ms"].get<double>(),
+                j["fleet_follower_apply_last100_ms"].get<double>());
+  }
+  for (const char* mw : {"ros1", "ros2"}) {
+    const std::string prefix = std::string(mw) + "_link";
+    if (j.contains(prefix)) {
+      std::printf("%-34s %s\n", prefix.c_str(), j[prefix].get<std::string>().c_str());
+      continue;
+    }
+    for (const char* cam : {"320x240_mono8", "640x480_rgb8"}) {
+      const std::string k = prefix + "_" + cam;
+      if (!j.contains(k + "_adapter_median_ms")) continue;
+      std::printf("%-34s %10.3f  p99 %.3f  (issues 17, 18: p99 <= 5)\n",
+                  (std::string(mw) + " adapter " + cam).c_str(),
+                  j[k + "_adapter_median_ms"].get<double>(),
+                  j[k + "_adapter_p99_ms"].get<double>());
+      std::printf("%-34s %10.3f  p99 %.3f\n", (std::string(mw) + " end to end " + cam).c_str(),
+                  j[k + "_end_to_end_median_ms"].get<double>(),
+                  j[k + "_end_to_end_p99_ms"].get<double>());
+    }
+  }
+}
+
+}  // namespace
+
+void PrintStageTable(const nlohmann::json& j) {
+  std::printf("%-34s %10s\n", "stage", "median ms");
+  for (const char* key : {"sim_render_320x240_ms",
+                          "opencv_dis_fast_320x240_ms",
+                          "teach_step_ms",
+                          "repeat_step_default_ms",
+                          "repeat_step_default_mean_ms",
+                          "repeat_step_default_p90_ms",
+                          "repeat_step_default_with_watch_ms",
+                          "obstacle_watch_ms",
+                          "opencv_dis_fast_table1_320x240_ms",
+                          "repeat_step_ms",
+                          "repeat_step_1km_ms",
+                          "repeat_step_fresh_ms",
+                          "repeat_step_fresh_end_ms",
+                          "repeat_step_fresh_1km_ms",
+                          "segment_start_ms",
+                          "opencv_orb500_320x240_ms",
+                          "opencv_orb500_interleaved_ms",
+                          "opencv_orb_mapless_settings_320x240_ms",
+                          "orb_detector_320x240_ms",
+                          "dense_lk_320x240_ms",
+                          "opencv_pyrlk_every_pixel_320x240_ms",
+                          "opencv_dis_fast_ground_320x240_ms",
+                          "dominant_plane_step_ms",
+                          "dominant_plane_step_dis_medium_ms",
+                          "ipca_add_1000_ms",
+                          "markov_update_10000_ms",
+                          "subwindow_control_ms"}) {
+    std::printf("%-34s %10.3f\n", key, j[key].get<double>());
+  }
+  std::printf("%-34s %10.2f  (issue 2: <= 2.0)\n", "sim_render / dis_fast",
+              j["sim_render_over_dis_fast"].get<double>());
+  std::printf("%-34s %10.2f  (issue 3: <= 1.5)\n", "repeat_step / orb500",
+              j["repeat_step_over_orb"].get<double>());
+  std::printf("%-34s %10.2f  (issue 3: <= 1.5; ORB-500 timed after each step)\n",
+              "repeat_step / orb500 interl.",
+              j["repeat_step_over_orb_interleaved"].get<double>());
+  std::printf("%-34s %10.2f  (issue 21: <= 1.5)\n", "repeat_step_default / orb500",
+              j["repeat_step_default_over_orb"].get<double>());
+  std::printf("%-34s %10.2f  (issue 21: <= 1.5; ORB-500 timed after each step)\n",
+              "repeat_step_default / orb500 interl.",
+              j["repeat_step_default_over_orb_interleaved"].get<double>());
+  std::printf("%-34s %10.2f  (same keypoints and descriptors)\n",
+              "orb_detector / opencv same settings",
+              j["orb_detector_over_opencv_same_settings"].get<double>());
+  std::printf("%-34s %10.2f\n", "repeat_step_default_mean / orb500",
+              j["repeat_step_default_mean_over_orb"].get<double>());
+  std::printf("%-34s %10.2f  (issue 21: <= 1.0)\n", "obstacle_watch / dis_fast",
+              j["obstacle_watch_over_dis_fast"].get<double>());
+  std::printf("%-34s %10.2f\n", "repeat_step_fresh / orb500",
+              j["repeat_step_fresh_over_orb"].get<double>());
+  std::printf("%-34s %10.2f  (issue 3: <= 6.0)\n", "segment_start / orb500",
+              j["segment_start_over_orb"].get<double>());
+  std::printf("%-34s %10.2f  (issue 4: >= 10)\n", "pyrlk_every_pixel / dense_lk",
+              j["pyrlk_every_pixel_over_dense_lk"].get<double>());
+  std::printf("%-34s %10.2f  (issue 4: <= 2.0)\n", "dominant_plane_step / dis_fast",
+              j["dominant_plane_step_over_dis_fast"].get<double>());
+  for (const char* key : {"ipca_add_1000", "markov_update_10000", "subwindow_control"}) {
+    std::printf("%-34s %10.2f  (issue 5: <= 1.5)\n", (std::string(key) + " / dis_fast").c_str(),
+                j[std::string(key) + "_over_dis_fast"].get<double>());
+  }
+  PrintLinkRows(j);
+}
+
+void PrintLinkTable(const nlohmann::json& j) { PrintLinkRows(j); }
+
+}  // namespace mapless::bench

@@ -1,0 +1,195 @@
+// The run layer is open to new methods and new links: a method and a link written here, each
+// registered in one line, run through the same code as the commands (run::LinkKinds,
+// run::RunMethod), with the loop's safety rules, the decision log and the method's own status
+// fields.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "mapless/core/check.h"
+#include "mapless/robot/status.h"
+#include "mapless/run/link_kinds.h"
+#include "mapless/run/run_method.h"
+
+namespace mapless::run {
+namespace {
+
+// A method that drives straight on until it has seen `frames` frames, then finishes.
+struct StraightDetail : robot::DecisionDetail {
+  int left = 0;
+  void Fields(nlohmann::json* j) const override { (*j)["frames_left"] = left; }
+  void Draw(cv::Mat* picture, double, std::vector<std::string>* lines) const override {
+    cv::line(*picture, {0, 0}, {10, 10}, cv::Scalar(0, 0, 255));
+    lines->push_back("left " + std::to_string(left));
+  }
+};
+
+class StraightMethod : public robot::Method {
+ public:
+  explicit StraightMethod(int frames) : left_(frames) {}
+  const char* name() const override { return "straight"; }
+  bool needs_odometry() const override { return false; }
+  cv::Size image_size() const override { return {32, 24}; }
+  robot::Decision Step(const robot::Observation&) override {
+    robot::Decision d;
+    auto detail = std::make_shared<StraightDetail>();
+    detail->left = --left_;
+    d.detail = detail;
+    if (left_ <= 0) {
+      d.state = robot::MethodState::kFinished;
+      d.status = "done";
+      d.reason = "told to stop";
+      return d;
+    }
+    d.state = robot::MethodState::kDriving;
+    d.status = "driving";
+    d.command = Twist2{0.5, 0.0};
+    return d;
+  }
+
+ private:
+  int left_;
+};
+
+// A link that replays a list of frames and keeps what it was told.
+class ListLink : public robot::RobotLink {
+ public:
+  explicit ListLink(int frames, cv::Size size = {32, 24}) : frames_(frames), size_(size) {}
+  robot::LinkEvent Next() override {
+    robot::LinkEvent e;
+    if (next_ >= frames_) {
+      e.type = robot::LinkEventType::kClosed;
+      e.reason = "end of the list";
+      return e;
+    }
+    e.type = robot::LinkEventType::kFrame;
+    e.observation.image = cv::Mat(size_, CV_8UC1, cv::Scalar(next_));
+    e.observation.t_ns = FromSeconds(0.1 * next_);
+    now_ = e.observation.t_ns;
+    ++next_;
+    return e;
+  }
+  void Send(const Twist2& c, const robot::Observation&, const robot::Decision&) override {
+    sent.push_back(c);
+  }
+  void Stop(const std::string& reason) override { stops.push_back(reason); }
+  Timestamp now_ns() const override { return now_; }
+  std::vector<Twist2> sent;
+  std::vector<std::string> stops;
+
+ private:
+  int frames_;
+  cv::Size size_;
+  int next_ = 0;
+  Timestamp now_ = 0;
+};
+
+LinkKinds KindsWithList(ListLink** opened) {
+  LinkKinds kinds;
+  // The one registration line of the new link.
+  kinds.Add({"list", "list:N", [](const std::string& t) { return t.rfind("list:", 0) == 0; },
+             [opened](const std::string& t, const LinkRequest&) {
+               auto link = std::make_unique<ListLink>(std::stoi(t.substr(5)));
+               *opened = link.get();
+               return std::unique_ptr<robot::RobotLink>(std::move(link));
+             }});
+  return kinds;
+}
+
+TEST(RunLayer, ANewMethodOnANewLinkRunsThroughTheLoopWithItsOwnFields) {
+  ListLink* list = nullptr;
+  const LinkKinds kinds = KindsWithList(&list);
+  std::unique_ptr<robot::RobotLink> link = kinds.Open("list:10", LinkRequest{});
+  ASSERT_NE(list, nullptr);
+  StraightMethod method(5);
+  std::vector<nlohmann::json> log;
+  std::vector<std::string> said;
+  RunOptions options;
+  options.loop.max_speed_mps = 0.2;  // the loop's limits apply to any method
+  options.log = [&](const nlohmann::json& j) { log.push_back(j); };
+  options.say = [&](const std::string& s) { said.push_back(s); };
+  options.interrupted = [] { return false; };
+  const RunOutcome outcome = RunMethod(method, *link, options);
+  EXPECT_TRUE(outcome.loop.finished);
+  EXPECT_EQ(outcome.loop.reason, "told to stop");
+  EXPECT_EQ(outcome.loop.frames, 5);
+  EXPECT_EQ(outcome.driving_frames, 4);
+  ASSERT_EQ(log.size(), 5U);
+  EXPECT_EQ(log[0]["method"], "straight");
+  EXPECT_EQ(log[0]["frames_left"], 4);  // the method's own field, from its detail
+  EXPECT_EQ(log[4]["state"], "finished");
+  ASSERT_EQ(list->sent.size(), 5U);  // 4 commands and the final zero
+  EXPECT_DOUBLE_EQ(list->sent[0].v_mps, 0.2);
+  EXPECT_DOUBLE_EQ(list->sent[4].v_mps, 0.0);
+  ASSERT_FALSE(list->stops.empty());  // stopped at the end, with the reason
+  EXPECT_EQ(list->stops.back(), "told to stop");
+  ASSERT_EQ(said.size(), 1U);
+  EXPECT_EQ(said[0], "straight: done: told to stop");
+}
+
+TEST(RunLayer, TheLinkClosingStopsTheRobotAndTheRunSaysWhy) {
+  ListLink link(3);
+  StraightMethod method(100);
+  RunOptions options;
+  options.interrupted = [] { return false; };
+  const RunOutcome outcome = RunMethod(method, link, options);
+  EXPECT_FALSE(outcome.loop.finished);
+  EXPECT_EQ(outcome.loop.reason, "end of the list");
+  EXPECT_EQ(link.stops.back(), "end of the list");
+}
+
+TEST(RunLayer, FramesOfTheWrongSizeEndTheRunWithoutDriving) {
+  ListLink link(3, {64, 48});
+  StraightMethod method(100);
+  RunOptions options;
+  options.interrupted = [] { return false; };
+  const RunOutcome outcome = RunMethod(method, link, options);
+  EXPECT_FALSE(outcome.loop.finished);
+  EXPECT_NE(outcome.loop.reason.find("needs 8-bit grey 32x24"), std::string::npos);
+  EXPECT_TRUE(link.sent.empty());
+}
+
+TEST(RunLayer, AnInterruptStopsTheRun) {
+  ListLink link(100);
+  StraightMethod method(100);
+  RunOptions options;
+  int frames = 0;
+  options.observer = [&](const robot::Observation&, const robot::Decision&) {
+    ++frames;
+    return true;
+  };
+  options.interrupted = [&] { return frames >= 3; };
+  const RunOutcome outcome = RunMethod(method, link, options);
+  EXPECT_TRUE(outcome.interrupted);
+  EXPECT_EQ(outcome.loop.reason, "interrupted");
+  EXPECT_EQ(link.stops.back(), "interrupted");
+}
+
+TEST(RunLayer, TheMethodDrawsItsOwnDebugPicture) {
+  robot::Observation obs;
+  obs.image = cv::Mat(24, 32, CV_8UC1, cv::Scalar(0));
+  StraightMethod method(3);
+  const robot::Decision d = method.Step(obs);
+  const cv::Mat picture = robot::DebugImage(obs, d);
+  EXPECT_EQ(picture.cols, 320);  // small frames are enlarged
+  EXPECT_GT(cv::countNonZero(picture.reshape(1)), 0);
+}
+
+TEST(LinkKinds, StandardKindsTellSourcesApartAndRefuseWhatTheyCannotOpen) {
+  const robot::MiddlewareRegistry none;
+  LinkKinds kinds = StandardLinkKinds(none);
+  EXPECT_EQ(kinds.For("robot.yaml").name, "robot");
+  EXPECT_EQ(kinds.For("camera:0").name, "camera");
+  EXPECT_EQ(kinds.For("run.mcap").name, "recording");
+  EXPECT_EQ(kinds.Find("sim:office"), nullptr);  // the simulator is its own source
+  EXPECT_THROW(kinds.For("sim:office"), InputError);
+  EXPECT_THROW(kinds.Add({"robot", "again", [](const std::string&) { return true; },
+                          [](const std::string&, const LinkRequest&) {
+                            return std::unique_ptr<robot::RobotLink>();
+                          }}),
+               std::logic_error);
+}
+
+}  // namespace
+}  // namespace mapless::run
