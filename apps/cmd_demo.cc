@@ -10,12 +10,12 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
-#include "demo_runs.h"
 #include "interrupt.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/io/atomic_file.h"
 #include "mapless/io/output_dir.h"
 #include "mapless/route/route_store.h"
+#include "mapless/run/demo.h"
 #include "progress.h"
 
 namespace mapless::app {
@@ -82,16 +82,20 @@ void AddDemoCommand(CLI::App* app) {
 
     // 1. Repeat with the sloped funnel lane, decisions logged as JSON lines.
     progress.Stage(2, "repeating with the sloped funnel lane");
-    std::vector<DemoResult> results;
-    results.push_back(DemoRepeat(scenario, taught, args->seed, (out / "repeat.jsonl").string()));
+    std::vector<run::DemoResult> results;
+    JsonLines log((out / "repeat.jsonl").string(), /*in_place=*/true);
+    results.push_back(run::DemoRepeat(
+        scenario, taught, args->seed, [&log](const nlohmann::json& j) { log.Write(j); },
+        ThrowIfInterrupted));
     spdlog::info("demo: repeat: {}", results.back().status);
     // 2. The eigenspace follower while its leader is still teaching.
     progress.Stage(3, "eigenspace follower while the leader teaches");
-    results.push_back(DemoEigenspace(args->eigenspace_scenario, args->seed));
+    results.push_back(
+        run::DemoEigenspace(args->eigenspace_scenario, args->seed, ThrowIfInterrupted));
     spdlog::info("demo: eigenspace follower: {}", results.back().status);
     // 3. The visual potential to a destination and home.
     progress.Stage(4, "visual potential to a destination and home");
-    results.push_back(DemoPotential(args->potential_scenario, args->seed));
+    results.push_back(run::DemoPotential(args->potential_scenario, args->seed, ThrowIfInterrupted));
     spdlog::info("demo: visual potential: {}", results.back().status);
 
     report::HtmlReport html("mapless demo");
@@ -100,17 +104,17 @@ void AddDemoCommand(CLI::App* app) {
                    ". Every picture and plot is in this file; nothing is loaded from elsewhere.");
     html.Heading("Results");
     std::vector<std::vector<std::string>> rows;
-    for (const DemoResult& r : results) rows.push_back(r.row);
+    for (const run::DemoResult& r : results) rows.push_back(r.row);
     html.Table({"method", "scenario", "success", "final error (m)", "detail"}, rows);
-    std::vector<RunSection> sections;
-    for (const DemoResult& r : results) {
-      AddRunSection(&html, r.section);
+    std::vector<run::RunSection> sections;
+    for (const run::DemoResult& r : results) {
+      run::AddRunSection(&html, r.section);
       sections.push_back(r.section);
     }
-    const std::string index = WriteReport((out / "report").string(), html, sections);
+    const std::string index = run::WriteReport((out / "report").string(), html, sections);
     nlohmann::json j{{"scenario", scenario.name}, {"keyframes", taught.route->keyframes.size()}};
     j["runs"] = nlohmann::json::array();
-    for (const DemoResult& r : results)
+    for (const run::DemoResult& r : results)
       j["runs"].push_back({{"method", r.row[0]},
                            {"scenario", r.row[1]},
                            {"success", r.success},
@@ -123,7 +127,7 @@ void AddDemoCommand(CLI::App* app) {
         "{0}/summary.json and the report: {0}/report/index.html (PNG plots beside it)",
         args->out);
     int failed = 0;
-    for (const DemoResult& r : results) failed += !r.success;
+    for (const run::DemoResult& r : results) failed += !r.success;
     if (failed > 0)
       throw RunFailed("demo: " + std::to_string(failed) + " of the three runs did not succeed");
   });

@@ -12,6 +12,7 @@
 #include "mapless/io/limits.h"
 #include "mapless/recording/recording_link.h"
 #include "mapless/robot/methods.h"
+#include "mapless/run/decision_log.h"
 #include "recording_args.h"
 #include "robot_run.h"
 
@@ -79,6 +80,87 @@ void NavigateOnRobot(const NavigateArgs& a, bool by_index) {
   RunOnSource(method, a.robot, args);
 }
 
+// `navigate --scenario`: the suite's run of the visual potential on the simulator (calibrated by
+// driving first, or from --calibration), its decisions logged in the run layer's one format.
+void NavigateOnSim(const NavigateArgs& a, bool by_index) {
+  if (a.scenario.empty()) throw InputError("navigate: give --scenario (simulator) or --robot");
+  RefuseOutputOverInputs(a.log, "--log", {a.scenario, a.calibration});
+  RefuseOutputOverInputs(a.save_calibration, "--save-calibration",
+                         {a.scenario, a.calibration, a.log});
+  if (by_index && a.destination_index < 0) {
+    throw InputError("--destination-index " + std::to_string(a.destination_index) +
+                     ": must be 0 or more");
+  }
+  sim::Scenario scenario = sim::LoadScenario(a.scenario);
+  // The robot must start, and its goal lie, where the world is: the scenario's area (objects,
+  // taught path, starts and destinations) with a margin. Outside it there is nothing to see.
+  const Eigen::Vector4d area = sim::ScenarioBounds(scenario, kNavigationMarginM);
+  const auto in_area = [&](double x, double y) {
+    return x >= area[0] && y >= area[1] && x <= area[2] && y <= area[3];
+  };
+  const std::string area_text =
+      fmt::format("[{:.1f}, {:.1f}] x [{:.1f}, {:.1f}] m", area[0], area[2], area[1], area[3]);
+  if (!a.start.empty()) {
+    scenario.teach_start = ParsePoseDeg(a.start, "--start");
+    if (!in_area(scenario.teach_start.x_m, scenario.teach_start.y_m))
+      throw InputError("--start " + a.start + ": outside the scenario's area " + area_text);
+  }
+  eval::PotentialRunOptions o;
+  o.seed = a.seed;
+  o.motion_noise_frac = a.motion_noise;
+  o.image_noise_sigma = a.image_noise;
+  o.homing = a.homing;
+  if (!a.destination.empty() && a.destination_index >= 0)
+    throw InputError("--destination and --destination-index: give one of them");
+  if (!a.destination.empty()) {
+    const std::vector<double> d = ParseNumbers(a.destination, "--destination", 2, "X,Y");
+    if (!in_area(d[0], d[1]))
+      throw InputError("--destination " + a.destination + ": outside the scenario's area " +
+                       area_text);
+    o.destination = Eigen::Vector2d(d[0], d[1]);
+  } else if (a.destination_index >= 0) {
+    if (a.destination_index >= static_cast<int>(scenario.destinations.size()))
+      throw InputError("--destination-index " + std::to_string(a.destination_index) +
+                       ": scenario " + scenario.name + " has " +
+                       std::to_string(scenario.destinations.size()) + " destinations");
+    o.destination = scenario.destinations[static_cast<std::size_t>(a.destination_index)];
+  }
+  if (o.homing && !o.destination) throw InputError("--homing needs a destination");
+
+  navigation::PlanarFlowCalibration calibration;
+  if (!a.calibration.empty()) {
+    calibration = navigation::CalibrationFromYaml(
+        io::ReadFile(a.calibration, io::kMaxYamlFileBytes), a.calibration);
+    if (calibration.width != scenario.camera.model.width ||
+        calibration.height != scenario.camera.model.height)
+      throw InputError(a.calibration + ": calibrated for " + std::to_string(calibration.width) +
+                       "x" + std::to_string(calibration.height) + ", the camera is " +
+                       std::to_string(scenario.camera.model.width) + "x" +
+                       std::to_string(scenario.camera.model.height));
+  } else {
+    spdlog::info("navigate: calibrating the planar flows (straight at T_m, then turning)");
+    calibration = eval::CalibrateOnSimulator(scenario, o.nav);
+  }
+  if (!a.save_calibration.empty())
+    io::WriteFileAtomic(a.save_calibration, navigation::CalibrationToYaml(calibration));
+
+  RefuseOutputOverInputs(a.record.path, "--record", {a.calibration, a.scenario});
+  const auto recorder = OpenRecorder(a.record, recording::CameraInfoOf(scenario.camera.model));
+  std::unique_ptr<JsonLines> log;
+  if (!a.log.empty()) log = std::make_unique<JsonLines>(a.log);
+  o.wrap_link = run::LogDecisions(
+      "navigate", log ? run::JsonSink([&log](const nlohmann::json& j) { log->Write(j); }) : nullptr,
+      RecordingWrapper(recorder.get(), "navigate"));
+  StopCleanlyOnInterrupt();
+  const eval::PotentialRun run = eval::RunPotential(
+      scenario, calibration, o,
+      [](const Pose2&, const cv::Mat&, const navigation::PotentialStep&) { ThrowIfInterrupted(); });
+  spdlog::info("navigate: {} after {:.1f} s ({} frames){}", run.status, run.duration_s,
+               run.path.size(),
+               o.destination ? fmt::format(", {:.2f} m from the goal", run.final_error_m) : "");
+  if (!run.success) throw RunFailed("navigate: " + run.status);
+}
+
 }  // namespace
 
 void AddNavigateCommand(CLI::App* app) {
@@ -115,106 +197,12 @@ void AddNavigateCommand(CLI::App* app) {
       ->capture_default_str()
       ->check(FiniteIn(0.0, 100.0));
   cmd->callback([a, cmd] {
+    const bool by_index = cmd->count("--destination-index") > 0;
     if (!a->robot.empty()) {
-      NavigateOnRobot(*a, cmd->count("--destination-index") > 0);
-      return;
-    }
-    if (a->scenario.empty()) throw InputError("navigate: give --scenario (simulator) or --robot");
-    RefuseOutputOverInputs(a->log, "--log", {a->scenario, a->calibration});
-    RefuseOutputOverInputs(a->save_calibration, "--save-calibration",
-                           {a->scenario, a->calibration, a->log});
-    if (cmd->count("--destination-index") > 0 && a->destination_index < 0) {
-      throw InputError("--destination-index " + std::to_string(a->destination_index) +
-                       ": must be 0 or more");
-    }
-    sim::Scenario scenario = sim::LoadScenario(a->scenario);
-    // The robot must start, and its goal lie, where the world is: the scenario's area (objects,
-    // taught path, starts and destinations) with a margin. Outside it there is nothing to see.
-    const Eigen::Vector4d area = sim::ScenarioBounds(scenario, kNavigationMarginM);
-    const auto in_area = [&](double x, double y) {
-      return x >= area[0] && y >= area[1] && x <= area[2] && y <= area[3];
-    };
-    const std::string area_text =
-        fmt::format("[{:.1f}, {:.1f}] x [{:.1f}, {:.1f}] m", area[0], area[2], area[1], area[3]);
-    if (!a->start.empty()) {
-      scenario.teach_start = ParsePoseDeg(a->start, "--start");
-      if (!in_area(scenario.teach_start.x_m, scenario.teach_start.y_m))
-        throw InputError("--start " + a->start + ": outside the scenario's area " + area_text);
-    }
-    eval::PotentialRunOptions o;
-    o.seed = a->seed;
-    o.motion_noise_frac = a->motion_noise;
-    o.image_noise_sigma = a->image_noise;
-    o.homing = a->homing;
-    if (!a->destination.empty() && a->destination_index >= 0)
-      throw InputError("--destination and --destination-index: give one of them");
-    if (!a->destination.empty()) {
-      const std::vector<double> d = ParseNumbers(a->destination, "--destination", 2, "X,Y");
-      if (!in_area(d[0], d[1]))
-        throw InputError("--destination " + a->destination + ": outside the scenario's area " +
-                         area_text);
-      o.destination = Eigen::Vector2d(d[0], d[1]);
-    } else if (a->destination_index >= 0) {
-      if (a->destination_index >= static_cast<int>(scenario.destinations.size()))
-        throw InputError("--destination-index " + std::to_string(a->destination_index) +
-                         ": scenario " + scenario.name + " has " +
-                         std::to_string(scenario.destinations.size()) + " destinations");
-      o.destination = scenario.destinations[static_cast<std::size_t>(a->destination_index)];
-    }
-    if (o.homing && !o.destination) throw InputError("--homing needs a destination");
-
-    navigation::PlanarFlowCalibration calibration;
-    if (!a->calibration.empty()) {
-      calibration = navigation::CalibrationFromYaml(
-          io::ReadFile(a->calibration, io::kMaxYamlFileBytes), a->calibration);
-      if (calibration.width != scenario.camera.model.width ||
-          calibration.height != scenario.camera.model.height)
-        throw InputError(a->calibration + ": calibrated for " + std::to_string(calibration.width) +
-                         "x" + std::to_string(calibration.height) + ", the camera is " +
-                         std::to_string(scenario.camera.model.width) + "x" +
-                         std::to_string(scenario.camera.model.height));
+      NavigateOnRobot(*a, by_index);
     } else {
-      spdlog::info("navigate: calibrating the planar flows (straight at T_m, then turning)");
-      calibration = eval::CalibrateOnSimulator(scenario, o.nav);
+      NavigateOnSim(*a, by_index);
     }
-    if (!a->save_calibration.empty())
-      io::WriteFileAtomic(a->save_calibration, navigation::CalibrationToYaml(calibration));
-
-    RefuseOutputOverInputs(a->record.path, "--record", {a->calibration, a->scenario});
-    const auto recorder = OpenRecorder(a->record, recording::CameraInfoOf(scenario.camera.model));
-    o.wrap_link = RecordingWrapper(recorder.get(), "navigate");
-    JsonLines log(a->log.empty() ? std::string() : a->log);
-    StopCleanlyOnInterrupt();
-    const bool logging = !a->log.empty();
-    int frame = 0;
-    const eval::PotentialRun run = eval::RunPotential(
-        scenario, calibration, o,
-        [&](const Pose2& truth, const cv::Mat&, const navigation::PotentialStep& s) {
-          ThrowIfInterrupted();
-          if (logging) {
-            nlohmann::json j;
-            j["frame"] = frame;
-            j["x_m"] = truth.x_m;
-            j["y_m"] = truth.y_m;
-            j["theta_deg"] = RadToDeg(truth.theta_rad);
-            j["status"] = navigation::PotentialStatusName(s.status);
-            j["leg"] = s.leg;
-            j["plane_fraction"] = s.plane_fraction;
-            j["free_ahead"] = s.free_ahead;
-            j["ground_mismatch"] = s.ground_mismatch;
-            j["theta_d_deg"] = RadToDeg(s.theta_d_rad);
-            j["force_theta_deg"] = RadToDeg(s.theta_rad);
-            j["v_mps"] = s.command.v_mps;
-            j["omega_radps"] = s.command.omega_radps;
-            if (!s.reason.empty()) j["reason"] = s.reason;
-            log.Write(j);
-          }
-          ++frame;
-        });
-    spdlog::info("navigate: {} after {:.1f} s ({} frames){}", run.status, run.duration_s,
-                 run.path.size(),
-                 o.destination ? fmt::format(", {:.2f} m from the goal", run.final_error_m) : "");
-    if (!run.success) throw RunFailed("navigate: " + run.status);
   });
 }
 

@@ -10,12 +10,11 @@
 #include "cli_common.h"
 #include "interrupt.h"
 #include "mapless/core/check.h"
-#include "mapless/eval/eigenspace.h"
-#include "mapless/eval/potential.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/io/atomic_file.h"
 #include "mapless/robot/robot_file.h"
 #include "mapless/robot/sim_serve.h"
+#include "mapless/run/sim_episode.h"
 #include "robot_run.h"
 
 namespace mapless::app {
@@ -26,22 +25,77 @@ nlohmann::json PoseJson(const Pose2& p) {
   return {{"x_m", p.x_m}, {"y_m", p.y_m}, {"theta_deg", RadToDeg(p.theta_rad)}};
 }
 
+struct ServeArgs {
+  std::string scenario;
+  std::string robot;
+  std::string like = "teach";
+  std::uint64_t seed = 1;
+  double motion_noise = 0.1;
+  double image_noise = 2.0;
+  double timeout_s = 600.0;
+  std::string summary;
+  std::string encoding = "mono8";
+  std::string size;
+};
+
+void Serve(const ServeArgs& a) {
+  RefuseOutputOverInputs(a.summary, "--summary", {a.robot, a.scenario});
+  cv::Size size;
+  if (!a.size.empty()) {
+    int w = 0, h = 0;
+    char x = 0;
+    std::istringstream in(a.size);
+    if (!(in >> w >> x >> h) || x != 'x' || w < 16 || h < 16 || w > 4096 || h > 4096 || !in.eof())
+      throw InputError("--size " + a.size + ": expected WIDTHxHEIGHT, 16 to 4096 a side");
+    size = cv::Size(w, h);
+  }
+  const robot::RobotFile file = robot::LoadRobotFile(a.robot);
+  const sim::Scenario scenario = sim::LoadScenario(a.scenario);
+  const eval::SimSetup setup =
+      run::SimSetupLike(scenario, a.like, a.seed, a.motion_noise, a.image_noise);
+  sim::Simulation sim(setup.world, setup.camera, {}, setup.seed);
+  const int r = sim.AddRobot(setup.start, setup.robot);
+  StopCleanlyOnInterrupt();
+  robot::ServeOptions options;
+  options.period_s = 1.0 / scenario.camera.rate_hz;
+  options.timeout_s = a.timeout_s;
+  options.interrupted = [] { return InterruptSignal() != 0; };
+  options.log = [](const std::string& m) { spdlog::info("{}", m); };
+  options.encoding = a.encoding;
+  options.size = size;
+  const robot::ServeSummary s = BuiltinMiddlewares().For(file).serve(sim, r, file, options);
+  spdlog::info("sim serve: {} after {} frames, {} commands{}, {:.1f} s simulated{}", s.end,
+               s.frames, s.commands,
+               s.resent > 0 ? ", " + std::to_string(s.resent) + " frames sent again" : "",
+               s.sim_time_s, s.collided ? "; " + s.collision : "");
+  if (!a.summary.empty()) {
+    nlohmann::json j;
+    j["scenario"] = scenario.name;
+    j["like"] = a.like;
+    j["seed"] = a.seed;
+    j["middleware"] = file.middleware;
+    j["end"] = s.end;
+    j["frames"] = s.frames;
+    j["commands"] = s.commands;
+    j["resent"] = s.resent;
+    j["sim_time_s"] = s.sim_time_s;
+    j["collided"] = s.collided;
+    if (s.collided) j["collision"] = s.collision;
+    j["final"] = PoseJson(s.final_pose);
+    if (s.have_decided_pose) {
+      j["decided"] = PoseJson(s.decided_pose);
+      j["decided_x_m"] = s.decided_pose.x_m;  // flat, for scripts
+      j["decided_y_m"] = s.decided_pose.y_m;
+    }
+    io::WriteFileAtomic(a.summary, j.dump(2) + "\n");
+  }
+  ThrowIfInterrupted();
+}
+
 }  // namespace
 
 void AddSimServeCommand(CLI::App* simcmd) {
-  struct Args {
-    std::string scenario;
-    std::string robot;
-    std::string like = "teach";
-    std::uint64_t seed = 1;
-    double motion_noise = 0.1;
-    double image_noise = 2.0;
-    double timeout_s = 600.0;
-    std::string summary;
-    std::string encoding = "mono8";
-    std::string size;
-  };
-  auto a = std::make_shared<Args>();
+  auto a = std::make_shared<ServeArgs>();
   CLI::App* cmd = simcmd->add_subcommand(
       "serve",
       "Serve a simulated robot over the robot file's middleware: camera, odometry and /clock "
@@ -76,84 +130,7 @@ void AddSimServeCommand(CLI::App* simcmd) {
   cmd->add_option("--size", a->size, "Publish the camera at WIDTHxHEIGHT (default: as simulated)");
   cmd->add_option("--summary", a->summary,
                   "Write the run's ground truth (pose at the method's last decision) as JSON here");
-  cmd->callback([a] {
-    RefuseOutputOverInputs(a->summary, "--summary", {a->robot, a->scenario});
-    cv::Size size;
-    if (!a->size.empty()) {
-      int w = 0, h = 0;
-      char x = 0;
-      std::istringstream in(a->size);
-      if (!(in >> w >> x >> h) || x != 'x' || w < 16 || h < 16 || w > 4096 || h > 4096 || !in.eof())
-        throw InputError("--size " + a->size + ": expected WIDTHxHEIGHT, 16 to 4096 a side");
-      size = cv::Size(w, h);
-    }
-    const robot::RobotFile file = robot::LoadRobotFile(a->robot);
-    const sim::Scenario scenario = sim::LoadScenario(a->scenario);
-    eval::SimSetup setup;
-    if (a->like == "teach") {
-      setup.world = scenario.world;
-      setup.camera = scenario.camera;
-      setup.robot = scenario.robot;
-      setup.start = scenario.teach_start;
-      setup.seed = a->seed;
-    } else if (a->like == "repeat") {
-      eval::RepeatRunOptions o;
-      o.seed = a->seed;
-      o.motion_noise_frac = a->motion_noise;
-      o.image_noise_sigma = a->image_noise;
-      setup = eval::RepeatSimSetup(scenario, o);
-    } else if (a->like == "navigate") {
-      eval::PotentialRunOptions o;
-      o.seed = a->seed;
-      o.motion_noise_frac = a->motion_noise;
-      o.image_noise_sigma = a->image_noise;
-      setup = eval::PotentialSimSetup(scenario, o);
-    } else if (a->like == "follow") {
-      eval::EigenspaceRunOptions o;
-      o.seed = a->seed;
-      o.motion_noise = a->motion_noise;
-      setup = eval::FollowSimSetup(scenario, o);
-    } else {
-      throw InputError("--like " + a->like + ": must be teach, repeat, navigate or follow");
-    }
-    sim::Simulation sim(setup.world, setup.camera, {}, setup.seed);
-    const int r = sim.AddRobot(setup.start, setup.robot);
-    StopCleanlyOnInterrupt();
-    robot::ServeOptions options;
-    options.period_s = 1.0 / scenario.camera.rate_hz;
-    options.timeout_s = a->timeout_s;
-    options.interrupted = [] { return InterruptSignal() != 0; };
-    options.log = [](const std::string& m) { spdlog::info("{}", m); };
-    options.encoding = a->encoding;
-    options.size = size;
-    const robot::ServeSummary s = BuiltinMiddlewares().For(file).serve(sim, r, file, options);
-    spdlog::info("sim serve: {} after {} frames, {} commands{}, {:.1f} s simulated{}", s.end,
-                 s.frames, s.commands,
-                 s.resent > 0 ? ", " + std::to_string(s.resent) + " frames sent again" : "",
-                 s.sim_time_s, s.collided ? "; " + s.collision : "");
-    if (!a->summary.empty()) {
-      nlohmann::json j;
-      j["scenario"] = scenario.name;
-      j["like"] = a->like;
-      j["seed"] = a->seed;
-      j["middleware"] = file.middleware;
-      j["end"] = s.end;
-      j["frames"] = s.frames;
-      j["commands"] = s.commands;
-      j["resent"] = s.resent;
-      j["sim_time_s"] = s.sim_time_s;
-      j["collided"] = s.collided;
-      if (s.collided) j["collision"] = s.collision;
-      j["final"] = PoseJson(s.final_pose);
-      if (s.have_decided_pose) {
-        j["decided"] = PoseJson(s.decided_pose);
-        j["decided_x_m"] = s.decided_pose.x_m;  // flat, for scripts
-        j["decided_y_m"] = s.decided_pose.y_m;
-      }
-      io::WriteFileAtomic(a->summary, j.dump(2) + "\n");
-    }
-    ThrowIfInterrupted();
-  });
+  cmd->callback([a] { Serve(*a); });
 }
 
 }  // namespace mapless::app

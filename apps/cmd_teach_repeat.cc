@@ -18,10 +18,10 @@
 #include "mapless/recording/recording_link.h"
 #include "mapless/robot/methods.h"
 #include "mapless/robot/robot_file.h"
-#include "mapless/run/decision_log.h"
-#include "mapless/run/link_kinds.h"
 #include "mapless/route/appearance_store.h"
 #include "mapless/route/route_store.h"
+#include "mapless/run/decision_log.h"
+#include "mapless/run/link_kinds.h"
 #include "recording_args.h"
 #include "robot_run.h"
 #include "teach.h"
@@ -77,9 +77,9 @@ void RepeatOnSim(const RepeatArgs& r, const std::shared_ptr<route::Route>& route
   run_options.seed = r.seed;
   run_options.motion_noise_frac = r.motion_noise;
   run_options.image_noise_sigma = r.image_noise;
-  run_options.wrap_link =
-      run::LogDecisions("repeat", [&log](const nlohmann::json& j) { log.Write(j); },
-                        RecordingWrapper(recorder.get(), "repeat"));
+  run_options.wrap_link = run::LogDecisions(
+      "repeat", [&log](const nlohmann::json& j) { log.Write(j); },
+      RecordingWrapper(recorder.get(), "repeat"));
   const double speed = eval::RepeatSpeedFor(scenario, run_options.max_repeat_speed_mps);
   run_options.repeat.sloped.max_speed_mps = speed;
   run_options.repeat.standard.forward_speed_mps = speed;
@@ -92,9 +92,50 @@ void RepeatOnSim(const RepeatArgs& r, const std::shared_ptr<route::Route>& route
   if (!run.success) throw RunFailed("repeat did not succeed: " + run.status);
 }
 
+// `mapless repeat`: the funnel-lane repeat on a robot, a recording or the simulator.
+void Repeat(const RepeatArgs& r) {
+  if (r.source.empty() && r.robot.empty())
+    throw InputError("repeat: give --source (simulator, recording, camera) or --robot");
+  RefuseOutputOverInputs(r.log, "--log", {r.route, run::SourceInput(r.source), r.robot});
+  RefuseOutputOverInputs(r.record.path, "--record", {r.route, run::SourceInput(r.source), r.robot});
+  if (!r.record.path.empty() && !r.source.empty() && !run::IsSim(r.source))
+    throw InputError("--record: records runs on the simulator or a robot; " + r.source +
+                     " is played open loop (its decisions are in --log)");
+  auto route = std::make_shared<route::Route>(route::LoadRoute(r.route));
+  if (!route->complete)
+    spdlog::warn("repeat: {} is an interrupted teach; repeating its {} keyframes", r.route,
+                 route->keyframes.size());
+  navigation::RepeatOptions options;
+  options.controller = navigation::ParseController(r.controller);
+  options.switching = navigation::ParseSwitching(r.switching);
+  options.end_by_local_scale = ParseEndByLocalScale(r.end);
+  options.redetect_every_frames = r.redetect_every;
+  options.recovery_keyframes = r.recover_keyframes;
+  options.carry_on.max_distance_m = r.carry_on_m;
+  options.features.type = features::ParseDetectorType(route->detector);
+  options.obstacle = ObstacleWatchFor(r.robot, r.on_obstacle, options.obstacle, true);
+  if (!r.robot.empty() || !run::IsSim(r.source)) {
+    if (!r.robot.empty()) {
+      options.sloped.max_speed_mps = r.speed;
+      options.standard.forward_speed_mps = r.speed;
+    }
+    robot::RepeatMethod method(route, options);
+    SourceRunArgs args;
+    args.log = r.log;
+    args.playback = r.playback;
+    args.playback.fps = r.fps;
+    args.record = &r.record;
+    args.size_needed_by = "the route " + r.route + " was taught at";
+    args.robot = !r.robot.empty();
+    RunOnSource(method, args.robot ? r.robot : r.source, args);
+    return;
+  }
+  RepeatOnSim(r, route, options);
+}
+
 }  // namespace
 
-void AddTeachRepeatCommands(CLI::App* app) {
+static void AddTeachCommand(CLI::App* app) {
   auto t = std::make_shared<TeachArgs>();
   CLI::App* teach = app->add_subcommand(
       "teach",
@@ -124,7 +165,9 @@ void AddTeachRepeatCommands(CLI::App* app) {
   AddPlaybackOptions(teach, &t->playback);
   AddRecordOptions(teach, &t->record);
   teach->callback([t] { Teach(*t); });
+}
 
+static void AddRepeatCommand(CLI::App* app) {
   auto r = std::make_shared<RepeatArgs>();
   CLI::App* repeat = app->add_subcommand(
       "repeat",
@@ -193,47 +236,10 @@ void AddTeachRepeatCommands(CLI::App* app) {
       ->check(FiniteIn(io::kMinFolderFps, io::kMaxFolderFps));
   AddPlaybackOptions(repeat, &r->playback);
   AddRecordOptions(repeat, &r->record);
-  repeat->callback([r] {
-    if (r->source.empty() && r->robot.empty())
-      throw InputError("repeat: give --source (simulator, recording, camera) or --robot");
-    RefuseOutputOverInputs(r->log, "--log", {r->route, run::SourceInput(r->source), r->robot});
-    RefuseOutputOverInputs(r->record.path, "--record",
-                           {r->route, run::SourceInput(r->source), r->robot});
-    if (!r->record.path.empty() && !r->source.empty() && !run::IsSim(r->source))
-      throw InputError("--record: records runs on the simulator or a robot; " + r->source +
-                       " is played open loop (its decisions are in --log)");
-    auto route = std::make_shared<route::Route>(route::LoadRoute(r->route));
-    if (!route->complete)
-      spdlog::warn("repeat: {} is an interrupted teach; repeating its {} keyframes", r->route,
-                   route->keyframes.size());
-    navigation::RepeatOptions options;
-    options.controller = navigation::ParseController(r->controller);
-    options.switching = navigation::ParseSwitching(r->switching);
-    options.end_by_local_scale = ParseEndByLocalScale(r->end);
-    options.redetect_every_frames = r->redetect_every;
-    options.recovery_keyframes = r->recover_keyframes;
-    options.carry_on.max_distance_m = r->carry_on_m;
-    options.features.type = features::ParseDetectorType(route->detector);
-    options.obstacle = ObstacleWatchFor(r->robot, r->on_obstacle, options.obstacle, true);
-    if (!r->robot.empty() || !run::IsSim(r->source)) {
-      if (!r->robot.empty()) {
-        options.sloped.max_speed_mps = r->speed;
-        options.standard.forward_speed_mps = r->speed;
-      }
-      robot::RepeatMethod method(route, options);
-      SourceRunArgs args;
-      args.log = r->log;
-      args.playback = r->playback;
-      args.playback.fps = r->fps;
-      args.record = &r->record;
-      args.size_needed_by = "the route " + r->route + " was taught at";
-      args.robot = !r->robot.empty();
-      RunOnSource(method, args.robot ? r->robot : r->source, args);
-      return;
-    }
-    RepeatOnSim(*r, route, options);
-  });
+  repeat->callback([r] { Repeat(*r); });
+}
 
+static void AddRouteCommand(CLI::App* app) {
   CLI::App* route_cmd = app->add_subcommand("route", "Inspect a taught route");
   route_cmd->require_subcommand(1);
   struct InfoArgs {
@@ -290,6 +296,12 @@ void AddTeachRepeatCommands(CLI::App* app) {
                   j["duration_s"].get<double>());
     }
   });
+}
+
+void AddTeachRepeatCommands(CLI::App* app) {
+  AddTeachCommand(app);
+  AddRepeatCommand(app);
+  AddRouteCommand(app);
 }
 
 }  // namespace mapless::app

@@ -4,14 +4,12 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
-#include <filesystem>
 #include <optional>
 #include <thread>
 
 #include "cli_common.h"
 #include "interrupt.h"
 #include "mapless/core/check.h"
-#include "mapless/eval/eigenspace.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/fleet/client.h"
 #include "mapless/fleet/curve.h"
@@ -59,8 +57,8 @@ struct LeadArgs {
 // A leader restarted on its route goes on where it stopped: the teacher has the route so far, and
 // on the simulator the frames up to there are driven, not rendered (the returned test).
 std::function<bool(const sim::DriveFrame&)> ResumeLeader(const fleet::RouteCopy& copy,
-                                                        fleet::RouteKind kind,
-                                                        run::Teacher* teacher) {
+                                                         fleet::RouteKind kind,
+                                                         run::Teacher* teacher) {
   if (copy.next_sequence() == 0 || copy.complete()) return {};
   const int stored = static_cast<int>(copy.next_sequence()) - 1;  // record 0 is the header
   if (stored == 0) {
@@ -156,16 +154,132 @@ void Lead(const LeadArgs& a) {
   }
 }
 
-// The route a follower's method asks for; a route the leader completed too short to follow ends
-// the run with the reason (waiting for more cannot help).
-template <typename RoutePtr>
-RoutePtr NotTooShort(const fleet::RouteCopy& copy, RoutePtr route, const char* unit, int minimum) {
-  if (route == nullptr && copy.complete()) {
-    const std::uint64_t n = copy.next_sequence() >= 2 ? copy.next_sequence() - 2 : 0;
-    throw RunFailed("follow: the leader completed its route with " + std::to_string(n) + " " +
-                    unit + "; a route to follow needs at least " + std::to_string(minimum));
+}  // namespace
+
+namespace {
+
+// The robot stays still (nothing is sent) until the route's header says what to follow and, for
+// a copy resumed from disk, until the leader has confirmed it is the same route; what it waits for
+// (no connection, a handshake failing) is said every 5 s.
+void WaitForLeader(const fleet::RouteCopy& copy, const fleet::FollowerClient& client,
+                   const FollowConnectArgs& a) {
+  if (copy.next_sequence() > 0)
+    spdlog::info("follow: waiting for the leader to confirm the copy in {}", a.route);
+  auto next_word = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (!copy.header() || !client.Verified()) {
+    ThrowIfInterrupted();
+    if (!client.Refusal().empty()) throw RunFailed("follow: " + client.Refusal());
+    if (std::chrono::steady_clock::now() > next_word) {
+      const fleet::ClientStats stats = client.stats();
+      spdlog::info("follow: still waiting for the leader's route: {}",
+                   stats.link_state.empty() ? "nothing heard from " + a.connect : stats.link_state);
+      next_word += std::chrono::seconds(5);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  return route;
+}
+
+// The method for the route the header announces, reading the copy as it grows.
+std::unique_ptr<robot::Method> FollowerMethod(const fleet::RouteHeader& header,
+                                              const fleet::RouteCopy& copy,
+                                              const FollowConnectArgs& a,
+                                              const std::optional<sim::Scenario>& scenario) {
+  const cv::Size size(header.image_width, header.image_height);
+  if (header.kind == fleet::RouteKind::kEigenspace) {
+    navigation::AppearanceFollowerOptions follower;
+    follower.obstacle = ObstacleWatchFor(a.robot, a.on_obstacle, follower.obstacle, false);
+    SetFollowerRecovery(a.carry_on_m, &follower);
+    return std::make_unique<robot::FollowMethod>(
+        [&copy] {
+          auto route = copy.AppearanceRoute();
+          if (!route && copy.complete())  // waiting for more cannot help
+            throw RunFailed("follow: the leader completed its route without route images");
+          return route;
+        },
+        follower, size);
+  }
+  navigation::RepeatOptions repeat;
+  repeat.features.type = features::ParseDetectorType(header.detector);
+  repeat.obstacle = ObstacleWatchFor(a.robot, a.on_obstacle, repeat.obstacle, true);
+  repeat.carry_on.max_distance_m = a.carry_on_m;
+  if (scenario) {
+    const double speed =
+        eval::RepeatSpeedFor(*scenario, eval::RepeatRunOptions{}.max_repeat_speed_mps);
+    repeat.sloped.max_speed_mps = speed;
+    repeat.standard.forward_speed_mps = speed;
+  }
+  return std::make_unique<robot::RepeatMethod>(
+      robot::RepeatMethod::RouteUpdates([&copy](route::Route* route) {
+        const bool changed = copy.UpdateFunnel(route);
+        if (route->complete && route->keyframes.size() < 2)
+          throw RunFailed("follow: the leader completed its route with " +
+                          std::to_string(route->keyframes.size()) +
+                          " keyframes; a route to follow needs at least 2");
+        return changed;
+      }),
+      repeat, size);
+}
+
+// The follower on the simulator, in step with the wall clock; its summary for `eval fleet`.
+void FollowOnSim(robot::Method& method, const sim::Scenario& scenario,
+                 const fleet::RouteHeader& header, const fleet::RouteCopy& copy,
+                 const fleet::FollowerClient& client, const FollowConnectArgs& a) {
+  if (scenario.camera.model.width != header.image_width ||
+      scenario.camera.model.height != header.image_height)
+    throw InputError(a.source + ": the camera is " + std::to_string(scenario.camera.model.width) +
+                     "x" + std::to_string(scenario.camera.model.height) +
+                     ", the leader's route is " + std::to_string(header.image_width) + "x" +
+                     std::to_string(header.image_height));
+  run::SimRun sim(scenario,
+                  run::FollowEpisode(scenario, header.kind, a.seed, a.motion_noise,
+                                     /*live_leader=*/true),
+                  a.rate);
+  const std::vector<Pose2>& taught = sim.episode().taught;
+  double lateral_sq = 0.0;
+  int moving = 0;
+  int waited = 0;  // frames stopped at the end of the route taught so far
+  const run::RunOutcome outcome = RunOnSim(
+      method, sim, a.log, nullptr, [&](const robot::Observation&, const robot::Decision& decision) {
+        if (decision.reason.rfind("waiting for the leader", 0) == 0 ||
+            decision.status == "waiting_for_leader")
+          ++waited;
+        if (decision.state == robot::MethodState::kDriving) {
+          const double d = eval::DistanceToPath(taught, sim.truth().x_m, sim.truth().y_m);
+          lateral_sq += d * d;
+          ++moving;
+        }
+        return true;
+      });
+  const robot::LoopResult& result = outcome.loop;
+  const bool success = sim.succeeded(result.finished);
+  const fleet::ClientStats stats = client.stats();
+  spdlog::info("follow: {} ({} frames); {:.2f} m from the route's end; {} records applied",
+               result.reason, result.frames, sim.error_at_end_m(), stats.applied);
+  if (!a.summary.empty()) {
+    const std::vector<double>& latency = stats.latency_ms;
+    const auto pct = [&](double p) {  // -1: no live records (the route was finished)
+      return latency.empty() ? -1.0 : robot::Percentile(latency, p);
+    };
+    const nlohmann::json j = {{"completed", success},
+                              {"reason", result.reason},
+                              {"collided", sim.collided()},
+                              {"final_error_m", sim.error_at_end_m()},
+                              {"lateral_rms_m", moving > 0 ? std::sqrt(lateral_sq / moving) : 0.0},
+                              {"frames", result.frames},
+                              {"frames_waiting_for_leader", waited},
+                              {"records_received", stats.received},
+                              {"records_applied", stats.applied},
+                              {"duplicates_dropped", stats.duplicates_dropped},
+                              {"ahead_dropped", stats.ahead_dropped},
+                              {"rejected", stats.rejected},
+                              {"subscriptions", stats.subscriptions},
+                              {"copy_records", copy.next_sequence()},
+                              {"latency_samples", latency.size()},
+                              {"latency_median_ms", pct(0.5)},
+                              {"latency_p99_ms", pct(0.99)}};
+    io::WriteFileAtomic(a.summary, j.dump(1) + "\n");
+  }
+  if (!success) throw RunFailed("follow did not succeed: " + result.reason);
 }
 
 }  // namespace
@@ -191,122 +305,18 @@ void FollowConnected(const FollowConnectArgs& a) {
                  copy.next_sequence());
   fleet::FollowerClient client(copy, options, FleetLog);
   StopCleanlyOnInterrupt();
-  // The robot stays still (nothing is sent) until the route's header says what to follow and,
-  // for a copy resumed from disk, until the leader has confirmed it is the same route.
-  if (copy.next_sequence() > 0)
-    spdlog::info("follow: waiting for the leader to confirm the copy in {}", a.route);
-  // Said every 5 s while nothing comes: what it waits for (no connection, a handshake failing).
-  auto next_word = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-  while (!copy.header() || !client.Verified()) {
-    ThrowIfInterrupted();
-    if (!client.Refusal().empty()) throw RunFailed("follow: " + client.Refusal());
-    if (std::chrono::steady_clock::now() > next_word) {
-      const fleet::ClientStats stats = client.stats();
-      spdlog::info("follow: still waiting for the leader's route: {}",
-                   stats.link_state.empty() ? "nothing heard from " + a.connect : stats.link_state);
-      next_word += std::chrono::seconds(5);
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
+  WaitForLeader(copy, client, a);
   const fleet::RouteHeader header = *copy.header();
-  const cv::Size size(header.image_width, header.image_height);
-  std::unique_ptr<robot::Method> method;
-  if (header.kind == fleet::RouteKind::kFunnel) {
-    navigation::RepeatOptions repeat;
-    repeat.features.type = features::ParseDetectorType(header.detector);
-    repeat.obstacle = ObstacleWatchFor(a.robot, a.on_obstacle, repeat.obstacle, true);
-    repeat.carry_on.max_distance_m = a.carry_on_m;
-    if (scenario) {
-      const double speed =
-          eval::RepeatSpeedFor(*scenario, eval::RepeatRunOptions{}.max_repeat_speed_mps);
-      repeat.sloped.max_speed_mps = speed;
-      repeat.standard.forward_speed_mps = speed;
-    }
-    method = std::make_unique<robot::RepeatMethod>(
-        robot::RepeatMethod::RouteUpdates([&copy](route::Route* route) {
-          const bool changed = copy.UpdateFunnel(route);
-          if (route->complete && route->keyframes.size() < 2)
-            throw RunFailed("follow: the leader completed its route with " +
-                            std::to_string(route->keyframes.size()) +
-                            " keyframes; a route to follow needs at least 2");
-          return changed;
-        }),
-        repeat, size);
-  } else {
-    navigation::AppearanceFollowerOptions follower;
-    follower.obstacle = ObstacleWatchFor(a.robot, a.on_obstacle, follower.obstacle, false);
-    SetFollowerRecovery(a.carry_on_m, &follower);
-    method = std::make_unique<robot::FollowMethod>(
-        [&copy] { return NotTooShort(copy, copy.AppearanceRoute(), "route images", 1); }, follower,
-        size);
-  }
+  const std::unique_ptr<robot::Method> method = FollowerMethod(header, copy, a, scenario);
   spdlog::info("follow: a {} route from {}", fleet::RouteKindName(header.kind), a.connect);
-  if (!scenario) {
-    SourceRunArgs args;
-    args.log = a.log;
-    args.robot = true;
-    RunOnSource(*method, a.robot, args);
+  if (scenario) {
+    FollowOnSim(*method, *scenario, header, copy, client, a);
     return;
   }
-  if (scenario->camera.model.width != size.width || scenario->camera.model.height != size.height)
-    throw InputError(a.source + ": the camera is " + std::to_string(scenario->camera.model.width) +
-                     "x" + std::to_string(scenario->camera.model.height) +
-                     ", the leader's route is " + std::to_string(size.width) + "x" +
-                     std::to_string(size.height));
-  run::SimRun sim(*scenario,
-                  run::FollowEpisode(*scenario, header.kind, a.seed, a.motion_noise,
-                                     /*live_leader=*/true),
-                  a.rate);
-  const std::vector<Pose2>& taught = sim.episode().taught;
-  double lateral_sq = 0.0;
-  int moving = 0;
-  int waited = 0;  // frames stopped at the end of the route taught so far
-  const run::RunOutcome outcome =
-      RunOnSim(*method, sim, a.log, nullptr,
-               [&](const robot::Observation&, const robot::Decision& decision) {
-                 if (decision.reason.rfind("waiting for the leader", 0) == 0 ||
-                     decision.status == "waiting_for_leader")
-                   ++waited;
-                 if (decision.state == robot::MethodState::kDriving) {
-                   const double d =
-                       eval::DistanceToPath(taught, sim.truth().x_m, sim.truth().y_m);
-                   lateral_sq += d * d;
-                   ++moving;
-                 }
-                 return true;
-               });
-  const robot::LoopResult& result = outcome.loop;
-  const double final_error = sim.error_at_end_m();
-  const bool success = sim.succeeded(result.finished);
-  const fleet::ClientStats stats = client.stats();
-  spdlog::info("follow: {} ({} frames); {:.2f} m from the route's end; {} records applied",
-               result.reason, result.frames, final_error, stats.applied);
-  if (!a.summary.empty()) {
-    const std::vector<double>& latency = stats.latency_ms;
-    const auto pct = [&](double p) {  // -1: no live records (the route was finished)
-      return latency.empty() ? -1.0 : robot::Percentile(latency, p);
-    };
-    nlohmann::json j;
-    j["completed"] = success;
-    j["reason"] = result.reason;
-    j["collided"] = sim.collided();
-    j["final_error_m"] = final_error;
-    j["lateral_rms_m"] = moving > 0 ? std::sqrt(lateral_sq / moving) : 0.0;
-    j["frames"] = result.frames;
-    j["frames_waiting_for_leader"] = waited;
-    j["records_received"] = stats.received;
-    j["records_applied"] = stats.applied;
-    j["duplicates_dropped"] = stats.duplicates_dropped;
-    j["ahead_dropped"] = stats.ahead_dropped;
-    j["rejected"] = stats.rejected;
-    j["subscriptions"] = stats.subscriptions;
-    j["copy_records"] = copy.next_sequence();
-    j["latency_samples"] = latency.size();
-    j["latency_median_ms"] = pct(0.5);
-    j["latency_p99_ms"] = pct(0.99);
-    io::WriteFileAtomic(a.summary, j.dump(1) + "\n");
-  }
-  if (!success) throw RunFailed("follow did not succeed: " + result.reason);
+  SourceRunArgs args;
+  args.log = a.log;
+  args.robot = true;
+  RunOnSource(*method, a.robot, args);
 }
 
 void AddLeadCommand(CLI::App* app) {

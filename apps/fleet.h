@@ -1,6 +1,5 @@
 // `mapless lead` (teach a route and serve it to followers), `mapless follow --connect` (follow a
-// route a leader serves, while it is still being taught), `mapless fleet keygen`, and
-// `mapless eval fleet` (one leader and N followers as separate processes on loopback).
+// route a leader serves, while it is still being taught) and `mapless fleet keygen`.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -29,26 +28,5 @@ void FollowConnected(const FollowConnectArgs& a);
 
 void AddLeadCommand(CLI::App* app);
 void AddFleetCommand(CLI::App* app);  // mapless fleet keygen
-
-// `mapless eval fleet`: one leader and N followers as separate processes of this program on
-// loopback, on the simulator, with the faults asked for.
-struct FleetEvalArgs {
-  int followers = 3;
-  std::string method = "funnel";
-  std::string scenario;  // default: table1_almost_straight (funnel), office_aliasing (eigenspace)
-  double rate = 4.0;     // simulated seconds per wall-clock second, every process
-  double start_after_s = 3.0;       // wall clock: followers start this long after the leader
-  double kill_leader_at_s = 0.0;    // > 0: SIGKILL the leader then, and start it again
-  double kill_follower_at_s = 0.0;  // > 0: SIGKILL follower 1 then, and start it again
-  double link_down_at_s = 0.0;      // > 0: the last follower's link (a relay) goes down then ...
-  double link_down_for_s = 10.0;    // ... for this long
-  bool curve = false;               // CURVE keys for everyone
-  std::string keep;                 // work directory to keep (default: a temporary one, removed)
-  std::uint64_t seed = 1;
-};
-void AddFleetEvalOptions(CLI::App* eval, FleetEvalArgs* args);
-// Prints the table (stderr with json) and the JSON; throws RunFailed when a follower did not
-// complete, a copy differs from the leader's route, or records are missing.
-void RunFleetEval(const FleetEvalArgs& args, bool json);
 
 }  // namespace mapless::app

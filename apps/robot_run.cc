@@ -114,11 +114,10 @@ void RunOnRecording(robot::Method& method, const std::string& source, const Sour
   // A replay on which the method never once drove answered nothing (issue 40: exit 0 with every
   // decision "stopped: needs odometry").
   if (!outcome.loop.finished && outcome.loop.frames > 0 && outcome.driving_frames == 0)
-    throw RunFailed(std::string(method.name()) + " on " + source + ": stopped on all " +
-                    std::to_string(outcome.loop.frames) + " frames" +
-                    (outcome.last_stop_reason.empty()
-                         ? ""
-                         : ", the last time: " + outcome.last_stop_reason));
+    throw RunFailed(
+        std::string(method.name()) + " on " + source + ": stopped on all " +
+        std::to_string(outcome.loop.frames) + " frames" +
+        (outcome.last_stop_reason.empty() ? "" : ", the last time: " + outcome.last_stop_reason));
 }
 
 }  // namespace

@@ -78,8 +78,8 @@ void Teach(const TeachArgs& t) {
   teacher_options.detector = t.detector;
   // A video or folder without --poses never has odometry; a recording's first frames may come
   // before its first odometry message, as a robot's do.
-  teacher_options.never_odometry = !robot && !scenario && !live &&
-                                   !recording::IsRecording(t.source) && t.playback.poses.empty();
+  teacher_options.never_odometry =
+      !robot && !scenario && !live && !recording::IsRecording(t.source) && t.playback.poses.empty();
   run::Teacher teacher(teacher_options, store);
   const run::FrameTap tap = [&](const robot::Observation& f, const std::optional<Pose2>& truth) {
     if (!recorder) return;
@@ -93,8 +93,9 @@ void Teach(const TeachArgs& t) {
       outcome = run::TeachOnSimulator(*scenario, teacher, tap);
     } else {
       if (robot)
-        spdlog::info("teach: recording from the robot's camera; drive the robot, Ctrl-C ends the "
-                     "route");
+        spdlog::info(
+            "teach: recording from the robot's camera; drive the robot, Ctrl-C ends the "
+            "route");
       outcome = run::TeachFromLink(*link, teacher, tap);
     }
     if (outcome.failed) throw RunFailed("teach: " + outcome.end);

@@ -13,12 +13,12 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "mapless/bench/bench.h"
+#include "mapless/bench/timing.h"
 #include "mapless/core/rng.h"
 #include "mapless/fleet/client.h"
 #include "mapless/fleet/route_log.h"
 #include "mapless/fleet/server.h"
-#include "mapless/bench/bench.h"
-#include "mapless/bench/timing.h"
 #include "mapless/robot/link_bench.h"
 
 namespace mapless::bench {
@@ -91,7 +91,8 @@ double Percentile(const std::vector<double>& v, double p) {  // -1: nothing meas
 // (RouteCopy::FunnelRoute); medians over the first and the last 100 records.
 void BenchFollowerPerRecord(const std::string& root, nlohmann::json* j) {
   constexpr int kRecords = 1000;
-  std::vector<fleet::Record> records = {fleet::HeaderRecord(BenchHeader(fleet::RouteKind::kFunnel))};
+  std::vector<fleet::Record> records = {
+      fleet::HeaderRecord(BenchHeader(fleet::RouteKind::kFunnel))};
   for (int i = 0; i < kRecords; ++i) records.push_back(BenchRecord(fleet::RouteKind::kFunnel, i));
   for (std::size_t i = 0; i < records.size(); ++i) records[i].sequence = i;
   for (const bool pieces : {true, false}) {
@@ -102,8 +103,9 @@ void BenchFollowerPerRecord(const std::string& root, nlohmann::json* j) {
       const auto t0 = Clock::now();
       copy.Apply({r});
       const auto t1 = Clock::now();
-      const std::size_t n = pieces ? (copy.UpdateFunnel(&route), route.keyframes.size())
-                                   : (copy.FunnelRoute() ? copy.FunnelRoute()->keyframes.size() : 0);
+      const std::size_t n = pieces
+                                ? (copy.UpdateFunnel(&route), route.keyframes.size())
+                                : (copy.FunnelRoute() ? copy.FunnelRoute()->keyframes.size() : 0);
       const auto t2 = Clock::now();
       if (n == 0 && r.sequence > 2) throw std::runtime_error("bench: the follower read no route");
       apply_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());

@@ -10,11 +10,11 @@
 #include <opencv2/video/tracking.hpp>
 #include <sstream>
 
-#include "mapless/bench/bench.h"
-#include "mapless/bench/timing.h"
 #include "mapless/appearance/image.h"
 #include "mapless/appearance/pca.h"
 #include "mapless/appearance/subwindow.h"
+#include "mapless/bench/bench.h"
+#include "mapless/bench/timing.h"
 #include "mapless/control/subwindow_steering.h"
 #include "mapless/core/check.h"
 #include "mapless/eval/potential.h"
@@ -183,8 +183,8 @@ nlohmann::json BenchStages(const StageOptions& options) {
   std::vector<View> views;
   for (const std::string& name : names) {
     sim::Scenario scenario = sim::LoadScenario(name);
-    scenario.camera.model = sim::CameraModel::FromFov(BenchFrameSize().width,
-                                                      BenchFrameSize().height, DegToRad(60.0));
+    scenario.camera.model =
+        sim::CameraModel::FromFov(BenchFrameSize().width, BenchFrameSize().height, DegToRad(60.0));
     renderers.push_back(std::make_unique<sim::Renderer>(scenario.world, sim::RenderOptions{}));
     for (const Pose2& p : PosesAlong(scenario, 12))
       views.push_back({renderers.back().get(), scenario.camera, p});
@@ -238,8 +238,7 @@ nlohmann::json BenchStages(const StageOptions& options) {
     std::vector<float> error;
     j["opencv_pyrlk_every_pixel_320x240_ms"] = MedianMs(5, 1, [&](int i) {
       const auto k = static_cast<std::size_t>(i) % pair_a.size();
-      cv::calcOpticalFlowPyrLK(pair_a[k], pair_b[k], every, next, status, error, cv::Size(5, 5),
-                               4);
+      cv::calcOpticalFlowPyrLK(pair_a[k], pair_b[k], every, next, status, error, cv::Size(5, 5), 4);
     });
   }
   j["pyrlk_every_pixel_over_dense_lk"] = j["opencv_pyrlk_every_pixel_320x240_ms"].get<double>() /

@@ -96,8 +96,7 @@ void PrintStageTable(const nlohmann::json& j) {
   std::printf("%-34s %10.2f  (issue 3: <= 1.5)\n", "repeat_step / orb500",
               j["repeat_step_over_orb"].get<double>());
   std::printf("%-34s %10.2f  (issue 3: <= 1.5; ORB-500 timed after each step)\n",
-              "repeat_step / orb500 interl.",
-              j["repeat_step_over_orb_interleaved"].get<double>());
+              "repeat_step / orb500 interl.", j["repeat_step_over_orb_interleaved"].get<double>());
   std::printf("%-34s %10.2f  (issue 21: <= 1.5)\n", "repeat_step_default / orb500",
               j["repeat_step_default_over_orb"].get<double>());
   std::printf("%-34s %10.2f  (issue 21: <= 1.5; ORB-500 timed after each step)\n",

@@ -1,5 +1,7 @@
 // `mapless bench`, teach & repeat (issues 3 and 21): the teach step, the repeat step in its
 // modes, the obstacle watch, against stock ORB-500 and DIS fast measured in the same run.
+#include "mapless/eval/teach_repeat.h"
+
 #include <nlohmann/json.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -7,7 +9,6 @@
 
 #include "mapless/bench/bench.h"
 #include "mapless/bench/timing.h"
-#include "mapless/eval/teach_repeat.h"
 #include "mapless/features/features.h"
 #include "mapless/navigation/obstacle_watch.h"
 #include "mapless/navigation/repeat.h"
@@ -45,6 +46,63 @@ double WatchMs(const std::vector<cv::Mat>& grey, double forward_m) {
   return Median(ms);
 }
 
+// The obstacle watch alone (issue 21): at the teach drive's speed per frame, against DIS fast on
+// the same frames (the watch's target: <= 1x DIS fast on top of the step).
+void BenchObstacleWatch(const sim::Scenario& scenario, const std::vector<cv::Mat>& grey,
+                        nlohmann::json* j) {
+  const double forward_m = scenario.teach_speed_mps / scenario.camera.rate_hz;
+  (*j)["obstacle_watch_ms"] = WatchMs(grey, forward_m);
+  {
+    const auto dis = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_FAST);
+    cv::Mat flow;
+    (*j)["opencv_dis_fast_table1_320x240_ms"] =
+        Median(TimesMs(static_cast<int>(grey.size()) - 1, [&](int i) {
+          dis->calc(grey[static_cast<std::size_t>(i)], grey[static_cast<std::size_t>(i) + 1], flow);
+        }));
+  }
+  (*j)["obstacle_watch_over_dis_fast"] = (*j)["obstacle_watch_ms"].get<double>() /
+                                         (*j)["opencv_dis_fast_table1_320x240_ms"].get<double>();
+}
+
+// `route`'s keyframes repeated `times` times (a long route of the same segments).
+std::shared_ptr<route::Route> LongRoute(const route::Route& route, int times) {
+  auto long_route = std::make_shared<route::Route>(route);
+  long_route->keyframes.clear();
+  for (int k = 0; k < times; ++k) {
+    for (const auto& kf : route.keyframes) {
+      route::Keyframe copy = kf;
+      copy.index = static_cast<int>(long_route->keyframes.size());
+      long_route->keyframes.push_back(copy);
+    }
+  }
+  return long_route;
+}
+
+// mapless's ORB settings (the FAST threshold 10) by OpenCV and by OrbDetector, which gives the
+// same keypoints and descriptors (features/orb.h), on the same grey frames, interleaved frame by
+// frame so that both see the same host speed.
+void BenchOrbSettings(const std::vector<cv::Mat>& grey, nlohmann::json* j) {
+  std::vector<cv::KeyPoint> kp;
+  cv::Mat desc;
+  const features::FeatureOptions fo;
+  auto opencv = cv::ORB::create(fo.max_features, 1.2f, 8, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31,
+                                fo.orb_fast_threshold);
+  const features::OrbDetector ours(fo.max_features, fo.orb_fast_threshold);
+  // Interleaved, frame by frame, so both see the same host speed.
+  std::vector<double> theirs_ms, ours_ms;
+  for (int i = 0; i < 120; ++i) {
+    const cv::Mat& g = grey[static_cast<std::size_t>(i) % grey.size()];
+    theirs_ms.push_back(
+        TimesMs(1, [&](int) { opencv->detectAndCompute(g, cv::noArray(), kp, desc); })[0]);
+    ours_ms.push_back(TimesMs(1, [&](int) { ours.DetectAndCompute(g, &kp, &desc); })[0]);
+  }
+  (*j)["opencv_orb_mapless_settings_320x240_ms"] = Median(theirs_ms);
+  (*j)["orb_detector_320x240_ms"] = Median(ours_ms);
+  (*j)["orb_detector_over_opencv_same_settings"] =
+      (*j)["orb_detector_320x240_ms"].get<double>() /
+      (*j)["opencv_orb_mapless_settings_320x240_ms"].get<double>();
+}
+
 }  // namespace
 
 // Teach & repeat stages (issue 3) on the frames of the table1_almost_straight teach drive; the
@@ -52,9 +110,7 @@ double WatchMs(const std::vector<cv::Mat>& grey, double forward_m) {
 void BenchTeachRepeat(nlohmann::json* j) {
   const sim::Scenario scenario = BenchScenario("table1_almost_straight");
   std::vector<cv::Mat> frames;
-  sim::DriveOptions drive;
-  sim::DriveTaughtPath(scenario, drive,
-                       [&](const sim::DriveFrame& f) { frames.push_back(f.image); });
+  sim::DriveTaughtPath(scenario, {}, [&](const sim::DriveFrame& f) { frames.push_back(f.image); });
   const int n = static_cast<int>(frames.size());
   // Teach: KLT tracking + keyframe test per frame (keyframe frames also detect and describe).
   {
@@ -134,20 +190,8 @@ void BenchTeachRepeat(nlohmann::json* j) {
     // What `repeat` runs by default: the step with the obstacle watch.
     (*j)["repeat_step_default_with_watch_ms"] = Median(default_step(true, nullptr));
   }
-  // The obstacle watch alone (issue 21): at the teach drive's 3 cm per frame, against DIS fast
-  // on the same frames (the watch's target: <= 1x DIS fast on top of the step).
-  const double forward_m = scenario.teach_speed_mps / scenario.camera.rate_hz;
   const std::vector<cv::Mat> grey = GreyFrames(frames);
-  (*j)["obstacle_watch_ms"] = WatchMs(grey, forward_m);
-  {
-    const auto dis = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_FAST);
-    cv::Mat flow;
-    (*j)["opencv_dis_fast_table1_320x240_ms"] = Median(TimesMs(n - 1, [&](int i) {
-      dis->calc(grey[static_cast<std::size_t>(i)], grey[static_cast<std::size_t>(i) + 1], flow);
-    }));
-  }
-  (*j)["obstacle_watch_over_dis_fast"] = (*j)["obstacle_watch_ms"].get<double>() /
-                                         (*j)["opencv_dis_fast_table1_320x240_ms"].get<double>();
+  BenchObstacleWatch(scenario, grey, j);
   {
     std::vector<double> orb_interleaved;
     (*j)["repeat_step_ms"] = repeat_median(taught.route, 0, true, false, &orb_interleaved);
@@ -159,15 +203,7 @@ void BenchTeachRepeat(nlohmann::json* j) {
   (*j)["repeat_step_fresh_end_ms"] = repeat_median(taught.route, 1, false, true);
   // The same on a 1 km route (the 10 m route's keyframes repeated 100 times): the per-frame cost
   // depends only on the current segment.
-  auto long_route = std::make_shared<route::Route>(*taught.route);
-  long_route->keyframes.clear();
-  for (int k = 0; k < 100; ++k) {
-    for (const auto& kf : taught.route->keyframes) {
-      route::Keyframe copy = kf;
-      copy.index = static_cast<int>(long_route->keyframes.size());
-      long_route->keyframes.push_back(copy);
-    }
-  }
+  const auto long_route = LongRoute(*taught.route, 100);
   (*j)["route_1km_keyframes"] = long_route->keyframes.size();
   (*j)["repeat_step_1km_ms"] = repeat_median(long_route, 0, true);
   (*j)["repeat_step_fresh_1km_ms"] = repeat_median(long_route, 1, false);
@@ -181,28 +217,8 @@ void BenchTeachRepeat(nlohmann::json* j) {
     stock_orb->detectAndCompute(frames[static_cast<std::size_t>(i % n)], cv::noArray(), kp, desc);
   }));
   const double orb_ms = (*j)["opencv_orb500_320x240_ms"].get<double>();
-  // mapless's ORB settings (the FAST threshold 10) by OpenCV and by OrbDetector, which gives the
-  // same keypoints and descriptors (features/orb.h), on the same grey frames.
-  {
-    const features::FeatureOptions fo;
-    auto opencv = cv::ORB::create(fo.max_features, 1.2f, 8, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31,
-                                  fo.orb_fast_threshold);
-    const features::OrbDetector ours(fo.max_features, fo.orb_fast_threshold);
-    // Interleaved, frame by frame, so both see the same host speed.
-    std::vector<double> theirs_ms, ours_ms;
-    for (int i = 0; i < 120; ++i) {
-      const cv::Mat& g = grey[static_cast<std::size_t>(i % n)];
-      theirs_ms.push_back(
-          TimesMs(1, [&](int) { opencv->detectAndCompute(g, cv::noArray(), kp, desc); })[0]);
-      ours_ms.push_back(TimesMs(1, [&](int) { ours.DetectAndCompute(g, &kp, &desc); })[0]);
-    }
-    (*j)["opencv_orb_mapless_settings_320x240_ms"] = Median(theirs_ms);
-    (*j)["orb_detector_320x240_ms"] = Median(ours_ms);
-    (*j)["orb_detector_over_opencv_same_settings"] =
-        (*j)["orb_detector_320x240_ms"].get<double>() /
-        (*j)["opencv_orb_mapless_settings_320x240_ms"].get<double>();
-    (*j)["orb_detector_over_orb"] = (*j)["orb_detector_320x240_ms"].get<double>() / orb_ms;
-  }
+  BenchOrbSettings(grey, j);
+  (*j)["orb_detector_over_orb"] = (*j)["orb_detector_320x240_ms"].get<double>() / orb_ms;
   (*j)["repeat_step_over_orb"] = (*j)["repeat_step_ms"].get<double>() / orb_ms;
   (*j)["repeat_step_default_over_orb"] = (*j)["repeat_step_default_ms"].get<double>() / orb_ms;
   (*j)["repeat_step_default_mean_over_orb"] =

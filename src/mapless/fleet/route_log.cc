@@ -382,9 +382,9 @@ void RouteCopy::ApplyOne(const Record& record, std::optional<route::Keyframe>* d
     MAPLESS_CHECK(images_ < static_cast<std::size_t>(io::kMaxKeyframes),
                   what << ": more than " << io::kMaxKeyframes << " route images");
     route::StoredAppearanceImage image = route::ParseAppearanceEntry(record.parts[0], what);
-    image.low = !low.empty() ? low
-                             : io::DecodeImage(record.parts[1], what + " image",
-                                               cv::IMREAD_GRAYSCALE);
+    image.low = !low.empty()
+                    ? low
+                    : io::DecodeImage(record.parts[1], what + " image", cv::IMREAD_GRAYSCALE);
     MAPLESS_CHECK(image.low.cols == header_->low_width && image.low.rows == header_->low_height,
                   what << ": image is " << image.low.cols << "x" << image.low.rows
                        << ", the route's are " << header_->low_width << "x" << header_->low_height);

@@ -328,6 +328,69 @@ FollowerStep AppearanceFollower::Update(const cv::Mat& image, const Pose2& odome
   return step;
 }
 
+// Where on the route the robot is: Payá et al.'s Markov localization over the route images (one
+// Bayes update per markov_update_images of travel, within the window the distance driven allows),
+// or the nearest projection. False when the localization is lost (the step says so).
+bool AppearanceFollower::Localize(const appearance::Vector& projection, double advance_m,
+                                  const Pose2& odometry, const route::AppearanceRoute& route,
+                                  FollowerStep* step) {
+  const int n = route.size();
+  if (options_.use_markov) {
+    const double spacing = std::max(route.SpacingM(), 1e-3);
+    pending_advance_images_ += advance_m / spacing;
+    // One Bayes update per markov_update_images of travel: consecutive frames see nearly the same
+    // image and their errors are not independent (updating at every frame counts the same
+    // evidence many times over).
+    if (!have_localization_ || std::abs(pending_advance_images_) >= options_.markov_update_images ||
+        route.size() != last_route_size_) {
+      if (options_.ahead_margin_m >= 0.0 && options_.start_window_m > 0.0 && start_index_ >= 0) {
+        const double ahead_m =
+            driven_m_ * (1.0 + options_.ahead_fraction) + options_.ahead_margin_m;
+        const double behind_m = driven_m_ * (1.0 - options_.behind_fraction) -
+                                options_.ahead_margin_m - options_.start_window_m;
+        markov_.set_index_limits(
+            options_.behind_fraction < 1.0
+                ? start_index_ + static_cast<int>(std::floor(behind_m / spacing))
+                : -1,
+            start_index_ + static_cast<int>(std::ceil(ahead_m / spacing)));
+      }
+      markov_.set_uniform_mixing(since_localized_m_ < options_.uniform_mixing_for_m
+                                     ? options_.markov.uniform_mixing
+                                     : 0.0);
+      // Carrying on: the images are known not to fit here, so the belief moves by odometry alone.
+      last_localization_ =
+          carrying_ ? markov_.Predict(route.size(), pending_advance_images_)
+                    : markov_.Update(route.space.projections, projection, pending_advance_images_);
+      pending_advance_images_ = 0.0;
+      have_localization_ = true;
+      last_route_size_ = route.size();
+    }
+    const localization::Localization& loc = last_localization_;
+    step->index =
+        std::clamp(loc.index + static_cast<int>(std::lround(pending_advance_images_)), 0, n - 1);
+    step->probability = loc.probability;
+    const Eigen::VectorXd& belief = markov_.belief();
+    step->belief.resize(static_cast<std::size_t>(belief.size()));
+    for (Eigen::Index i = 0; i < belief.size(); ++i)
+      step->belief[static_cast<std::size_t>(i)] = static_cast<float>(belief[i]);
+    if (loc.status == localization::LocalizationStatus::kLost) {
+      StartInitialization(odometry, loc.index);
+      step->state = FollowerState::kStopped;
+      step->reason = "localization lost (probability " + std::to_string(loc.probability) +
+                     "); localizing again";
+      return false;
+    }
+  } else {
+    const std::vector<localization::Neighbour> nn =
+        localization::NearestProjections(route.space.projections, projection, 2);
+    step->index = nn.front().index;
+    step->probability = nn.size() > 1 && nn[1].distance > 0.0F
+                            ? 1.0 - static_cast<double>(nn[0].distance) / nn[1].distance
+                            : 1.0;
+  }
+  return true;
+}
+
 FollowerStep AppearanceFollower::Decide(const cv::Mat& image, const Pose2& odometry,
                                         const route::AppearanceRoute& route) {
   double advance_m = 0.0;
@@ -365,59 +428,7 @@ FollowerStep AppearanceFollower::Decide(const cv::Mat& image, const Pose2& odome
   if (initializing_) return Initialize(projection, odometry, route);
 
   const int n = route.size();
-  if (options_.use_markov) {
-    const double spacing = std::max(route.SpacingM(), 1e-3);
-    pending_advance_images_ += advance_m / spacing;
-    // One Bayes update per markov_update_images of travel: consecutive frames see nearly the same
-    // image and their errors are not independent (updating at every frame counts the same
-    // evidence many times over).
-    if (!have_localization_ || std::abs(pending_advance_images_) >= options_.markov_update_images ||
-        route.size() != last_route_size_) {
-      if (options_.ahead_margin_m >= 0.0 && options_.start_window_m > 0.0 && start_index_ >= 0) {
-        const double ahead_m =
-            driven_m_ * (1.0 + options_.ahead_fraction) + options_.ahead_margin_m;
-        const double behind_m = driven_m_ * (1.0 - options_.behind_fraction) -
-                                options_.ahead_margin_m - options_.start_window_m;
-        markov_.set_index_limits(
-            options_.behind_fraction < 1.0
-                ? start_index_ + static_cast<int>(std::floor(behind_m / spacing))
-                : -1,
-            start_index_ + static_cast<int>(std::ceil(ahead_m / spacing)));
-      }
-      markov_.set_uniform_mixing(since_localized_m_ < options_.uniform_mixing_for_m
-                                     ? options_.markov.uniform_mixing
-                                     : 0.0);
-      // Carrying on: the images are known not to fit here, so the belief moves by odometry alone.
-      last_localization_ =
-          carrying_ ? markov_.Predict(route.size(), pending_advance_images_)
-                    : markov_.Update(route.space.projections, projection, pending_advance_images_);
-      pending_advance_images_ = 0.0;
-      have_localization_ = true;
-      last_route_size_ = route.size();
-    }
-    const localization::Localization& loc = last_localization_;
-    step.index =
-        std::clamp(loc.index + static_cast<int>(std::lround(pending_advance_images_)), 0, n - 1);
-    step.probability = loc.probability;
-    const Eigen::VectorXd& belief = markov_.belief();
-    step.belief.resize(static_cast<std::size_t>(belief.size()));
-    for (Eigen::Index i = 0; i < belief.size(); ++i)
-      step.belief[static_cast<std::size_t>(i)] = static_cast<float>(belief[i]);
-    if (loc.status == localization::LocalizationStatus::kLost) {
-      StartInitialization(odometry, loc.index);
-      step.state = FollowerState::kStopped;
-      step.reason = "localization lost (probability " + std::to_string(loc.probability) +
-                    "); localizing again";
-      return step;
-    }
-  } else {
-    const std::vector<localization::Neighbour> nn =
-        localization::NearestProjections(route.space.projections, projection, 2);
-    step.index = nn.front().index;
-    step.probability = nn.size() > 1 && nn[1].distance > 0.0F
-                           ? 1.0 - static_cast<double>(nn[0].distance) / nn[1].distance
-                           : 1.0;
-  }
+  if (!Localize(projection, advance_m, odometry, route, &step)) return step;
   ++follow_frames_;
   if (route.complete && step.index >= n - 1 - options_.arrive_within_images &&
       follow_frames_ >= options_.min_follow_frames &&

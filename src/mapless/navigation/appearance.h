@@ -189,6 +189,8 @@ class AppearanceFollower {
  private:
   FollowerStep Decide(const cv::Mat& image, const Pose2& odometry,
                       const route::AppearanceRoute& route);
+  bool Localize(const appearance::Vector& projection, double advance_m, const Pose2& odometry,
+                const route::AppearanceRoute& route, FollowerStep* step);
   FollowerStep Initialize(const appearance::Vector& projection, const Pose2& odometry,
                           const route::AppearanceRoute& route);
   // centre_index < 0: around the route start (or the whole route when start_window_m is 0).

@@ -273,20 +273,52 @@ cv::Mat ObstacleWatch::FitGround(const std::vector<cv::Point2f>& here,
   return best;
 }
 
-ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, const std::vector<cv::Mat>& pyramid,
-                                  Timestamp t_ns, const std::vector<cv::Point2f>& known_px) {
-  ObstacleCheck check;
+const ObstacleWatch::Frame* ObstacleWatch::BaselineFrame(const cv::Size& size,
+                                                         Timestamp t_ns) const {
   // The newest frame at least a baseline behind; none when the robot turned too much since.
   const Frame* earlier = nullptr;
   for (auto it = history_.rbegin(); it != history_.rend(); ++it) {
     if (forward_m_ - it->forward_m < options_.baseline_m) continue;
     if (std::abs(turned_rad_ - it->turned_rad) <= options_.max_baseline_rad &&
-        ToSeconds(t_ns - it->t_ns) <= options_.max_age_s &&
-        it->pyramid.front().size() == grey.size()) {
+        ToSeconds(t_ns - it->t_ns) <= options_.max_age_s && it->pyramid.front().size() == size) {
       earlier = &*it;
     }
     break;
   }
+  return earlier;
+}
+
+void ObstacleWatch::Vote(const cv::Mat& grey, const cv::Rect& region, int obstacle_points,
+                         ObstacleCheck* check) {
+  check->observed = true;
+  check->blocked_fraction = static_cast<double>(obstacle_points) / check->region_points;
+  votes_ = check->blocked_fraction > options_.min_blocked_fraction ? votes_ + 1 : 0;
+  const bool at_once = check->blocked_fraction > options_.single_check_fraction &&
+                       obstacle_points >= options_.min_obstacle_points;
+  if (votes_ >= options_.confirm_frames || at_once) {
+    blocked_ = true;
+    blocked_at_fraction_ = check->blocked_fraction;
+    blocked_image_ = grey.clone();
+    blocked_mask_ = cv::Mat::zeros(region.size(), CV_8UC1);
+    for (const cv::Point2f& p : check->obstacle_px) {
+      cv::circle(blocked_mask_,
+                 cv::Point(static_cast<int>(p.x) - region.x, static_cast<int>(p.y) - region.y),
+                 options_.grid_px, cv::Scalar(255), cv::FILLED);
+    }
+    check->blocked = true;
+    std::ostringstream why;
+    why << "obstacle ahead: " << static_cast<int>(std::lround(100.0 * check->blocked_fraction))
+        << "% of the ground ahead does not move like the ground: stopped";
+    check->reason = why.str();
+    settle_ = 0;
+    free_votes_ = 0;
+  }
+}
+
+ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, const std::vector<cv::Mat>& pyramid,
+                                  Timestamp t_ns, const std::vector<cv::Point2f>& known_px) {
+  ObstacleCheck check;
+  const Frame* earlier = BaselineFrame(grey.size(), t_ns);
   if (earlier == nullptr) return check;  // not observable: keep the votes as they are
   const cv::Size size = grey.size();
   const cv::Rect region = Region(size);
@@ -378,29 +410,7 @@ ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, const std::vector<cv::Mat
   if (check.region_points < options_.min_region_points &&
       obstacle_points < options_.min_obstacle_points)
     return check;
-  check.observed = true;
-  check.blocked_fraction = static_cast<double>(obstacle_points) / check.region_points;
-  votes_ = check.blocked_fraction > options_.min_blocked_fraction ? votes_ + 1 : 0;
-  const bool at_once = check.blocked_fraction > options_.single_check_fraction &&
-                       obstacle_points >= options_.min_obstacle_points;
-  if (votes_ >= options_.confirm_frames || at_once) {
-    blocked_ = true;
-    blocked_at_fraction_ = check.blocked_fraction;
-    blocked_image_ = grey.clone();
-    blocked_mask_ = cv::Mat::zeros(region.size(), CV_8UC1);
-    for (const cv::Point2f& p : check.obstacle_px) {
-      cv::circle(blocked_mask_,
-                 cv::Point(static_cast<int>(p.x) - region.x, static_cast<int>(p.y) - region.y),
-                 options_.grid_px, cv::Scalar(255), cv::FILLED);
-    }
-    check.blocked = true;
-    std::ostringstream why;
-    why << "obstacle ahead: " << static_cast<int>(std::lround(100.0 * check.blocked_fraction))
-        << "% of the ground ahead does not move like the ground: stopped";
-    check.reason = why.str();
-    settle_ = 0;
-    free_votes_ = 0;
-  }
+  Vote(grey, region, obstacle_points, &check);
   return check;
 }
 

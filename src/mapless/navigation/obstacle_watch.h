@@ -154,6 +154,11 @@ class ObstacleWatch {
                     const std::vector<int>& draw) const;
   ObstacleCheck Look(const cv::Mat& grey, const std::vector<cv::Mat>& pyramid, Timestamp t_ns,
                      const std::vector<cv::Point2f>& known_px);
+  // The newest frame at least a baseline behind (null when the robot turned too much since, or
+  // it is too old).
+  const Frame* BaselineFrame(const cv::Size& size, Timestamp t_ns) const;
+  // The check observed the region: the votes, and the robot blocked when they say so.
+  void Vote(const cv::Mat& grey, const cv::Rect& region, int obstacle_points, ObstacleCheck* check);
   ObstacleCheck WatchBlocked(const cv::Mat& grey);
 
   ObstacleWatchOptions options_;

@@ -233,6 +233,9 @@ PotentialStep PotentialNavigator::Update(const cv::Mat& image, const Pose2& odom
   return step;
 }
 
+// Ohnishi & Imiya's navigation, one frame, in the stages below: the destination (Section 5.4's
+// turn round at it), turning in place, the motion the plane needs, the dominant plane of the flow
+// (Section 3), and the potential's force and command (Section 4, Eq. 11-17).
 PotentialStep PotentialNavigator::Decide(const cv::Mat& image, const Pose2& odometry) {
   MAPLESS_CHECK(image.cols == calibration_.width && image.rows == calibration_.height,
                 "PotentialNavigator: image is " << image.cols << "x" << image.rows
@@ -242,26 +245,7 @@ PotentialStep PotentialNavigator::Decide(const cv::Mat& image, const Pose2& odom
   step.leg = leg_;
   const cv::Mat grey = Grey(image);
   if (!start_) start_ = Eigen::Vector2d(odometry.x_m, odometry.y_m);
-  const double vmax = options_.potential.max_translation_mps;
-  const double turn_rate = options_.search_rate_fraction * options_.potential.max_rotation_radps;
-
-  if (destination_) {
-    const Eigen::Vector2d to = *destination_ - Eigen::Vector2d(odometry.x_m, odometry.y_m);
-    step.theta_d_rad = WrapAngle(std::atan2(to.y(), to.x()) - odometry.theta_rad);
-    goal_distance_m_ = to.norm();
-    if (status_ != PotentialStatus::kTurningAround && to.norm() <= options_.arrive_radius_m) {
-      if (options_.homing && leg_ == 0) {
-        // Section 5.4: turn 180 degrees, swap start and destination, navigate back.
-        leg_ = 1;
-        std::swap(*destination_, *start_);
-        status_ = PotentialStatus::kTurningAround;
-        turn_direction_ = 1.0;
-        turn_target_rad_ = odometry.theta_rad + kPi;
-      } else {
-        status_ = PotentialStatus::kArrived;
-      }
-    }
-  }
+  UpdateGoal(odometry, &step);
   if (finished()) {
     step.status = status_;
     step.reason = status_ == PotentialStatus::kArrived ? "destination reached" : "aborted";
@@ -270,22 +254,53 @@ PotentialStep PotentialNavigator::Decide(const cv::Mat& image, const Pose2& odom
     return step;
   }
   step.leg = leg_;
+  if (TurnInPlace(grey, odometry, &step) || WaitForMotion(grey, odometry, &step)) return step;
+  ground::DominantPlane plane;
+  cv::Mat flow;
+  if (!FindGround(grey, odometry, &plane, &flow, &step)) return step;
+  Steer(grey, odometry, plane, flow, &step);
+  status_ = PotentialStatus::kDriving;
+  step.status = status_;
+  return step;
+}
 
+void PotentialNavigator::UpdateGoal(const Pose2& odometry, PotentialStep* step) {
+  if (!destination_) return;
+  const Eigen::Vector2d to = *destination_ - Eigen::Vector2d(odometry.x_m, odometry.y_m);
+  step->theta_d_rad = WrapAngle(std::atan2(to.y(), to.x()) - odometry.theta_rad);
+  goal_distance_m_ = to.norm();
+  if (status_ != PotentialStatus::kTurningAround && to.norm() <= options_.arrive_radius_m) {
+    if (options_.homing && leg_ == 0) {
+      // Section 5.4: turn 180 degrees, swap start and destination, navigate back.
+      leg_ = 1;
+      std::swap(*destination_, *start_);
+      status_ = PotentialStatus::kTurningAround;
+      turn_direction_ = 1.0;
+      turn_target_rad_ = odometry.theta_rad + kPi;
+    } else {
+      status_ = PotentialStatus::kArrived;
+    }
+  }
+}
+
+bool PotentialNavigator::TurnInPlace(const cv::Mat& grey, const Pose2& odometry,
+                                     PotentialStep* step) {
+  const double turn_rate = options_.search_rate_fraction * options_.potential.max_rotation_radps;
   // Turning in place (searching, or turning round at the destination) until the target heading.
   if (status_ == PotentialStatus::kSearching || status_ == PotentialStatus::kTurningAround) {
     const double left = turn_direction_ * WrapAngle(turn_target_rad_ - odometry.theta_rad);
     if (left > 0.02) {
-      step.status = status_;
-      step.reason = status_ == PotentialStatus::kSearching
-                        ? "no ground plane: turning in place to look for free ground"
-                        : "destination reached: turning round to go home";
+      step->status = status_;
+      step->reason = status_ == PotentialStatus::kSearching
+                         ? "no ground plane: turning in place to look for free ground"
+                         : "destination reached: turning round to go home";
       // Slow down near the target so the turn does not overshoot by a frame.
       const double period = std::max(calibration_.period_s, 1e-3);
       const double rate = std::min(turn_rate, left / period);
-      step.command = {0.0, turn_direction_ * rate};
+      step->command = {0.0, turn_direction_ * rate};
       previous_ = grey;
       previous_odometry_ = odometry;
-      return step;
+      return true;
     }
     if (status_ == PotentialStatus::kTurningAround) search_steps_ = 0;
     misses_ = 0;
@@ -294,6 +309,12 @@ PotentialStep PotentialNavigator::Decide(const cv::Mat& image, const Pose2& odom
     status_ = PotentialStatus::kLooking;
   }
 
+  return false;
+}
+
+bool PotentialNavigator::WaitForMotion(const cv::Mat& grey, const Pose2& odometry,
+                                       PotentialStep* step) {
+  const double vmax = options_.potential.max_translation_mps;
   // The plane is observable only when the camera translated between the two frames.
   const double moved =
       std::hypot(odometry.x_m - previous_odometry_.x_m, odometry.y_m - previous_odometry_.y_m);
@@ -303,19 +324,26 @@ PotentialStep PotentialNavigator::Decide(const cv::Mat& image, const Pose2& odom
     // would drive blind towards it, so turn away first.
     previous_ = grey;
     previous_odometry_ = odometry;
-    return Search(step, odometry,
-                  last_plane_found_ ? "stopped with an obstacle ahead" : "no ground plane");
+    *step = Search(*step, odometry,
+                   last_plane_found_ ? "stopped with an obstacle ahead" : "no ground plane");
+    return true;
   }
   if (previous_.empty() || moved < options_.min_motion_m) {
     status_ = PotentialStatus::kLooking;
-    step.status = status_;
-    step.reason = "creeping forward one frame to see the ground move";
-    step.command = {options_.creep_fraction * vmax, 0.0};
+    step->status = status_;
+    step->reason = "creeping forward one frame to see the ground move";
+    step->command = {options_.creep_fraction * vmax, 0.0};
     previous_ = grey;
     previous_odometry_ = odometry;
-    return step;
+    return true;
   }
 
+  return false;
+}
+
+bool PotentialNavigator::FindGround(const cv::Mat& grey, const Pose2& odometry,
+                                    ground::DominantPlane* found, cv::Mat* flow_out,
+                                    PotentialStep* step) {
   cv::Mat flow = flow::ComputeFlow(previous_, grey, options_.flow);
   const Pose2 motion = previous_odometry_.Inverse() * odometry;  // this frame's, by odometry
   previous_ = grey;
@@ -333,18 +361,18 @@ PotentialStep PotentialNavigator::Decide(const cv::Mat& image, const Pose2& odom
   ground::DominantPlane plane = ground::DetectDominantPlane(flow, plane_options);
   bool not_ground = false;
   if (plane.found && options_.ground_check_tolerance > 0.0) {
-    step.ground_mismatch = GroundMismatch(plane.model, motion);
-    not_ground = step.ground_mismatch > options_.ground_check_tolerance;
+    step->ground_mismatch = GroundMismatch(plane.model, motion);
+    not_ground = step->ground_mismatch > options_.ground_check_tolerance;
     if (not_ground) {
       plane.found = false;
       plane.mask.setTo(0);
     }
   }
-  step.plane_found = plane.found;
-  step.plane_fraction = plane.roi_fraction;
+  step->plane_found = plane.found;
+  step->plane_fraction = plane.roi_fraction;
   last_plane_fraction_ = plane.roi_fraction;
   last_plane_found_ = plane.found;
-  step.plane_mask = plane.mask;
+  step->plane_mask = plane.mask;
   if (!plane.found) {
     std::ostringstream why;
     if (not_ground) {
@@ -354,17 +382,29 @@ PotentialStep PotentialNavigator::Decide(const cv::Mat& image, const Pose2& odom
       why << "no ground plane (" << static_cast<int>(std::lround(100.0 * plane.roi_fraction))
           << "% of the view)";
     }
-    if (++misses_ >= options_.misses_before_search) return Search(step, odometry, why.str());
+    if (++misses_ >= options_.misses_before_search) {
+      *step = Search(*step, odometry, why.str());
+      return false;
+    }
     // Stop and look again (the next frame, standing, cannot see: it creeps one frame).
     status_ = PotentialStatus::kLooking;
-    step.status = status_;
-    step.reason = why.str() + ": stopped to look again";
-    step.command = {};
-    return step;
+    step->status = status_;
+    step->reason = why.str() + ": stopped to look again";
+    step->command = {};
+    return false;
   }
   search_steps_ = 0;
   misses_ = 0;
 
+  *found = plane;
+  *flow_out = flow;
+  return true;
+}
+
+void PotentialNavigator::Steer(const cv::Mat& grey, const Pose2& odometry,
+                               const ground::DominantPlane& plane, const cv::Mat& flow,
+                               PotentialStep* step) {
+  const double vmax = options_.potential.max_translation_mps;
   if (options_.min_free_ahead > 0.0) {
     // The safety window: the ground just in front of the robot (the bottom-centre of the image),
     // measured on the detected map (before any experimental noise below).
@@ -372,10 +412,10 @@ PotentialStep PotentialNavigator::Decide(const cv::Mat& image, const Pose2& odom
     const int h = std::max(1, static_cast<int>(std::lround(m.rows * options_.ahead_rows)));
     const int w = std::max(1, static_cast<int>(std::lround(m.cols * options_.ahead_cols)));
     const cv::Rect ahead((m.cols - w) / 2, m.rows - h, w, h);
-    step.free_ahead = static_cast<double>(cv::countNonZero(m(ahead))) / ahead.area();
+    step->free_ahead = static_cast<double>(cv::countNonZero(m(ahead))) / ahead.area();
   }
   // The map the potential sees: the detected one, or (robustness experiments) a copy with
-  // inverted pixels, so step.plane_mask stays the detection.
+  // inverted pixels, so step->plane_mask stays the detection.
   cv::Mat map = plane.mask;
   if (options_.plane_noise_fraction > 0.0) {
     map = plane.mask.clone();
@@ -397,7 +437,7 @@ PotentialStep PotentialNavigator::Decide(const cv::Mat& image, const Pose2& odom
     cv::resize(ground::PlanarFlow(plane.model, flow.size()) / (flow_scale_ * options_.plane_scale),
                attraction, work_size_, 0, 0, cv::INTER_AREA);
   } else {
-    attraction = control::DesiredFlow(translational_flow_, rotational_flow_, step.theta_d_rad);
+    attraction = control::DesiredFlow(translational_flow_, rotational_flow_, step->theta_d_rad);
   }
   control::VisualPotentialOptions potential_options = options_.potential;
   potential_options.work_width_px = std::min(d.cols, options_.potential.work_width_px);
@@ -410,38 +450,35 @@ PotentialStep PotentialNavigator::Decide(const cv::Mat& image, const Pose2& odom
       have_force_ ? options_.force_filter * force + (1.0 - options_.force_filter) * filtered_force_
                   : force;
   have_force_ = true;
-  step.force = filtered_force_;
-  const control::PotentialCommand c = control::CommandFromForce(step.force, options_.potential);
-  step.theta_rad = c.theta_rad;
+  step->force = filtered_force_;
+  const control::PotentialCommand c = control::CommandFromForce(step->force, options_.potential);
+  step->theta_rad = c.theta_rad;
   last_theta_rad_ = c.theta_rad;
-  step.command = c.twist;
-  if (!options_.allow_reverse && step.command.v_mps < 0.0) {
+  step->command = c.twist;
+  if (!options_.allow_reverse && step->command.v_mps < 0.0) {
     // A force pointing backwards: a robot that does not reverse turns in place towards it at the
     // full rate (Eq. 17 would give R -> 0 as the force points straight back).
-    step.command.v_mps = 0.0;
-    step.command.omega_radps =
+    step->command.v_mps = 0.0;
+    step->command.omega_radps =
         (c.theta_rad >= 0.0 ? 1.0 : -1.0) * options_.potential.max_rotation_radps;
   }
-  if (step.free_ahead < options_.min_free_ahead) {
+  if (step->free_ahead < options_.min_free_ahead) {
     // An obstacle close in front: no forward motion; turn in place towards the force's side.
-    step.command.v_mps = 0.0;
-    step.command.omega_radps =
+    step->command.v_mps = 0.0;
+    step->command.omega_radps =
         AvoidanceDirection(odometry, c.theta_rad) * options_.potential.max_rotation_radps;
-    step.reason = "obstacle just ahead: turning in place";
+    step->reason = "obstacle just ahead: turning in place";
   }
   if (options_.full_speed_plane_fraction > options_.plane.min_plane_fraction) {
     const double lo = options_.plane.min_plane_fraction;
-    step.command.v_mps *=
+    step->command.v_mps *=
         std::clamp((plane.roi_fraction - lo) / (options_.full_speed_plane_fraction - lo), 0.0, 1.0);
   }
   if (goal_distance_m_ >= 0.0 && goal_distance_m_ < options_.approach_radius_m) {
     const double cap = std::max(options_.creep_fraction * vmax,
                                 vmax * goal_distance_m_ / options_.approach_radius_m);
-    step.command.v_mps = std::min(step.command.v_mps, cap);
+    step->command.v_mps = std::min(step->command.v_mps, cap);
   }
-  status_ = PotentialStatus::kDriving;
-  step.status = status_;
-  return step;
 }
 
 }  // namespace mapless::navigation

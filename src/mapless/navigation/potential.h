@@ -165,6 +165,15 @@ class PotentialNavigator {
 
  private:
   PotentialStep Decide(const cv::Mat& image, const Pose2& odometry);
+  // The stages of Decide; those returning bool are true when they decided the frame (TurnInPlace,
+  // WaitForMotion) or when there is ground to steer on (FindGround: false when it decided).
+  void UpdateGoal(const Pose2& odometry, PotentialStep* step);
+  bool TurnInPlace(const cv::Mat& grey, const Pose2& odometry, PotentialStep* step);
+  bool WaitForMotion(const cv::Mat& grey, const Pose2& odometry, PotentialStep* step);
+  bool FindGround(const cv::Mat& grey, const Pose2& odometry, ground::DominantPlane* plane,
+                  cv::Mat* flow, PotentialStep* step);
+  void Steer(const cv::Mat& grey, const Pose2& odometry, const ground::DominantPlane& plane,
+             const cv::Mat& flow, PotentialStep* step);
   PotentialStep Search(PotentialStep step, const Pose2& odometry, const std::string& why);
   double GroundMismatch(const cv::Mat& model, const Pose2& motion) const;
   // +1 (left) or -1: the side of theta, or the side chosen by a turn within escape_distance_m.

@@ -267,6 +267,9 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns,
   return step;
 }
 
+// Algorithm 1 of Kassir et al., one frame, in the stages below: the leader's next keyframe (a live
+// route), tracking and matching the destination, recovery and carrying on where it no longer
+// matches, waiting, the switch to the next segment (line 9), and the funnel lane (line 19).
 RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
   RepeatStep step;
   step.destination = destination_;
@@ -276,32 +279,52 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
                 "RepeatSession: frame is " << grey.cols << "x" << grey.rows
                                            << " but the route was taught at " << route_->image_width
                                            << "x" << route_->image_height);
+  if (waiting_for_route_ && !NextTaughtKeyframe(&step)) return step;
+  const bool short_long = TrackDestination(grey, t_ns, &step);
+  if (HoldOrCarryOn(t_ns, short_long, &step)) return step;
+  std::vector<control::FeaturePair> pairs = Pairs();
+  if (SwitchSegment(grey, t_ns, &pairs, &step)) return step;
+  // Line 19: control with the funnel lane.
+  if (options_.controller == Controller::kSloped) {
+    step.sloped = control::ComputeSlopedFunnelLane(pairs, options_.sloped);
+    step.command = step.sloped.twist;
+  } else {
+    step.standard = control::ComputeStandardFunnelLane(pairs, options_.standard);
+    step.command = step.standard.twist;
+  }
+  step.status = RepeatStatus::kDriving;
+  return step;
+}
 
+bool RepeatSession::NextTaughtKeyframe(RepeatStep* step) {
   const int known = static_cast<int>(route_->keyframes.size());
-  if (waiting_for_route_) {
-    if (destination_ + 1 >= known) {
-      previous_.release();
-      current_px_.clear();
-      destination_px_.clear();
-      scene_px_.clear();
-      if (route_->complete)
-        return Stop(step, RepeatStatus::kCompleted, "route completed: passed the last keyframe");
-      return Stop(step, RepeatStatus::kWaiting,
-                  "waiting for the leader: keyframe " + std::to_string(destination_) +
-                      " is the last it has taught so far");
-    }
-    // The leader taught the next keyframe: switch to it as at any segment switch.
-    waiting_for_route_ = false;
-    MarkSwitch();
-    ++destination_;
-    step.switched = true;
-    step.destination = destination_;
-    have_expected_dx_ = false;  // the robot stood still: no prediction from the last segment
+  if (destination_ + 1 >= known) {
+    previous_.release();
     current_px_.clear();
     destination_px_.clear();
     scene_px_.clear();
+    if (route_->complete)
+      *step = Stop(*step, RepeatStatus::kCompleted, "route completed: passed the last keyframe");
+    else
+      *step = Stop(*step, RepeatStatus::kWaiting,
+                   "waiting for the leader: keyframe " + std::to_string(destination_) +
+                       " is the last it has taught so far");
+    return false;
   }
+  // The leader taught the next keyframe: switch to it as at any segment switch.
+  waiting_for_route_ = false;
+  MarkSwitch();
+  ++destination_;
+  step->switched = true;
+  step->destination = destination_;
+  have_expected_dx_ = false;  // the robot stood still: no prediction from the last segment
+  current_px_.clear();
+  destination_px_.clear();
+  scene_px_.clear();
+  return true;
+}
 
+bool RepeatSession::TrackDestination(const cv::Mat& grey, Timestamp t_ns, RepeatStep* step) {
   // Periodic refresh (an option; see RepeatOptions::redetect_every_frames): no point tracking
   // features that are about to be replaced.
   ++frames_since_detect_;
@@ -326,48 +349,53 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
   previous_ = grey.clone();
   // Lines 20-27: too few features left, detect and match again (or refresh).
   if (static_cast<int>(current_px_.size()) < options_.min_features || refresh)
-    DetectAndMatch(grey, &step);
-  step.matches = last_matches_;
-  step.tracked = static_cast<int>(current_px_.size());
+    DetectAndMatch(grey, step);
+  step->matches = last_matches_;
+  step->tracked = static_cast<int>(current_px_.size());
   // The destination is short of features from a frame with fewer than min_features until one
   // matches it as well as a recovered keyframe must: a few matches that come and go (the
   // landmarks' surroundings, the robot creeping a frame at a time) do not end the shortage.
   const int found = std::max(options_.recovery_min_features, options_.min_features);
-  if (step.tracked < options_.min_features && !short_since_ns_) short_since_ns_ = t_ns;
-  if (step.tracked >= found) short_since_ns_.reset();
+  if (step->tracked < options_.min_features && !short_since_ns_) short_since_ns_ = t_ns;
+  if (step->tracked >= found) short_since_ns_.reset();
   // Back on the route after a detour: the keyframe that matches best (the detour may have taken
   // the robot past the destination and more).
   if (reacquire_) {
     reacquire_ = false;
-    Reacquire(&step);
-    step.matches = last_matches_;
-    step.tracked = static_cast<int>(current_px_.size());
+    Reacquire(step);
+    step->matches = last_matches_;
+    step->tracked = static_cast<int>(current_px_.size());
   }
   // Keyframe recovery, once the destination has been short for recovery_after_s (a shortage
   // that passes by itself is waited out, not skipped).
-  const bool short_long = step.tracked < options_.min_features && short_since_ns_ &&
+  const bool short_long = step->tracked < options_.min_features && short_since_ns_ &&
                           ToSeconds(t_ns - *short_since_ns_) >= options_.recovery_after_s;
   // While carrying on, CarryOn tries every keyframe recovery would (and farther): not twice.
-  if (short_long && !carrying_ && Recover(&step)) {
-    step.matches = last_matches_;
-    step.tracked = static_cast<int>(current_px_.size());
+  if (short_long && !carrying_ && Recover(step)) {
+    step->matches = last_matches_;
+    step->tracked = static_cast<int>(current_px_.size());
   }
+  return short_long;
+}
+
+bool RepeatSession::HoldOrCarryOn(Timestamp t_ns, bool short_long, RepeatStep* step) {
   // Carrying on through keyframes that recovery could not find (RepeatOptions::carry_on), until
   // the destination or a following keyframe matches as well as a recovered keyframe must.
-  const bool carry = carry_active_ ? step.tracked < found : short_long && !step.switched;
+  const int found = std::max(options_.recovery_min_features, options_.min_features);
+  const bool carry = carry_active_ ? step->tracked < found : short_long && !step->switched;
   if (carry) {
-    if (const std::optional<Twist2> command = CarryOn(t_ns, &step)) {
-      step.command = *command;
-      step.status = RepeatStatus::kDriving;
-      return step;
+    if (const std::optional<Twist2> command = CarryOn(t_ns, step)) {
+      step->command = *command;
+      step->status = RepeatStatus::kDriving;
+      return true;
     }
-    step.matches = last_matches_;
-    step.tracked = static_cast<int>(current_px_.size());
+    step->matches = last_matches_;
+    step->tracked = static_cast<int>(current_px_.size());
   }
   // The destination matches again: the funnel lane drives; carrying on resumes where it was
   // if the destination is lost again.
-  if (step.tracked >= found) carry_active_ = false;
-  if (step.tracked < options_.min_features) {
+  if (step->tracked >= found) carry_active_ = false;
+  if (step->tracked < options_.min_features) {
     // Stop while features are insufficient; abort if that lasts too long.
     if (!waiting_) {
       waiting_ = true;
@@ -376,25 +404,29 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
     const double waited = ToSeconds(t_ns - waiting_since_ns_);
     if (waited > options_.guided_release_s) have_expected_dx_ = false;
     if (waited > options_.abort_after_s) {
-      return Stop(step, RepeatStatus::kAborted,
-                  "aborted: fewer than " + std::to_string(options_.min_features) +
-                      " features matched keyframe " + std::to_string(destination_) + " for " +
-                      std::to_string(static_cast<int>(waited)) + " s");
+      *step = Stop(*step, RepeatStatus::kAborted,
+                   "aborted: fewer than " + std::to_string(options_.min_features) +
+                       " features matched keyframe " + std::to_string(destination_) + " for " +
+                       std::to_string(static_cast<int>(waited)) + " s");
+      return true;
     }
-    step = Stop(step, RepeatStatus::kWaiting,
-                "stopped: only " + std::to_string(step.tracked) + " features match keyframe " +
-                    std::to_string(destination_) + " (need " +
-                    std::to_string(options_.min_features) + ")");
-    return step;
+    *step = Stop(*step, RepeatStatus::kWaiting,
+                 "stopped: only " + std::to_string(step->tracked) + " features match keyframe " +
+                     std::to_string(destination_) + " (need " +
+                     std::to_string(options_.min_features) + ")");
+    return true;
   }
   waiting_ = false;
   expected_dx_ = MedianDx(destination_px_, current_px_);
   have_expected_dx_ = true;
+  return false;
+}
 
+bool RepeatSession::SwitchSegment(const cv::Mat& grey, Timestamp t_ns,
+                                  std::vector<control::FeaturePair>* pairs, RepeatStep* step) {
   // Line 9: switch to the next segment.
-  std::vector<control::FeaturePair> pairs = Pairs();
-  step.switching = control::CheckSwitch(pairs, options_.switch_rule);
-  const bool enough = static_cast<int>(pairs.size()) >= options_.min_switch_features;
+  step->switching = control::CheckSwitch(*pairs, options_.switch_rule);
+  const bool enough = static_cast<int>(pairs->size()) >= options_.min_switch_features;
   const bool last = destination_ + 1 >= static_cast<int>(route_->keyframes.size());
   // The route's end (or every keyframe with Switching::kLocalScale): the local scale instead of
   // StdRatio (see RepeatOptions); with too few nearby pairs (a sparse view), StdRatio.
@@ -405,64 +437,56 @@ RepeatStep RepeatSession::Decide(const cv::Mat& image, Timestamp t_ns) {
       points.push_back(
           {current_px_[i].x, current_px_[i].y, destination_px_[i].x, destination_px_[i].y});
     }
-    step.local_scale = control::MeasureLocalScale(points, options_.local_scale);
+    step->local_scale = control::MeasureLocalScale(points, options_.local_scale);
   }
-  const bool by_scale = step.local_scale.ok;
-  const bool condition = by_scale ? step.local_scale.ratio > options_.switch_rule.min_std_ratio &&
-                                        step.switching.ed_px < options_.switch_rule.max_ed_px
-                                  : step.switching.switch_now;
+  const bool by_scale = step->local_scale.ok;
+  const bool condition = by_scale ? step->local_scale.ratio > options_.switch_rule.min_std_ratio &&
+                                        step->switching.ed_px < options_.switch_rule.max_ed_px
+                                  : step->switching.switch_now;
   switch_votes_ = (condition && enough) ? switch_votes_ + 1 : 0;
-  const bool mse_says = options_.switching == Switching::kMse && mse_.Update(pairs) && enough;
+  const bool mse_says = options_.switching == Switching::kMse && mse_.Update(*pairs) && enough;
   const int confirm = last ? options_.final_confirm_frames : options_.switch_confirm_frames;
   const bool switch_now =
       options_.switching != Switching::kMse || by_scale ? switch_votes_ >= confirm : mse_says;
-  if (switch_now) {
-    step.switched = true;
-    MarkSwitch();
-    ++destination_;
-    mse_.Reset();
-    switch_votes_ = 0;
-    step.destination = destination_;
-    if (destination_ >= static_cast<int>(route_->keyframes.size())) {
-      destination_ = static_cast<int>(route_->keyframes.size()) - 1;
-      step.destination = destination_;
-      if (!route_->complete && options_.wait_for_leader) {
-        waiting_for_route_ = true;
-        return Stop(step, RepeatStatus::kWaiting,
-                    "waiting for the leader: keyframe " + std::to_string(destination_) +
-                        " is the last it has taught so far");
-      }
-      return Stop(step, RepeatStatus::kCompleted, "route completed: passed the last keyframe");
+  if (!switch_now) return false;
+  step->switched = true;
+  MarkSwitch();
+  ++destination_;
+  mse_.Reset();
+  switch_votes_ = 0;
+  step->destination = destination_;
+  if (destination_ >= static_cast<int>(route_->keyframes.size())) {
+    destination_ = static_cast<int>(route_->keyframes.size()) - 1;
+    step->destination = destination_;
+    if (!route_->complete && options_.wait_for_leader) {
+      waiting_for_route_ = true;
+      *step = Stop(*step, RepeatStatus::kWaiting,
+                   "waiting for the leader: keyframe " + std::to_string(destination_) +
+                       " is the last it has taught so far");
+      return true;
     }
-    // Predict the displacement against the new destination: the current one against the old
-    // destination, minus how far features moved from it to the new one during the teach.
-    const auto& next = route_->keyframes[static_cast<std::size_t>(destination_)];
-    if (!next.segment_start_px.empty())
-      expected_dx_ -= MedianDx(next.segment_start_px, next.segment_end_px);
-    // Lines 11-14: detect and match against the new destination.
-    DetectAndMatch(grey, &step);
-    step.matches = last_matches_;
-    step.tracked = static_cast<int>(current_px_.size());
-    if (step.tracked < options_.min_features) {
-      waiting_ = true;
-      waiting_since_ns_ = t_ns;
-      return Stop(step, RepeatStatus::kWaiting,
-                  "stopped: only " + std::to_string(step.tracked) + " features match keyframe " +
-                      std::to_string(destination_));
-    }
-    pairs = Pairs();
+    *step = Stop(*step, RepeatStatus::kCompleted, "route completed: passed the last keyframe");
+    return true;
   }
-
-  // Line 19: control with the funnel lane.
-  if (options_.controller == Controller::kSloped) {
-    step.sloped = control::ComputeSlopedFunnelLane(pairs, options_.sloped);
-    step.command = step.sloped.twist;
-  } else {
-    step.standard = control::ComputeStandardFunnelLane(pairs, options_.standard);
-    step.command = step.standard.twist;
+  // Predict the displacement against the new destination: the current one against the old
+  // destination, minus how far features moved from it to the new one during the teach.
+  const auto& next = route_->keyframes[static_cast<std::size_t>(destination_)];
+  if (!next.segment_start_px.empty())
+    expected_dx_ -= MedianDx(next.segment_start_px, next.segment_end_px);
+  // Lines 11-14: detect and match against the new destination.
+  DetectAndMatch(grey, step);
+  step->matches = last_matches_;
+  step->tracked = static_cast<int>(current_px_.size());
+  if (step->tracked < options_.min_features) {
+    waiting_ = true;
+    waiting_since_ns_ = t_ns;
+    *step = Stop(*step, RepeatStatus::kWaiting,
+                 "stopped: only " + std::to_string(step->tracked) + " features match keyframe " +
+                     std::to_string(destination_));
+    return true;
   }
-  step.status = RepeatStatus::kDriving;
-  return step;
+  *pairs = Pairs();
+  return false;
 }
 
 }  // namespace mapless::navigation

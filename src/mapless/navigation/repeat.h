@@ -171,6 +171,17 @@ class RepeatSession {
 
  private:
   RepeatStep Decide(const cv::Mat& image, Timestamp t_ns);
+  // The stages of Decide, each true when the frame's decision is made (returned in `step`):
+  // A live route: on to the keyframe the leader taught since (false: still waiting, or done).
+  bool NextTaughtKeyframe(RepeatStep* step);
+  // Algorithm 1, lines 16-18 and 20-27, with reacquiring and keyframe recovery; true when the
+  // destination has been short of features for recovery_after_s.
+  bool TrackDestination(const cv::Mat& grey, Timestamp t_ns, RepeatStep* step);
+  // Carrying on along the taught odometry, or stopping (and aborting) while too few match.
+  bool HoldOrCarryOn(Timestamp t_ns, bool short_long, RepeatStep* step);
+  // Line 9: the switch to the next segment (and the route's end); `pairs` then for the new one.
+  bool SwitchSegment(const cv::Mat& grey, Timestamp t_ns, std::vector<control::FeaturePair>* pairs,
+                     RepeatStep* step);
   void DetectAndMatch(const cv::Mat& grey, RepeatStep* step);
   // The current frame's features (extracted once per frame) matched with keyframe k, outliers
   // rejected: current pixels and keyframe pixels.

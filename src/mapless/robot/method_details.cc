@@ -81,8 +81,7 @@ void PotentialDetail::Draw(cv::Mat* out, double, std::vector<std::string>* lines
     cv::arrowedLine(*out, centre, tip, kRed, 2, cv::LINE_AA);
   }
   lines->push_back("plane " + FixedText(s.plane_fraction, 2) + "  ahead " +
-                   FixedText(s.free_ahead, 2) + "  theta " +
-                   FixedText(RadToDeg(s.theta_rad), 1));
+                   FixedText(s.free_ahead, 2) + "  theta " + FixedText(RadToDeg(s.theta_rad), 1));
 }
 
 // ---- follow: the localization and the sub-window fit ------------------------------------------

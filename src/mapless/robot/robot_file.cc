@@ -79,6 +79,72 @@ void RobotFile::Validate() const {
   obstacle.Validate();
 }
 
+namespace {
+
+// The section `topics`: each topic valid, and each role's topic another.
+void ParseTopics(const io::YamlMap& t, RobotFile* r) {
+  t.CheckKnownKeys(
+      {"image", "compressed_image", "odometry", "cmd_vel", "status", "debug_image", "estop"});
+  auto get = [&](const char* key, std::string* field, bool may_be_empty) {
+    *field = t.GetString(key, *field);
+    CheckTopic(t, key, *field, may_be_empty);
+  };
+  get("image", &r->topics.image, false);
+  get("compressed_image", &r->topics.compressed_image, true);
+  get("odometry", &r->topics.odometry, true);
+  get("cmd_vel", &r->topics.cmd_vel, false);
+  get("status", &r->topics.status, false);
+  get("debug_image", &r->topics.debug_image, true);
+  get("estop", &r->topics.estop, true);
+  // One topic for two roles (cmd_vel on the camera topic, say) would feed mapless its own
+  // messages or drive the robot with them: every topic it uses must be another.
+  const std::pair<const char*, const std::string*> roles[] = {
+      {"image", &r->topics.image},       {"compressed_image", &r->topics.compressed_image},
+      {"odometry", &r->topics.odometry}, {"cmd_vel", &r->topics.cmd_vel},
+      {"status", &r->topics.status},     {"debug_image", &r->topics.debug_image},
+      {"estop", &r->topics.estop}};
+  for (std::size_t i = 0; i < std::size(roles); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      if (roles[i].second->empty() || r->Resolve(*roles[i].second) != r->Resolve(*roles[j].second))
+        continue;
+      t.Fail(roles[i].first, "'" + *roles[i].second + "' is also the " + roles[j].first +
+                                 " topic; each role needs a topic of its own");
+    }
+  }
+}
+
+// The section `obstacles`: the obstacle watch (navigation/obstacle_watch.h).
+void ParseObstacles(const io::YamlMap& o, RobotFile* r) {
+  o.CheckKnownKeys({"on_obstacle", "region_top", "region_width", "region_half_width_m", "horizon",
+                    "baseline_m", "min_blocked_fraction"});
+  const std::string on = o.GetString("on_obstacle", "stop");
+  if (on != "stop" && on != "avoid" && on != "off")
+    o.Fail("on_obstacle", "'" + on + "' is not stop, avoid or off");
+  r->obstacle.enabled = on != "off";
+  r->obstacle.avoid = on == "avoid";
+  const auto fraction = [&](const std::string& key, double fallback, double lo, double hi) {
+    const double v = o.GetDouble(key, fallback);
+    if (!std::isfinite(v) || v < lo || v > hi)
+      o.Fail(key, "must be in [" + std::to_string(lo).substr(0, 4) + ", " +
+                      std::to_string(hi).substr(0, 4) + "]");
+    return v;
+  };
+  r->obstacle.region_top = fraction("region_top", r->obstacle.region_top, 0.0, 0.95);
+  r->obstacle.fit_top = std::min(r->obstacle.fit_top, r->obstacle.region_top);
+  r->obstacle.region_width = fraction("region_width", r->obstacle.region_width, 0.05, 1.0);
+  r->obstacle.region_half_width_m =
+      fraction("region_half_width_m", r->obstacle.region_half_width_m, 0.05, 2.0);
+  r->obstacle.horizon = fraction("horizon", r->obstacle.horizon, 0.0, 0.94);
+  if (r->obstacle.horizon >= r->obstacle.region_top)
+    o.Fail("horizon", "must be above region_top (a smaller fraction)");
+  r->obstacle.baseline_m = fraction("baseline_m", r->obstacle.baseline_m, 0.01, 1.0);
+  r->obstacle_baseline_given = o.Has("baseline_m");
+  r->obstacle.min_blocked_fraction =
+      fraction("min_blocked_fraction", r->obstacle.min_blocked_fraction, 0.01, 0.99);
+}
+
+}  // namespace
+
 RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
   return io::WithYamlErrors(name, [&] {
     const io::YamlMap map = io::YamlMap::LoadString(text, name);
@@ -102,38 +168,7 @@ RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
     r.node_name = map.GetString("node_name", r.node_name);
     if (!ValidTopic(r.node_name) || r.node_name.find('/') != std::string::npos)
       map.Fail("node_name", "'" + r.node_name + "' is not a ROS node name");
-    if (map.Has("topics")) {
-      const io::YamlMap t = map.GetMap("topics");
-      t.CheckKnownKeys(
-          {"image", "compressed_image", "odometry", "cmd_vel", "status", "debug_image", "estop"});
-      auto get = [&](const char* key, std::string* field, bool may_be_empty) {
-        *field = t.GetString(key, *field);
-        CheckTopic(t, key, *field, may_be_empty);
-      };
-      get("image", &r.topics.image, false);
-      get("compressed_image", &r.topics.compressed_image, true);
-      get("odometry", &r.topics.odometry, true);
-      get("cmd_vel", &r.topics.cmd_vel, false);
-      get("status", &r.topics.status, false);
-      get("debug_image", &r.topics.debug_image, true);
-      get("estop", &r.topics.estop, true);
-      // One topic for two roles (cmd_vel on the camera topic, say) would feed mapless its own
-      // messages or drive the robot with them: every topic it uses must be another.
-      const std::pair<const char*, const std::string*> roles[] = {
-          {"image", &r.topics.image},       {"compressed_image", &r.topics.compressed_image},
-          {"odometry", &r.topics.odometry}, {"cmd_vel", &r.topics.cmd_vel},
-          {"status", &r.topics.status},     {"debug_image", &r.topics.debug_image},
-          {"estop", &r.topics.estop}};
-      for (std::size_t i = 0; i < std::size(roles); ++i) {
-        for (std::size_t j = 0; j < i; ++j) {
-          if (roles[i].second->empty() ||
-              r.Resolve(*roles[i].second) != r.Resolve(*roles[j].second))
-            continue;
-          t.Fail(roles[i].first, "'" + *roles[i].second + "' is also the " + roles[j].first +
-                                     " topic; each role needs a topic of its own");
-        }
-      }
-    }
+    if (map.Has("topics")) ParseTopics(map.GetMap("topics"), &r);
     if (map.Has("limits")) {
       const io::YamlMap l = map.GetMap("limits");
       l.CheckKnownKeys({"max_speed_mps", "max_turn_rate_radps"});
@@ -169,35 +204,7 @@ RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
         s.Fail("give_up_without_frames_s", "must be in [0, 3600] (0: wait for ever)");
       r.connect_timeout_s = Positive(s, "connect_timeout_s", r.connect_timeout_s, 600.0);
     }
-    if (map.Has("obstacles")) {
-      const io::YamlMap o = map.GetMap("obstacles");
-      o.CheckKnownKeys({"on_obstacle", "region_top", "region_width", "region_half_width_m",
-                        "horizon", "baseline_m", "min_blocked_fraction"});
-      const std::string on = o.GetString("on_obstacle", "stop");
-      if (on != "stop" && on != "avoid" && on != "off")
-        o.Fail("on_obstacle", "'" + on + "' is not stop, avoid or off");
-      r.obstacle.enabled = on != "off";
-      r.obstacle.avoid = on == "avoid";
-      const auto fraction = [&](const std::string& key, double fallback, double lo, double hi) {
-        const double v = o.GetDouble(key, fallback);
-        if (!std::isfinite(v) || v < lo || v > hi)
-          o.Fail(key, "must be in [" + std::to_string(lo).substr(0, 4) + ", " +
-                          std::to_string(hi).substr(0, 4) + "]");
-        return v;
-      };
-      r.obstacle.region_top = fraction("region_top", r.obstacle.region_top, 0.0, 0.95);
-      r.obstacle.fit_top = std::min(r.obstacle.fit_top, r.obstacle.region_top);
-      r.obstacle.region_width = fraction("region_width", r.obstacle.region_width, 0.05, 1.0);
-      r.obstacle.region_half_width_m =
-          fraction("region_half_width_m", r.obstacle.region_half_width_m, 0.05, 2.0);
-      r.obstacle.horizon = fraction("horizon", r.obstacle.horizon, 0.0, 0.94);
-      if (r.obstacle.horizon >= r.obstacle.region_top)
-        o.Fail("horizon", "must be above region_top (a smaller fraction)");
-      r.obstacle.baseline_m = fraction("baseline_m", r.obstacle.baseline_m, 0.01, 1.0);
-      r.obstacle_baseline_given = o.Has("baseline_m");
-      r.obstacle.min_blocked_fraction =
-          fraction("min_blocked_fraction", r.obstacle.min_blocked_fraction, 0.01, 0.99);
-    }
+    if (map.Has("obstacles")) ParseObstacles(map.GetMap("obstacles"), &r);
     r.use_sim_time = map.GetBool("use_sim_time", false);
     r.Validate();
     return r;

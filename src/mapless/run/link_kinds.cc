@@ -24,9 +24,10 @@ std::unique_ptr<robot::RobotLink> OpenPlayback(const std::string& text,
       std::make_unique<recording::PlaybackLink>(recording::OpenSource(text, request.playback));
   if (request.image_size.area() > 0) {
     const cv::Size size = request.image_size;
-    const std::string whose = request.size_needed_by.empty()
-                                  ? request.method + " needs " + SizeText(size.width, size.height)
-                                  : request.size_needed_by + " " + SizeText(size.width, size.height);
+    const std::string whose =
+        request.size_needed_by.empty()
+            ? request.method + " needs " + SizeText(size.width, size.height)
+            : request.size_needed_by + " " + SizeText(size.width, size.height);
     link->set_frame_check([text, size, whose](const io::Frame& frame) {
       if (frame.image.cols != size.width || frame.image.rows != size.height)
         throw InputError(text + ": frame " + frame.name + " is " +

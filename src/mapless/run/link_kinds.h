@@ -25,7 +25,7 @@ struct LinkRequest {
   // frames differ is refused (`size_needed_by` says whose size it is: "the route R was taught at").
   cv::Size image_size;
   std::string size_needed_by;
-  recording::PlaybackOptions playback;          // recordings, videos, image folders, cameras
+  recording::PlaybackOptions playback;           // recordings, videos, image folders, cameras
   std::function<void(const std::string&)> warn;  // bad input heard on the way (may be empty)
 };
 

@@ -12,8 +12,7 @@ namespace mapless::run {
 RunOutcome RunMethod(robot::Method& method, robot::RobotLink& link, const RunOptions& options) {
   std::unique_ptr<robot::RobotLink> recording;
   if (options.recorder)
-    recording =
-        std::make_unique<recording::RecordingLink>(link, *options.recorder, method.name());
+    recording = std::make_unique<recording::RecordingLink>(link, *options.recorder, method.name());
   robot::RobotLink& used = recording ? *recording : link;
   const std::function<bool()> interrupted =
       options.interrupted ? options.interrupted : [] { return InterruptRequested(); };

@@ -35,8 +35,8 @@ struct RunOptions {
 };
 
 struct RunOutcome {
-  robot::LoopResult loop;  // finished or not, the reason, frames
-  int driving_frames = 0;  // frames on which the method drove
+  robot::LoopResult loop;        // finished or not, the reason, frames
+  int driving_frames = 0;        // frames on which the method drove
   std::string last_stop_reason;  // why the method last held the robot (empty: it never did)
   bool interrupted = false;
   // The recording ended (a recording's normal end: the method was not done but nothing failed).

@@ -4,7 +4,9 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "mapless/core/check.h"
 #include "mapless/eval/eigenspace.h"
+#include "mapless/eval/potential.h"
 #include "mapless/run/decision_log.h"
 
 namespace mapless::run {
@@ -13,8 +15,7 @@ void Pacer::At(Timestamp sim_ns) {
   if (rate_ <= 0.0) return;
   using Clock = std::chrono::steady_clock;
   const std::int64_t now =
-      std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch())
-          .count();
+      std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
   if (!started_) {
     started_ = true;
     wall0_ns_ = now;
@@ -51,6 +52,40 @@ SimEpisode FollowEpisode(const sim::Scenario& scenario, fleet::RouteKind kind, s
     episode.tolerance_m = run.arrive_tolerance_m;
   }
   return episode;
+}
+
+eval::SimSetup SimSetupLike(const sim::Scenario& scenario, const std::string& like,
+                            std::uint64_t seed, double motion_noise, double image_noise) {
+  if (like == "teach") {
+    eval::SimSetup setup;
+    setup.world = scenario.world;
+    setup.camera = scenario.camera;
+    setup.robot = scenario.robot;
+    setup.start = scenario.teach_start;
+    setup.seed = seed;
+    return setup;
+  }
+  if (like == "repeat") {
+    eval::RepeatRunOptions o;
+    o.seed = seed;
+    o.motion_noise_frac = motion_noise;
+    o.image_noise_sigma = image_noise;
+    return eval::RepeatSimSetup(scenario, o);
+  }
+  if (like == "navigate") {
+    eval::PotentialRunOptions o;
+    o.seed = seed;
+    o.motion_noise_frac = motion_noise;
+    o.image_noise_sigma = image_noise;
+    return eval::PotentialSimSetup(scenario, o);
+  }
+  if (like == "follow") {
+    eval::EigenspaceRunOptions o;
+    o.seed = seed;
+    o.motion_noise = motion_noise;
+    return eval::FollowSimSetup(scenario, o);
+  }
+  throw InputError("--like " + like + ": must be teach, repeat, navigate or follow");
 }
 
 // The simulator's link paced to the wall clock.

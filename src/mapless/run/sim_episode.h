@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <nlohmann/json_fwd.hpp>
+#include <string>
 #include <vector>
 
 #include "mapless/eval/teach_repeat.h"
@@ -27,6 +28,12 @@ struct SimEpisode {
 // being taught, so the run may take twice as long.
 SimEpisode FollowEpisode(const sim::Scenario& scenario, fleet::RouteKind kind, std::uint64_t seed,
                          double motion_noise, bool live_leader);
+
+// The simulator set up like a run of `like` (`mapless sim serve --like`): teach (the teach start,
+// no noise), repeat, navigate or follow (as those commands' runs on the simulator, seeded). Throws
+// InputError for another.
+eval::SimSetup SimSetupLike(const sim::Scenario& scenario, const std::string& like,
+                            std::uint64_t seed, double motion_noise, double image_noise);
 
 // The episode's simulation with its robot as a link. `rate`: simulated seconds per wall-clock
 // second (0: as fast as it can).

@@ -35,7 +35,9 @@ void StoreSink::Start(const RouteStart& s) {
 }
 
 void StoreSink::Keyframe(const route::Keyframe& keyframe) { writers_->keyframes->Append(keyframe); }
-void StoreSink::Image(const route::StoredAppearanceImage& image) { writers_->images->Append(image); }
+void StoreSink::Image(const route::StoredAppearanceImage& image) {
+  writers_->images->Append(image);
+}
 
 void StoreSink::Finish() {
   if (writers_->keyframes) writers_->keyframes->Finish();
@@ -44,8 +46,7 @@ void StoreSink::Finish() {
 
 // ---- the teacher -------------------------------------------------------------------------------
 
-Teacher::Teacher(const TeacherOptions& options, RouteSink& sink)
-    : options_(options), sink_(sink) {
+Teacher::Teacher(const TeacherOptions& options, RouteSink& sink) : options_(options), sink_(sink) {
   if (options_.kind == RouteKind::kFunnel) {
     teach_options_.features.type = features::ParseDetectorType(options_.detector);
     teach_options_.Validate();
@@ -122,7 +123,8 @@ void Teacher::Finish() {
 
 TeachOutcome TeachFromLink(robot::RobotLink& link, Teacher& teacher, const FrameTap& tap,
                            const std::function<bool()>& interrupted) {
-  const std::function<bool()> stop = interrupted ? interrupted : [] { return InterruptRequested(); };
+  const std::function<bool()> stop =
+      interrupted ? interrupted : [] { return InterruptRequested(); };
   TeachOutcome outcome;
   while (true) {
     if (stop()) break;
@@ -148,7 +150,8 @@ TeachOutcome TeachOnSimulator(const sim::Scenario& scenario, Teacher& teacher, c
                               const std::function<bool(const sim::DriveFrame&)>& skip,
                               const std::function<void(Timestamp)>& pace,
                               const std::function<bool()>& interrupted) {
-  const std::function<bool()> stop = interrupted ? interrupted : [] { return InterruptRequested(); };
+  const std::function<bool()> stop =
+      interrupted ? interrupted : [] { return InterruptRequested(); };
   struct Stopped {};
   TeachOutcome outcome;
   sim::DriveOptions drive;

@@ -109,13 +109,13 @@ class Teacher {
 };
 
 // One frame as the teach loop hands it on (to be recorded, say) before the teacher has it.
-using FrameTap = std::function<void(const robot::Observation& frame,
-                                    const std::optional<Pose2>& truth)>;
+using FrameTap =
+    std::function<void(const robot::Observation& frame, const std::optional<Pose2>& truth)>;
 
 struct TeachOutcome {
   int frames = 0;
-  bool interrupted = false;  // the user ended it (Ctrl-C): the normal end on a live link
-  std::string end;           // why frames stopped: the end of the recording, the link closed, ...
+  bool interrupted = false;   // the user ended it (Ctrl-C): the normal end on a live link
+  std::string end;            // why frames stopped: the end of the recording, the link closed, ...
   bool source_ended = false;  // a recording's or the scripted drive's normal end
   bool failed = false;        // the link closed (a robot gone) or the drive did not complete
 };

@@ -328,6 +328,189 @@ void SubRays(const Prepared& p, std::int32_t candidate, int n, float near_m, flo
   }
 }
 
+// The surfaces of the world and the extra ones, prepared for this camera pose (those behind the
+// camera or outside the view are left out); a surface's group ties the faces of one object.
+std::vector<Prepared> PrepareSurfaces(const std::vector<Surface>& own,
+                                      const std::vector<Surface>& extra, const CameraModel& cam,
+                                      const Rigid3& camera_from_world,
+                                      const RenderOptions& options) {
+  std::vector<Prepared> prepared;
+  prepared.reserve(own.size() + extra.size());
+  int list_offset = 0;
+  const int group_base = 1 << 20;  // grouped surfaces: group_base + list offset + edge_group
+  for (const auto* list : {&own, &extra}) {
+    for (std::size_t k = 0; k < list->size(); ++k) {
+      const Surface& s = (*list)[k];
+      Prepared p;
+      if (!Prepare(s, cam, camera_from_world, options, &p)) continue;
+      p.group = s.edge_group >= 0 ? group_base + list_offset + s.edge_group
+                                  : static_cast<int>(prepared.size());
+      prepared.push_back(p);
+    }
+    list_offset += static_cast<int>(list->size());
+  }
+
+  return prepared;
+}
+
+// Pass 1: the nearest surface per pixel centre. Branchless over structure-of-arrays buffers so
+// that the compiler vectorises the ray-surface tests.
+void RasterNearest(const std::vector<Prepared>& prepared, const std::vector<float>& xd,
+                   const std::vector<float>& yd, int w, float near_m, float far_m, Buffers* out) {
+  Buffers& buf = *out;
+  for (std::size_t si = 0; si < prepared.size(); ++si) {
+    const Prepared& p = prepared[si];
+    switch (p.shape) {
+      case Surface::Shape::kParallelogram:
+        RasterSurface<Surface::Shape::kParallelogram>(p, static_cast<std::int32_t>(si), xd, yd, w,
+                                                      near_m, far_m, &buf);
+        break;
+      case Surface::Shape::kDisk:
+        RasterSurface<Surface::Shape::kDisk>(p, static_cast<std::int32_t>(si), xd, yd, w, near_m,
+                                             far_m, &buf);
+        break;
+      case Surface::Shape::kPlane:
+        RasterSurface<Surface::Shape::kPlane>(p, static_cast<std::int32_t>(si), xd, yd, w, near_m,
+                                              far_m, &buf);
+        break;
+    }
+  }
+}
+
+// The sky's grey level for a ray's vertical slope: the image rows' range mapped linearly from the
+// top of the sky to the horizon.
+struct SkyRamp {
+  double top = 0.0;
+  double horizon = 0.0;
+  float first_row = 0.0f;  // the slopes of the first and the last image row
+  float last_row = 0.0f;
+  float operator()(float yv) const {
+    const float f = std::clamp((yv - first_row) / (last_row - first_row), 0.0f, 1.0f);
+    return static_cast<float>(top + f * (horizon - top));
+  }
+};
+
+// Pass 2: silhouette pixels (where the visible surface differs from a neighbour's) supersampled
+// S x S, each surface that wins sub-rays shaded once at the centroid of its hits.
+void SupersampleEdges(const std::vector<Prepared>& prepared, const Buffers& buf,
+                      const std::vector<float>& xd, const std::vector<float>& yd,
+                      const CameraModel& cam, int ss, float near_m, float far_m, float lod_slope,
+                      const SkyRamp& sky, cv::Mat* image) {
+  const int w = cam.width;
+  const int h = cam.height;
+  const std::size_t npix = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+  const std::vector<std::int32_t>& id = buf.id;
+  const float sub_x = static_cast<float>(1.0 / cam.fx);
+  const float sub_y = static_cast<float>(1.0 / cam.fy);
+  // Mark both pixels of every horizontally or vertically adjacent pair that sees different
+  // surfaces (or a surface and the sky).
+  std::vector<std::int32_t> group(npix);
+  for (std::size_t i = 0; i < npix; ++i) {
+    group[i] = id[i] < 0 ? -1 : prepared[static_cast<std::size_t>(id[i])].group;
+  }
+  std::vector<std::uint8_t> edge(npix, 0);
+  for (int y = 0; y < h; ++y) {
+    const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = row + static_cast<std::size_t>(x);
+      if (x + 1 < w && group[i] != group[i + 1]) edge[i] = edge[i + 1] = 1;
+      if (y + 1 < h && group[i] != group[i + static_cast<std::size_t>(w)]) {
+        edge[i] = edge[i + static_cast<std::size_t>(w)] = 1;
+      }
+    }
+  }
+  struct Accum {
+    float t = 0.0f, alpha = 0.0f, beta = 0.0f, nd = 0.0f;
+    int n = 0;
+  };
+  std::vector<std::int32_t> candidates;
+  candidates.reserve(9);
+  std::array<Accum, 9> accum{};
+  const int nsub = ss * ss;
+  std::vector<float> sub_dx(static_cast<std::size_t>(nsub));
+  std::vector<float> sub_dy(static_cast<std::size_t>(nsub));
+  for (int sy = 0; sy < ss; ++sy) {
+    for (int sx = 0; sx < ss; ++sx) {
+      sub_dx[static_cast<std::size_t>(sy * ss + sx)] = ((sx + 0.5f) / ss - 0.5f) * sub_x;
+      sub_dy[static_cast<std::size_t>(sy * ss + sx)] = ((sy + 0.5f) / ss - 0.5f) * sub_y;
+    }
+  }
+  SubRayBuffers sub;
+  for (int y = 0; y < h; ++y) {
+    std::uint8_t* out = image->ptr<std::uint8_t>(y);
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i =
+          static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+      if (!edge[i]) continue;
+      // Surfaces seen in the 3x3 neighbourhood: the candidates for this pixel's sub-rays.
+      candidates.clear();
+      for (int dy = -1; dy <= 1; ++dy) {
+        const int yy = y + dy;
+        if (yy < 0 || yy >= h) continue;
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int xx = x + dx;
+          if (xx < 0 || xx >= w) continue;
+          const std::int32_t nid = id[static_cast<std::size_t>(yy) * static_cast<std::size_t>(w) +
+                                      static_cast<std::size_t>(xx)];
+          if (std::find(candidates.begin(), candidates.end(), nid) == candidates.end()) {
+            candidates.push_back(nid);
+          }
+        }
+      }
+      // Coverage by S x S sub-rays; each surface that wins sub-rays is shaded once, at the
+      // centroid of its winning hits (multisample anti-aliasing), the sky per sub-ray.
+      const float xc = xd[static_cast<std::size_t>(x)];
+      const float yc = yd[static_cast<std::size_t>(y)];
+      for (int k = 0; k < nsub; ++k) {
+        sub.xv[k] = xc + sub_dx[static_cast<std::size_t>(k)];
+        sub.yv[k] = yc + sub_dy[static_cast<std::size_t>(k)];
+        sub.t[k] = std::numeric_limits<float>::infinity();
+        sub.winner[k] = -1;
+      }
+      for (std::size_t c = 0; c < candidates.size(); ++c) {
+        if (candidates[c] < 0) continue;
+        const Prepared& p = prepared[static_cast<std::size_t>(candidates[c])];
+        const auto ci = static_cast<std::int32_t>(c);
+        switch (p.shape) {
+          case Surface::Shape::kParallelogram:
+            SubRays<Surface::Shape::kParallelogram>(p, ci, nsub, near_m, far_m, &sub);
+            break;
+          case Surface::Shape::kDisk:
+            SubRays<Surface::Shape::kDisk>(p, ci, nsub, near_m, far_m, &sub);
+            break;
+          case Surface::Shape::kPlane:
+            SubRays<Surface::Shape::kPlane>(p, ci, nsub, near_m, far_m, &sub);
+            break;
+        }
+      }
+      for (Accum& a : accum) a = Accum{};
+      float sky_sum = 0.0f;
+      for (int k = 0; k < nsub; ++k) {
+        if (sub.winner[k] < 0) {
+          sky_sum += sky(sub.yv[k]);
+          continue;
+        }
+        Accum& a = accum[static_cast<std::size_t>(sub.winner[k])];
+        a.t += sub.t[k];
+        a.alpha += sub.alpha[k];
+        a.beta += sub.beta[k];
+        a.nd += sub.nd[k];
+        ++a.n;
+      }
+      float sum = sky_sum;
+      for (std::size_t c = 0; c < candidates.size(); ++c) {
+        const Accum& a = accum[c];
+        if (a.n == 0) continue;
+        const float inv = 1.0f / static_cast<float>(a.n);
+        const Hit mean{a.t * inv, a.alpha * inv, a.beta * inv, a.nd * inv};
+        sum += static_cast<float>(a.n) *
+               ShadeHit(prepared[static_cast<std::size_t>(candidates[c])], mean, lod_slope);
+      }
+      out[x] = cv::saturate_cast<std::uint8_t>(sum / static_cast<float>(ss * ss));
+    }
+  }
+}
+
 }  // namespace
 
 void RenderOptions::Validate() const {
@@ -449,23 +632,8 @@ cv::Mat Renderer::Render(const CameraModel& cam, const Rigid3& world_from_camera
   const float near_m = static_cast<float>(options_.near_m);
   const float far_m = static_cast<float>(options_.far_m);
   const float lod_slope = static_cast<float>(0.5 * (3.0 + options_.anisotropy));
-
-  std::vector<Prepared> prepared;
-  prepared.reserve(surfaces_.size() + extra.size());
-  int list_offset = 0;
-  const int group_base = 1 << 20;  // grouped surfaces: group_base + list offset + edge_group
-  for (const auto* list : {&surfaces_, &extra}) {
-    for (std::size_t k = 0; k < list->size(); ++k) {
-      const Surface& s = (*list)[k];
-      Prepared p;
-      if (!Prepare(s, cam, camera_from_world, options_, &p)) continue;
-      p.group = s.edge_group >= 0 ? group_base + list_offset + s.edge_group
-                                  : static_cast<int>(prepared.size());
-      prepared.push_back(p);
-    }
-    list_offset += static_cast<int>(list->size());
-  }
-
+  const std::vector<Prepared> prepared =
+      PrepareSurfaces(surfaces_, extra, cam, camera_from_world, options_);
   std::vector<float> xd(static_cast<std::size_t>(w));
   std::vector<float> yd(static_cast<std::size_t>(h));
   for (int x = 0; x < w; ++x)
@@ -481,33 +649,10 @@ cv::Mat Renderer::Render(const CameraModel& cam, const Rigid3& world_from_camera
   buf.beta.resize(npix);
   buf.nd.resize(npix);
 
-  // Pass 1: nearest surface per pixel centre. Branchless over structure-of-arrays buffers so that
-  // the compiler vectorises the ray-surface tests.
-  for (std::size_t si = 0; si < prepared.size(); ++si) {
-    const Prepared& p = prepared[si];
-    switch (p.shape) {
-      case Surface::Shape::kParallelogram:
-        RasterSurface<Surface::Shape::kParallelogram>(p, static_cast<std::int32_t>(si), xd, yd, w,
-                                                      near_m, far_m, &buf);
-        break;
-      case Surface::Shape::kDisk:
-        RasterSurface<Surface::Shape::kDisk>(p, static_cast<std::int32_t>(si), xd, yd, w, near_m,
-                                             far_m, &buf);
-        break;
-      case Surface::Shape::kPlane:
-        RasterSurface<Surface::Shape::kPlane>(p, static_cast<std::int32_t>(si), xd, yd, w, near_m,
-                                              far_m, &buf);
-        break;
-    }
-  }
+  RasterNearest(prepared, xd, yd, w, near_m, far_m, &buf);
   const std::vector<float>& depth = buf.depth;
   const std::vector<std::int32_t>& id = buf.id;
-
-  auto sky = [&](float yv) {
-    // yv is the ray's vertical slope; map the image rows' range linearly.
-    const float f = std::clamp((yv - yd.front()) / (yd.back() - yd.front()), 0.0f, 1.0f);
-    return static_cast<float>(sky_top_ + f * (sky_horizon_ - sky_top_));
-  };
+  const SkyRamp sky{sky_top_, sky_horizon_, yd.front(), yd.back()};
 
   cv::Mat image(h, w, CV_8UC1);
   for (int y = 0; y < h; ++y) {
@@ -526,116 +671,8 @@ cv::Mat Renderer::Render(const CameraModel& cam, const Rigid3& world_from_camera
 
   // Pass 2: supersample silhouette pixels, where the visible surface differs from a neighbour.
   const int ss = options_.edge_supersample;
-  if (ss <= 1) return image;
-  const float sub_x = static_cast<float>(1.0 / cam.fx);
-  const float sub_y = static_cast<float>(1.0 / cam.fy);
-  // Mark both pixels of every horizontally or vertically adjacent pair that sees different
-  // surfaces (or a surface and the sky).
-  std::vector<std::int32_t> group(npix);
-  for (std::size_t i = 0; i < npix; ++i) {
-    group[i] = id[i] < 0 ? -1 : prepared[static_cast<std::size_t>(id[i])].group;
-  }
-  std::vector<std::uint8_t> edge(npix, 0);
-  for (int y = 0; y < h; ++y) {
-    const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = row + static_cast<std::size_t>(x);
-      if (x + 1 < w && group[i] != group[i + 1]) edge[i] = edge[i + 1] = 1;
-      if (y + 1 < h && group[i] != group[i + static_cast<std::size_t>(w)]) {
-        edge[i] = edge[i + static_cast<std::size_t>(w)] = 1;
-      }
-    }
-  }
-  struct Accum {
-    float t = 0.0f, alpha = 0.0f, beta = 0.0f, nd = 0.0f;
-    int n = 0;
-  };
-  std::vector<std::int32_t> candidates;
-  candidates.reserve(9);
-  std::array<Accum, 9> accum{};
-  const int nsub = ss * ss;
-  std::vector<float> sub_dx(static_cast<std::size_t>(nsub));
-  std::vector<float> sub_dy(static_cast<std::size_t>(nsub));
-  for (int sy = 0; sy < ss; ++sy) {
-    for (int sx = 0; sx < ss; ++sx) {
-      sub_dx[static_cast<std::size_t>(sy * ss + sx)] = ((sx + 0.5f) / ss - 0.5f) * sub_x;
-      sub_dy[static_cast<std::size_t>(sy * ss + sx)] = ((sy + 0.5f) / ss - 0.5f) * sub_y;
-    }
-  }
-  SubRayBuffers sub;
-  for (int y = 0; y < h; ++y) {
-    std::uint8_t* out = image.ptr<std::uint8_t>(y);
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i =
-          static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-      if (!edge[i]) continue;
-      // Surfaces seen in the 3x3 neighbourhood: the candidates for this pixel's sub-rays.
-      candidates.clear();
-      for (int dy = -1; dy <= 1; ++dy) {
-        const int yy = y + dy;
-        if (yy < 0 || yy >= h) continue;
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int xx = x + dx;
-          if (xx < 0 || xx >= w) continue;
-          const std::int32_t nid = id[static_cast<std::size_t>(yy) * static_cast<std::size_t>(w) +
-                                      static_cast<std::size_t>(xx)];
-          if (std::find(candidates.begin(), candidates.end(), nid) == candidates.end()) {
-            candidates.push_back(nid);
-          }
-        }
-      }
-      // Coverage by S x S sub-rays; each surface that wins sub-rays is shaded once, at the
-      // centroid of its winning hits (multisample anti-aliasing), the sky per sub-ray.
-      const float xc = xd[static_cast<std::size_t>(x)];
-      const float yc = yd[static_cast<std::size_t>(y)];
-      for (int k = 0; k < nsub; ++k) {
-        sub.xv[k] = xc + sub_dx[static_cast<std::size_t>(k)];
-        sub.yv[k] = yc + sub_dy[static_cast<std::size_t>(k)];
-        sub.t[k] = std::numeric_limits<float>::infinity();
-        sub.winner[k] = -1;
-      }
-      for (std::size_t c = 0; c < candidates.size(); ++c) {
-        if (candidates[c] < 0) continue;
-        const Prepared& p = prepared[static_cast<std::size_t>(candidates[c])];
-        const auto ci = static_cast<std::int32_t>(c);
-        switch (p.shape) {
-          case Surface::Shape::kParallelogram:
-            SubRays<Surface::Shape::kParallelogram>(p, ci, nsub, near_m, far_m, &sub);
-            break;
-          case Surface::Shape::kDisk:
-            SubRays<Surface::Shape::kDisk>(p, ci, nsub, near_m, far_m, &sub);
-            break;
-          case Surface::Shape::kPlane:
-            SubRays<Surface::Shape::kPlane>(p, ci, nsub, near_m, far_m, &sub);
-            break;
-        }
-      }
-      for (Accum& a : accum) a = Accum{};
-      float sky_sum = 0.0f;
-      for (int k = 0; k < nsub; ++k) {
-        if (sub.winner[k] < 0) {
-          sky_sum += sky(sub.yv[k]);
-          continue;
-        }
-        Accum& a = accum[static_cast<std::size_t>(sub.winner[k])];
-        a.t += sub.t[k];
-        a.alpha += sub.alpha[k];
-        a.beta += sub.beta[k];
-        a.nd += sub.nd[k];
-        ++a.n;
-      }
-      float sum = sky_sum;
-      for (std::size_t c = 0; c < candidates.size(); ++c) {
-        const Accum& a = accum[c];
-        if (a.n == 0) continue;
-        const float inv = 1.0f / static_cast<float>(a.n);
-        const Hit mean{a.t * inv, a.alpha * inv, a.beta * inv, a.nd * inv};
-        sum += static_cast<float>(a.n) *
-               ShadeHit(prepared[static_cast<std::size_t>(candidates[c])], mean, lod_slope);
-      }
-      out[x] = cv::saturate_cast<std::uint8_t>(sum / static_cast<float>(ss * ss));
-    }
-  }
+  if (ss > 1)
+    SupersampleEdges(prepared, buf, xd, yd, cam, ss, near_m, far_m, lod_slope, sky, &image);
   return image;
 }
 

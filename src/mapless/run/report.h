@@ -15,9 +15,9 @@
 #include "mapless/report/svg.h"
 #include "mapless/sim/world.h"
 
-namespace mapless::app {
+namespace mapless::run {
 
-class RunTrace;  // run_traces.h
+class RunTrace;  // traces.h
 
 // One run (or one suite entry) as the report shows it.
 struct RunSection {
@@ -61,4 +61,4 @@ void WriteSuiteReport(const std::string& dir, const std::string& suite, int runs
                       const std::vector<std::string>& experiments,
                       const std::vector<const RunTrace*>& traces);
 
-}  // namespace mapless::app
+}  // namespace mapless::run

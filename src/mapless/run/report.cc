@@ -1,4 +1,4 @@
-#include "run_report.h"
+#include "mapless/run/report.h"
 
 #include <unistd.h>
 
@@ -11,11 +11,11 @@
 #include "mapless/eval/potential.h"
 #include "mapless/io/atomic_file.h"
 #include "mapless/report/pictures.h"
+#include "mapless/run/traces.h"
 #include "mapless/sim/scenario.h"
 #include "mapless/viz/topdown.h"
-#include "run_traces.h"
 
-namespace mapless::app {
+namespace mapless::run {
 namespace {
 
 // Colours of the runs of a suite entry: one hue, light to dark.
@@ -164,4 +164,4 @@ void WriteSuiteReport(const std::string& dir, const std::string& suite, int runs
   WriteReport(dir, html, sections);
 }
 
-}  // namespace mapless::app
+}  // namespace mapless::run

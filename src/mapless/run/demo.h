@@ -3,13 +3,15 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "mapless/eval/teach_repeat.h"
-#include "run_report.h"
+#include "mapless/run/decision_log.h"
+#include "mapless/run/report.h"
 
-namespace mapless::app {
+namespace mapless::run {
 
 struct DemoResult {
   RunSection section;
@@ -18,13 +20,17 @@ struct DemoResult {
   std::string status;
 };
 
+// Each run calls `each_frame` once per frame (the command's check for an interrupt, which throws).
 // Teach & repeat with the sloped funnel lane: `taught` (already taught on `scenario`) repeated
-// from a perturbed start with motion and image noise; decisions as JSON lines to `log_path`.
+// from a perturbed start with motion and image noise; its decisions to `log` (decision_log.h).
 DemoResult DemoRepeat(const sim::Scenario& scenario, const eval::TaughtRoute& taught,
-                      std::uint64_t seed, const std::string& log_path);
+                      std::uint64_t seed, const JsonSink& log,
+                      const std::function<void()>& each_frame);
 // The eigenspace follower on `scenario_name` while the leader is still teaching it.
-DemoResult DemoEigenspace(const std::string& scenario_name, std::uint64_t seed);
+DemoResult DemoEigenspace(const std::string& scenario_name, std::uint64_t seed,
+                          const std::function<void()>& each_frame);
 // The visual potential to the scenario's first destination and home again.
-DemoResult DemoPotential(const std::string& scenario_name, std::uint64_t seed);
+DemoResult DemoPotential(const std::string& scenario_name, std::uint64_t seed,
+                         const std::function<void()>& each_frame);
 
-}  // namespace mapless::app
+}  // namespace mapless::run

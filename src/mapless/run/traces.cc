@@ -1,11 +1,11 @@
-#include "run_traces.h"
+#include "mapless/run/traces.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include "mapless/report/pictures.h"
 
-namespace mapless::app {
+namespace mapless::run {
 namespace {
 
 report::PlotSpec CommandsPlot(const std::vector<double>& t, const std::vector<double>& v,
@@ -122,4 +122,4 @@ void PotentialTrace::AddTo(RunSection* section) const {
       "of the control force (arrow).";
 }
 
-}  // namespace mapless::app
+}  // namespace mapless::run

@@ -14,9 +14,9 @@
 #include "mapless/eval/eigenspace.h"
 #include "mapless/eval/potential.h"
 #include "mapless/eval/teach_repeat.h"
-#include "run_report.h"
+#include "mapless/run/report.h"
 
-namespace mapless::app {
+namespace mapless::run {
 
 class RunTrace {
  public:
@@ -88,4 +88,4 @@ class PotentialTrace : public RunTrace {
   std::vector<std::pair<cv::Mat, std::string>> pictures_;
 };
 
-}  // namespace mapless::app
+}  // namespace mapless::run

@@ -1,47 +1,32 @@
-#include "demo_runs.h"
+#include "mapless/run/demo.h"
 
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
-#include "cli_common.h"
-#include "interrupt.h"
 #include "mapless/core/check.h"
 #include "mapless/eval/eigenspace.h"
 #include "mapless/eval/potential.h"
-#include "run_traces.h"
+#include "mapless/run/decision_log.h"
+#include "mapless/run/traces.h"
 
-namespace mapless::app {
+namespace mapless::run {
 
 DemoResult DemoRepeat(const sim::Scenario& scenario, const eval::TaughtRoute& taught,
-                      std::uint64_t seed, const std::string& log_path) {
+                      std::uint64_t seed, const JsonSink& log,
+                      const std::function<void()>& each_frame) {
   eval::RepeatRunOptions options;
   options.seed = seed;
   options.repeat.sloped.max_speed_mps =
       eval::RepeatSpeedFor(scenario, options.max_repeat_speed_mps);
-  JsonLines log(log_path, /*in_place=*/true);
+  options.wrap_link = LogDecisions("repeat", log);
   DemoResult out;
   RepeatTrace trace(taught, 1.0 / scenario.camera.rate_hz);
-  int frame = 0;
   const eval::RepeatRun run = eval::RepeatOnSimulator(
       scenario, taught, options,
-      [&](const Pose2& pose, const cv::Mat& image, const navigation::RepeatStep& s) {
-        ThrowIfInterrupted();
-        nlohmann::json j{{"frame", frame},
-                         {"x_m", pose.x_m},
-                         {"y_m", pose.y_m},
-                         {"destination", s.destination},
-                         {"matches", s.matches},
-                         {"std_ratio", s.switching.std_ratio},
-                         {"slope_x", s.sloped.slope_x},
-                         {"slope_y", s.sloped.slope_y},
-                         {"v_mps", s.command.v_mps},
-                         {"omega_radps", s.command.omega_radps},
-                         {"status", navigation::RepeatStatusName(s.status)}};
-        if (s.local_scale.ok) j["local_scale"] = s.local_scale.ratio;
-        log.Write(j);
+      [&](const Pose2&, const cv::Mat& image, const navigation::RepeatStep& s) {
+        if (each_frame) each_frame();
         trace.Step(image, s);
-        ++frame;
       });
   RunSection& s = out.section;
   s.title = "Teach & repeat: the sloped funnel lane (" + scenario.name + ")";
@@ -71,7 +56,8 @@ DemoResult DemoRepeat(const sim::Scenario& scenario, const eval::TaughtRoute& ta
   return out;
 }
 
-DemoResult DemoEigenspace(const std::string& scenario_name, std::uint64_t seed) {
+DemoResult DemoEigenspace(const std::string& scenario_name, std::uint64_t seed,
+                          const std::function<void()>& each_frame) {
   const sim::Scenario scenario = sim::LoadScenario(scenario_name);
   eval::EigenspaceRunOptions options =
       eval::EigenspaceEntryOptions({scenario_name, "concurrent"}, seed);
@@ -79,7 +65,7 @@ DemoResult DemoEigenspace(const std::string& scenario_name, std::uint64_t seed) 
   EigenspaceTrace trace(1.0 / scenario.camera.rate_hz);
   const eval::EigenspaceRun run = eval::RunEigenspaceFollow(
       scenario, options, [&](const navigation::FollowerStep& step, const Pose2&) {
-        ThrowIfInterrupted();
+        if (each_frame) each_frame();
         trace.Step(step);
       });
   RunSection& s = out.section;
@@ -113,7 +99,8 @@ DemoResult DemoEigenspace(const std::string& scenario_name, std::uint64_t seed) 
   return out;
 }
 
-DemoResult DemoPotential(const std::string& scenario_name, std::uint64_t seed) {
+DemoResult DemoPotential(const std::string& scenario_name, std::uint64_t seed,
+                         const std::function<void()>& each_frame) {
   const sim::Scenario scenario = sim::LoadScenario(scenario_name);
   MAPLESS_CHECK(!scenario.destinations.empty(), scenario_name << " has no destination");
   eval::PotentialRunOptions options;
@@ -130,7 +117,7 @@ DemoResult DemoPotential(const std::string& scenario_name, std::uint64_t seed) {
   const eval::PotentialRun run = eval::RunPotential(
       scenario, calibration, options,
       [&](const Pose2&, const cv::Mat& image, const navigation::PotentialStep& step) {
-        ThrowIfInterrupted();
+        if (each_frame) each_frame();
         trace.Step(image, step);
       });
   RunSection& s = out.section;
@@ -155,4 +142,4 @@ DemoResult DemoPotential(const std::string& scenario_name, std::uint64_t seed) {
   return out;
 }
 
-}  // namespace mapless::app
+}  // namespace mapless::run

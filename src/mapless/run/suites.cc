@@ -1,0 +1,265 @@
+#include "mapless/run/suites.h"
+
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <future>
+#include <map>
+#include <memory>
+
+#include "mapless/core/check.h"
+#include "mapless/eval/eigenspace.h"
+#include "mapless/eval/potential.h"
+#include "mapless/eval/suite.h"
+#include "mapless/run/report.h"
+#include "mapless/run/text.h"
+#include "mapless/run/traces.h"
+
+namespace mapless::run {
+
+namespace {
+
+// Calls fn(0) ... fn(n - 1), `jobs` at a time (each entry is independent and seeded, so the
+// results do not depend on `jobs`).
+void RunInBatches(std::size_t n, const SuiteOptions& options,
+                  const std::function<std::string(std::size_t)>& fn) {
+  if (options.on_start) options.on_start(static_cast<int>(n));
+  const auto run = [&](std::size_t k) {
+    const std::string line = fn(k);
+    if (options.on_entry_done) options.on_entry_done(line);
+  };
+  const int jobs = options.jobs;
+  std::size_t next = 0;
+  while (next < n) {
+    std::vector<std::future<void>> batch;
+    for (int j = 0; j < jobs && next < n; ++j, ++next)
+      batch.push_back(std::async(std::launch::async, run, next));
+    for (auto& f : batch) f.get();
+  }
+}
+
+template <typename Trace>
+std::vector<const RunTrace*> TracePointers(const std::vector<std::unique_ptr<Trace>>& traces) {
+  std::vector<const RunTrace*> out;
+  for (const auto& t : traces) out.push_back(t.get());
+  return out;
+}
+
+nlohmann::json SuiteJson(const std::string& suite, int runs, std::uint64_t seed) {
+  nlohmann::json j;
+  j["suite"] = suite;
+  j["runs"] = runs;
+  j["seed"] = seed;
+  j["results"] = nlohmann::json::array();
+  return j;
+}
+
+nlohmann::json EntryJson(const eval::EntryResult& r) {
+  return {{"scenario", r.scenario},
+          {"controller", r.controller},
+          {"runs", r.runs},
+          {"successes", r.successes},
+          {"final_error_m_rms", r.final_error_m_rms},
+          {"final_error_m_std", r.final_error_m_std},
+          {"final_error_m_max", r.final_error_m_max},
+          {"lateral_rms_m", r.lateral_rms_m},
+          {"collisions", r.collisions},
+          {"obstacle_stops", r.obstacle_stops},
+          {"went_round", r.went_round},
+          {"stops_at_added_object", r.stops_at_added_object},
+          {"min_clearance_m",
+           std::isfinite(r.min_clearance_m) ? nlohmann::json(r.min_clearance_m) : nlohmann::json()},
+          {"failures", r.failures}};
+}
+
+}  // namespace
+
+// `mapless eval potential`: Ohnishi & Imiya, Section 5 (see eval/potential.h).
+SuiteOutput RunPotentialSuite(const SuiteOptions& options) {
+  const int runs = options.runs;
+  const std::uint64_t seed = options.seed;
+  const std::string& only = options.only;
+  const std::string& report_dir = options.report_dir;
+  std::vector<eval::PotentialEntry> entries;
+  for (const auto& e : eval::PotentialSuiteEntries())
+    if (only.empty() || e.scenario == only) entries.push_back(e);
+  if (entries.empty()) throw InputError("--only '" + only + "': not a scenario of suite potential");
+  const navigation::PotentialNavOptions nav;
+  std::vector<eval::PotentialEntryResult> results(entries.size());
+  // With --report, the first run of each entry frame by frame.
+  std::vector<std::unique_ptr<PotentialTrace>> traces(entries.size());
+  RunInBatches(entries.size(), options, [&](std::size_t k) {
+    eval::PotentialObserver observer;
+    if (!report_dir.empty()) {
+      traces[k] = std::make_unique<PotentialTrace>(
+          1.0 / sim::LoadScenario(entries[k].scenario).camera.rate_hz);
+      observer = traces[k]->Observer();
+    }
+    results[k] = eval::RunPotentialEntry(entries[k], runs, seed, nav, observer);
+    return entries[k].scenario + " " + entries[k].experiment + ": " +
+           std::to_string(results[k].successes) + "/" + std::to_string(results[k].runs) +
+           " successes";
+  });
+  std::vector<eval::InclusionResult> inclusion;
+  for (const char* name : {"corridor_straight_3p5m", "obstacle_field"})
+    if (only.empty() || only == name)
+      // Table 1 is about the paper's detector: its options (1 px, the whole image), not the
+      // navigator's.
+      inclusion.push_back(
+          eval::InclusionOnSimulator(sim::LoadScenario(name), ground::DominantPlaneOptions{}));
+
+  nlohmann::json j = SuiteJson("potential", runs, seed);
+  std::string table;
+  Appendf(&table, "%-24s %-14s %9s %5s %10s %10s %10s\n", "scenario", "experiment", "success",
+          "coll", "final rms", "dev std", "dev max");
+  for (const auto& r : results) {
+    nlohmann::json e = EntryJson(r);
+    e["experiment"] = r.experiment;
+    e["deviation_std_m"] = r.deviation_std_m;
+    e["deviation_std_m_max"] = r.deviation_std_m_max;
+    e["deviations_m"] = r.deviations_m;
+    j["results"].push_back(e);
+    Appendf(&table, "%-24s %-14s %4d/%-4d %5d %9.3fm %9.4fm %9.4fm\n", r.scenario.c_str(),
+            r.experiment.c_str(), r.successes, r.runs, r.collisions, r.final_error_m_rms,
+            r.deviation_std_m, r.deviation_std_m_max);
+  }
+  j["inclusion"] = nlohmann::json::array();
+  for (const auto& in : inclusion) {
+    j["inclusion"].push_back({{"scenario", in.scenario},
+                              {"pairs", in.pairs},
+                              {"frames", in.frames},
+                              {"p_d0_in_d1", in.inclusion[0]},
+                              {"p_d1_in_d2", in.inclusion[1]},
+                              {"p_d2_in_d3", in.inclusion[2]}});
+    Appendf(&table, "inclusion %-24s %3d/%-3d pairs  P(D0<D1) %.3f  P(D1<D2) %.3f  P(D2<D3) %.3f\n",
+            in.scenario.c_str(), in.frames, in.pairs, in.inclusion[0], in.inclusion[1],
+            in.inclusion[2]);
+  }
+  if (!report_dir.empty()) {
+    std::vector<const eval::EntryResult*> entries_out;
+    std::vector<std::string> experiments;
+    for (const auto& r : results) entries_out.push_back(&r), experiments.push_back(r.experiment);
+    WriteSuiteReport(report_dir, "potential", runs, seed, entries_out, experiments,
+                     TracePointers(traces));
+  }
+  return {j, table};
+}
+
+// `mapless eval eigenspace`: Payá et al., Section 5 (see eval/eigenspace.h).
+SuiteOutput RunEigenspaceSuite(const SuiteOptions& options) {
+  const int runs = options.runs;
+  const std::uint64_t seed = options.seed;
+  const std::string& only = options.only;
+  const std::string& report_dir = options.report_dir;
+  std::vector<eval::EigenspaceEntry> entries;
+  for (const auto& e : eval::EigenspaceSuiteEntries())
+    if (only.empty() || e.scenario == only) entries.push_back(e);
+  if (entries.empty())
+    throw InputError("--only '" + only + "': not a scenario of suite eigenspace");
+  std::vector<eval::EigenspaceEntryResult> results(entries.size());
+  std::vector<std::unique_ptr<EigenspaceTrace>> traces(entries.size());
+  RunInBatches(entries.size(), options, [&](std::size_t k) {
+    eval::EigenspaceObserver observer;
+    if (!report_dir.empty()) {
+      traces[k] = std::make_unique<EigenspaceTrace>(
+          1.0 / sim::LoadScenario(entries[k].scenario).camera.rate_hz);
+      observer = traces[k]->Observer();
+    }
+    results[k] = eval::RunEigenspaceEntry(entries[k], runs, seed, observer);
+    return entries[k].scenario + " " + entries[k].experiment + ": " +
+           std::to_string(results[k].successes) + "/" + std::to_string(results[k].runs) +
+           " successes";
+  });
+  nlohmann::json j = SuiteJson("eigenspace", runs, seed);
+  std::string table;
+  Appendf(&table, "%-19s %-16s %9s %5s %10s %11s %11s %9s %9s %6s %7s %9s\n", "scenario",
+          "experiment", "success", "coll", "final rms", "lateral rms", "lateral max", "loc +-1",
+          "nn +-1", "stops", "at obj", "clearance");
+  for (const auto& r : results) {
+    nlohmann::json e = EntryJson(r);
+    e["experiment"] = r.experiment;
+    e["lateral_rms_m_max"] = r.lateral_rms_m_max;
+    e["localization_within_one"] = r.localization_within_one;
+    e["nearest_within_one"] = r.nearest_within_one;
+    e["stop_frames"] = r.stops;
+    j["results"].push_back(e);
+    const std::string clearance =
+        std::isfinite(r.min_clearance_m) ? Fixed(r.min_clearance_m, 2) + "m" : "-";
+    Appendf(&table, "%-19s %-16s %4d/%-4d %5d %9.3fm %10.3fm %10.3fm %9.3f %9.3f %6d %7d %9s\n",
+            r.scenario.c_str(), r.experiment.c_str(), r.successes, r.runs, r.collisions,
+            r.final_error_m_rms, r.lateral_rms_m, r.lateral_rms_m_max, r.localization_within_one,
+            r.nearest_within_one, r.obstacle_stops, r.stops_at_added_object, clearance.c_str());
+  }
+  if (!report_dir.empty()) {
+    std::vector<const eval::EntryResult*> entries_out;
+    std::vector<std::string> experiments;
+    for (const auto& r : results) entries_out.push_back(&r), experiments.push_back(r.experiment);
+    WriteSuiteReport(report_dir, "eigenspace", runs, seed, entries_out, experiments,
+                     TracePointers(traces));
+  }
+  return {j, table};
+}
+
+// `mapless eval table1 | funnel-scenarios | obstacles`: Kassir et al., Table I and beyond.
+SuiteOutput RunRepeatSuite(const std::string& suite, const SuiteOptions& options,
+                           const eval::RepeatRunOptions& base, const nlohmann::json& settings) {
+  std::vector<eval::SuiteEntry> entries = eval::SuiteEntries(suite);
+  if (!options.only.empty()) {
+    std::vector<eval::SuiteEntry> kept;
+    for (const auto& e : entries)
+      if (e.scenario == options.only) kept.push_back(e);
+    if (kept.empty())
+      throw InputError("--only '" + options.only + "': not a scenario of suite " + suite);
+    entries = kept;
+  }
+  // Teach each scenario once; evaluate entries in parallel (each run is independent and seeded,
+  // so the results do not depend on --jobs).
+  std::map<std::string, std::pair<sim::Scenario, eval::TaughtRoute>> taught;
+  for (const auto& e : entries) {
+    if (taught.count(e.scenario)) continue;
+    sim::Scenario s = sim::LoadScenario(e.scenario);
+    // Going round: the obstacle is not taken away, so a completed route went round it.
+    if (base.repeat.obstacle.avoid) s.repeat_variant = eval::ObjectsStay(s.repeat_variant);
+    taught.emplace(e.scenario,
+                   std::make_pair(s, eval::TeachOnSimulator(s, navigation::TeachOptions{})));
+  }
+  std::vector<eval::EntryResult> results(entries.size());
+  std::vector<std::unique_ptr<RepeatTrace>> traces(entries.size());
+  RunInBatches(entries.size(), options, [&](std::size_t k) {
+    const auto& [scenario, route] = taught.at(entries[k].scenario);
+    eval::RepeatObserver observer;
+    if (!options.report_dir.empty()) {
+      traces[k] = std::make_unique<RepeatTrace>(route, 1.0 / scenario.camera.rate_hz);
+      observer = traces[k]->Observer();
+    }
+    results[k] = eval::RunEntry(scenario, route, entries[k].controller, options.runs, options.seed,
+                                base, observer);
+    return entries[k].scenario + " " + results[k].controller + ": " +
+           std::to_string(results[k].successes) + "/" + std::to_string(results[k].runs) +
+           " successes";
+  });
+  nlohmann::json j = SuiteJson(suite, options.runs, options.seed);
+  j.update(settings);
+  std::string table;
+  Appendf(&table, "%-30s %-9s %9s %10s %10s %10s %10s %5s %6s %7s %9s %6s\n", "scenario", "control",
+          "success", "final rms", "final std", "final max", "lateral", "coll", "stops", "at obj",
+          "clearance", "round");
+  for (const auto& r : results) {
+    j["results"].push_back(EntryJson(r));
+    const std::string clearance =
+        std::isfinite(r.min_clearance_m) ? Fixed(r.min_clearance_m, 2) + "m" : "-";
+    Appendf(&table, "%-30s %-9s %4d/%-4d %9.2fm %9.2fm %9.2fm %9.2fm %5d %6d %7d %9s %6d\n",
+            r.scenario.c_str(), r.controller.c_str(), r.successes, r.runs, r.final_error_m_rms,
+            r.final_error_m_std, r.final_error_m_max, r.lateral_rms_m, r.collisions,
+            r.obstacle_stops, r.stops_at_added_object, clearance.c_str(), r.went_round);
+  }
+  if (!options.report_dir.empty()) {
+    std::vector<const eval::EntryResult*> entries_out;
+    for (const auto& r : results) entries_out.push_back(&r);
+    WriteSuiteReport(options.report_dir, suite, options.runs, options.seed, entries_out,
+                     std::vector<std::string>(results.size()), TracePointers(traces));
+  }
+  return {j, table};
+}
+
+}  // namespace mapless::run

@@ -1,0 +1,41 @@
+// The evaluation suites of `mapless eval SUITE` (eval/): each scenario's runs in parallel batches,
+// the results as one JSON object and a table, and with a report directory the HTML report with
+// the first run of each entry frame by frame (report.h, traces.h). The command parses a suite's
+// options and calls one of these.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "mapless/eval/teach_repeat.h"
+
+namespace mapless::run {
+
+struct SuiteOptions {
+  int runs = 10;
+  std::uint64_t seed = 1;  // run i uses seed + i
+  int jobs = 1;            // entries evaluated in parallel (the results do not depend on it)
+  std::string only;        // only this scenario of the suite
+  std::string report_dir;  // "" : no report
+  // Called once with the number of entries, then once per entry done (from any thread).
+  std::function<void(int total)> on_start;
+  std::function<void(const std::string& line)> on_entry_done;
+};
+
+struct SuiteOutput {
+  nlohmann::json json;  // {"suite", "runs", "seed", "results": [...], ...}
+  std::string table;    // the readable table, one line per entry
+};
+
+// table1, funnel-scenarios or obstacles: the funnel-lane repeat with `base`'s options (each
+// scenario taught once). `settings`: the repeat options as the command named them, into the JSON.
+SuiteOutput RunRepeatSuite(const std::string& suite, const SuiteOptions& options,
+                           const eval::RepeatRunOptions& base, const nlohmann::json& settings);
+// Ohnishi & Imiya, Section 5, and the inclusion of the hierarchical planes (Table 1).
+SuiteOutput RunPotentialSuite(const SuiteOptions& options);
+// Payá et al., Section 5.
+SuiteOutput RunEigenspaceSuite(const SuiteOptions& options);
+
+}  // namespace mapless::run
