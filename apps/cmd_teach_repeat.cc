@@ -22,6 +22,8 @@
 #include "mapless/route/route_store.h"
 #include "mapless/run/decision_log.h"
 #include "mapless/run/link_kinds.h"
+#include "mapless/run/sim_episode.h"
+#include "mapless/run/teach.h"
 #include "recording_args.h"
 #include "robot_run.h"
 #include "teach.h"
@@ -65,13 +67,12 @@ void RepeatOnSim(const RepeatArgs& r, const std::shared_ptr<route::Route>& route
   const auto recorder = OpenRecorder(r.record, recording::CameraInfoOf(scenario.camera.model));
   JsonLines log(r.log);
   StopCleanlyOnInterrupt();
+  const run::SimEpisode episode = run::FollowEpisode(scenario, run::RouteKind::kFunnel, r.seed,
+                                                     r.motion_noise, /*live_leader=*/false);
   eval::TaughtRoute taught;
   taught.route = route;
-  sim::DriveOptions drive;
-  drive.render_frames = false;
-  const sim::DriveSummary summary = sim::DriveTaughtPath(
-      scenario, drive, [&](const sim::DriveFrame& f) { taught.path.push_back(f.truth); });
-  taught.duration_s = summary.duration_s;
+  taught.path = episode.taught;
+  taught.duration_s = episode.taught_duration_s;
   eval::RepeatRunOptions run_options;
   run_options.repeat = options;
   run_options.seed = r.seed;

@@ -21,6 +21,8 @@ cd "$(dirname "$0")/.."
 jobs=$(nproc)
 bash scripts/setup.sh --test
 bash scripts/check_format.sh
+# No function over 120 lines in src/ or apps/ (issue 41: the long ones are where people change code).
+bash scripts/long_functions.sh 120 || { echo "test.sh: split the functions above (scripts/long_functions.sh)" >&2; exit 1; }
 
 # A GoogleTest case (label `unit`) runs in the release build only when tests/release_only_tests.txt
 # names it; every name there must be one.

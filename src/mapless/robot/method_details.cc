@@ -57,6 +57,7 @@ void PotentialDetail::Fields(nlohmann::json* j) const {
   (*j)["plane_found"] = s.plane_found;
   (*j)["plane_fraction"] = s.plane_fraction;
   (*j)["free_ahead"] = s.free_ahead;
+  (*j)["ground_mismatch"] = s.ground_mismatch;
   (*j)["theta_d_deg"] = RadToDeg(s.theta_d_rad);
   (*j)["theta_deg"] = RadToDeg(s.theta_rad);
   (*j)["force"] = {s.force[0], s.force[1]};

@@ -25,10 +25,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double SecondsSince(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
 void Say(const FleetEvalOptions& a, const std::string& line) {
   if (a.say) a.say("eval fleet: " + line);
 }

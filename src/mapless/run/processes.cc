@@ -22,9 +22,6 @@ namespace fs = std::filesystem;
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double ProcessSecondsSince(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 }  // namespace
 
 int FreePort() {
@@ -76,7 +73,7 @@ bool Child::Poll() {
 
 void Child::Wait(double seconds) {
   const auto t0 = Clock::now();
-  while (!Poll() && ProcessSecondsSince(t0) < seconds)
+  while (!Poll() && SecondsSince(t0) < seconds)
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   if (!Poll()) {
     Signal(SIGKILL);

@@ -5,6 +5,7 @@
 #include <sys/types.h>
 
 #include <atomic>
+#include <chrono>
 #include <map>
 #include <string>
 #include <thread>
@@ -12,6 +13,11 @@
 #include <vector>
 
 namespace mapless::run {
+
+// Seconds of the steady clock since `t0`.
+inline double SecondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 
 // A free TCP port on 127.0.0.1 (bound and released; the caller binds it right after).
 int FreePort();

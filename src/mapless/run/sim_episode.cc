@@ -35,6 +35,7 @@ SimEpisode FollowEpisode(const sim::Scenario& scenario, fleet::RouteKind kind, s
   const sim::DriveSummary drive = sim::DriveTaughtPath(
       scenario, path_only, [&](const sim::DriveFrame& f) { episode.taught.push_back(f.truth); });
   if (episode.taught.empty()) episode.taught.push_back(scenario.teach_start);
+  episode.taught_duration_s = drive.duration_s;
   const double factor = live_leader ? 2.0 : 1.0;
   if (kind == fleet::RouteKind::kFunnel) {
     eval::RepeatRunOptions run;

@@ -21,7 +21,8 @@ struct SimEpisode {
   eval::SimSetup setup;
   double timeout_s = 0.0;
   std::vector<Pose2> taught;  // the scenario's taught path (driven, not rendered)
-  double tolerance_m = 0.0;   // success: the run ends this close to the taught path's end
+  double taught_duration_s = 0.0;
+  double tolerance_m = 0.0;  // success: the run ends this close to the taught path's end
 };
 
 // The episode of following a route of `kind` on the scenario; `live_leader`: the route is still
