@@ -232,6 +232,53 @@ TEST(FleetRouteCopy, ABatchAppliesAsTheSameRecordsOneAtATime) {
 }
 
 // Waits (bounded) until `done` holds.
+// Issue 41: a leader's own records applied with what they were made from give the same route
+// directory; each record is encoded once for the wire; a follower's method reads the route in
+// pieces and gets the keyframes the whole-route snapshot has.
+TEST(FleetRouteCopy, OwnRecordsEncodedOnceAndTheRouteReadInPieces) {
+  RouteCopy applied(FreshDir("own_applied"));
+  RouteCopy own(FreshDir("own_own"));
+  route::Route pieces;
+  int changes = 0;
+  EXPECT_FALSE(own.UpdateFunnel(&pieces));  // nothing yet
+  const std::vector<Record> records = FunnelRecords(6, true);
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    applied.Apply({records[i]});
+    std::optional<route::Keyframe> kf;
+    if (records[i].type == RecordType::kKeyframe) kf = MakeKeyframe(static_cast<int>(i) - 1);
+    own.ApplyOwn(records[i], kf);
+    changes += own.UpdateFunnel(&pieces) ? 1 : 0;
+    EXPECT_EQ(pieces.keyframes.size(), i == 0 ? 0u : std::min<std::size_t>(i, 6));
+  }
+  EXPECT_EQ(Files(applied.dir()), Files(own.dir()));
+  EXPECT_EQ(changes, 7);  // six keyframes, then complete
+  EXPECT_FALSE(own.UpdateFunnel(&pieces));
+  ASSERT_NE(own.FunnelRoute(), nullptr);
+  EXPECT_TRUE(pieces.complete);
+  EXPECT_EQ(pieces.image_width, 320);
+  ASSERT_EQ(pieces.keyframes.size(), own.FunnelRoute()->keyframes.size());
+  for (std::size_t k = 0; k < pieces.keyframes.size(); ++k)
+    EXPECT_EQ(pieces.keyframes[k].t_ns, own.FunnelRoute()->keyframes[k].t_ns);
+  // The same bytes, the same buffer each time it is asked for.
+  const std::shared_ptr<const std::string> e3 = own.Encoded(3);
+  ASSERT_NE(e3, nullptr);
+  EXPECT_EQ(*e3, EncodeRecord(own.RecordsFrom(3, 1).at(0)));
+  EXPECT_EQ(own.Encoded(3).get(), e3.get());
+  EXPECT_EQ(own.Encoded(records.size()), nullptr);
+  // Route images: the image handed over is stored, not decoded again; the same files.
+  RouteCopy images_applied(FreshDir("own_images_applied"));
+  RouteCopy images_own(FreshDir("own_images_own"));
+  const std::vector<Record> image_records = ImageRecords(4, true);
+  for (std::size_t i = 0; i < image_records.size(); ++i) {
+    images_applied.Apply({image_records[i]});
+    const cv::Mat low = image_records[i].type == RecordType::kImage
+                            ? MakeImage(static_cast<int>(i) - 1).low
+                            : cv::Mat();
+    images_own.ApplyOwn(image_records[i], std::nullopt, low);
+  }
+  EXPECT_EQ(Files(images_applied.dir()), Files(images_own.dir()));
+}
+
 bool WaitFor(const std::function<bool()>& done, double seconds) {
   const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (std::chrono::steady_clock::now() < until) {

@@ -183,6 +183,12 @@ struct LeaderServer::Impl {
                                            std::to_string(from));
       }
       peer.fd = msg[1].get(ZMQ_SRCFD);
+      if (known && from == peer.next) {
+        // It has every record sent to it: nothing of ours is left in its queue.
+        queued_bytes -= peer.window_bytes;
+        peer.window.clear();
+        peer.window_bytes = 0;
+      }
       peer.next = from;
       peer.last_heard = Clock::now();
     }
@@ -191,6 +197,7 @@ struct LeaderServer::Impl {
   // Sends what each follower lacks; true when some follower's pipe is full (retry soon).
   bool SendRound() {
     bool blocked = false;
+    bool budget_full = false;
     const std::uint64_t size = log.next_sequence();
     const auto now = Clock::now();
     for (auto it = peers.begin(); it != peers.end();) {
@@ -208,6 +215,7 @@ struct LeaderServer::Impl {
         if (!bytes) break;
         if (!Affordable(peer, bytes->size())) {
           result = SendResult::kFull;  // the queues together are full: later
+          budget_full = true;
           break;
         }
         result = SendTo(router, it->first, bytes);
@@ -270,10 +278,34 @@ struct LeaderServer::Impl {
       }
       ++it;
     }
+    if (budget_full) DropSilentPeers(now);
     std::lock_guard<std::mutex> lock(stats_mutex);
     stats.followers = static_cast<int>(peers.size());
     stats.queued_bytes = queued_bytes;
     return blocked;
+  }
+
+  // The queues together are full: a follower that reads asks again within resubscribe_s when the
+  // leader falls silent (and then its queue is known to be empty), so one not heard from for
+  // stall_drop_s with records queued has stopped reading, even if its own queue never filled (the
+  // total filled first). It is dropped, as a full queue's follower is, so that the others move.
+  void DropSilentPeers(Clock::time_point now) {
+    for (auto it = peers.begin(); it != peers.end();) {
+      Peer& peer = it->second;
+      if (peer.window.empty() ||
+          now - peer.last_heard <= std::chrono::duration<double>(options.stall_drop_s)) {
+        ++it;
+        continue;
+      }
+      Count(&ServerStats::dropped);
+      LogLimited("followers dropped", "fleet: dropped the follower at " + peer.address +
+                                          " at record " + std::to_string(peer.next) +
+                                          ": nothing heard from it for " +
+                                          std::to_string(static_cast<int>(options.stall_drop_s)) +
+                                          " s while the leader's queues were full");
+      if (peer.fd >= 0) ::shutdown(peer.fd, SHUT_RDWR);
+      it = Forget(it);
+    }
   }
 
   void Run() {

@@ -31,8 +31,10 @@ using FleetLogger = std::function<void(const std::string&)>;
 // The bounds on what the network can make the leader hold (docs/hardening.md). A follower that
 // does not read fills its queue (peer_queue messages): after stall_drop_s it is dropped (its
 // connection closed) with a line; all queues together are held under
-// total_queue_bytes (a follower is served later rather than memory grown), and at most
-// max_followers are served at once (one more is told nothing and logged).
+// total_queue_bytes (a follower is served later rather than memory grown; while they are full, a
+// follower not heard from for stall_drop_s with records queued is dropped too: one that reads
+// asks again when the leader falls silent), and at most max_followers are served at once (one
+// more is told nothing and logged).
 struct ServerOptions {
   std::string bind = "tcp://127.0.0.1:5600";
   LeaderSecurity security;

@@ -113,7 +113,7 @@ RouteWriter::RouteWriter(std::string dir, const Manifest& manifest)
       width_(manifest.image_width),
       height_(manifest.image_height),
       complete_(manifest.complete) {
-  for (const ManifestEntry& e : manifest.keyframes) entries_.push_back({e.index, e.t_s});
+  for (const ManifestEntry& e : manifest.keyframes) entries_.push_back({e.index, e.t_s, {}});
 }
 
 std::unique_ptr<RouteWriter> RouteWriter::Reopen(const std::string& dir) {
@@ -149,7 +149,7 @@ void RouteWriter::AppendEncoded(int index, Timestamp t_ns, std::string_view yml,
   io::WriteNewFile(base.string() + ".png", png);
   pending_.push_back(base.string() + ".yml");
   pending_.push_back(base.string() + ".png");
-  entries_.push_back({index, ToSeconds(t_ns)});
+  entries_.push_back({index, ToSeconds(t_ns), {}});
 }
 
 void RouteWriter::Flush() {
@@ -172,13 +172,33 @@ void RouteWriter::WriteManifest() const {
   j["image_height"] = height_;
   j["complete"] = complete_;
   j["keyframes"] = nlohmann::json::array();
-  for (const Entry& e : entries_) {
-    j["keyframes"].push_back({{"index", e.index},
-                              {"t_s", e.t_s},
-                              {"data", KeyframeStem(e.index) + ".yml"},
-                              {"thumbnail", KeyframeStem(e.index) + ".png"}});
+  std::string text = j.dump(1);
+  if (!entries_.empty()) {
+    // The keyframes' array as nlohmann writes it (dump(1): one space per level), each entry's
+    // text made once: a follower appends one keyframe at a time, and writing every entry's JSON
+    // again each time grew with the route (issue 41). The same bytes as dumping it whole.
+    std::string keyframes = "[\n";
+    for (std::size_t k = 0; k < entries_.size(); ++k) {
+      const Entry& e = entries_[k];
+      if (e.text.empty()) {
+        const nlohmann::json entry = {{"index", e.index},
+                                      {"t_s", e.t_s},
+                                      {"data", KeyframeStem(e.index) + ".yml"},
+                                      {"thumbnail", KeyframeStem(e.index) + ".png"}};
+        std::string dumped = entry.dump(1);
+        e.text = "  ";
+        for (const char c : dumped) e.text += c == '\n' ? std::string("\n  ") : std::string(1, c);
+      }
+      keyframes += e.text;
+      keyframes += k + 1 < entries_.size() ? ",\n" : "\n";
+    }
+    keyframes += " ]";
+    const std::string empty = "\"keyframes\": []";
+    const std::size_t at = text.find(empty);
+    MAPLESS_CHECK(at != std::string::npos, "RouteWriter: no keyframes in the manifest");
+    text.replace(at + empty.size() - 2, 2, keyframes);
   }
-  io::WriteFileAtomic((std::filesystem::path(dir_) / "manifest.json").string(), j.dump(1) + "\n");
+  io::WriteFileAtomic((std::filesystem::path(dir_) / "manifest.json").string(), text + "\n");
 }
 
 Manifest ParseManifest(const std::string& text, const std::string& name) {

@@ -53,6 +53,7 @@ class RouteWriter {
   struct Entry {
     int index;
     double t_s;
+    mutable std::string text;  // its part of the manifest, written once (WriteManifest)
   };
   std::string dir_;
   std::string detector_;

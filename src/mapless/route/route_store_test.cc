@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <nlohmann/json.hpp>
 
 #include "mapless/core/check.h"
 #include "mapless/core/rng.h"
@@ -73,6 +74,25 @@ TEST(RouteStore, RoundTripsEveryField) {
       EXPECT_NE(got.odometry->theta_rad, expected.odometry->theta_rad);  // 0.1123456789 rounded
     }
   }
+}
+
+// The manifest is written a keyframe at a time (issue 41: each entry's text made once); it must be
+// the bytes nlohmann writes for the whole document, at every length and when finished.
+TEST(RouteStore, TheManifestIsWhatTheWholeDocumentDumpsTo) {
+  const std::string dir = FreshDir("manifest_text");
+  RouteWriter writer(dir, "orb", 640, 480);
+  const auto check = [&](const std::string& when) {
+    const std::string text = io::ReadFile(dir + "/manifest.json", 1 << 20);
+    EXPECT_EQ(text, nlohmann::json::parse(text).dump(1) + "\n") << when;
+  };
+  check("empty");
+  for (int i = 0; i < 4; ++i) {
+    writer.Append(MakeKeyframe(i));
+    check(std::to_string(i + 1) + " keyframes");
+  }
+  writer.Finish();
+  check("finished");
+  EXPECT_EQ(LoadRoute(dir).keyframes.size(), 4u);
 }
 
 TEST(RouteStore, AnUnfinishedTeachLoadsWithItsCompletedKeyframes) {
