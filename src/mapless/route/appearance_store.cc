@@ -10,6 +10,7 @@
 #include "mapless/io/atomic_file.h"
 #include "mapless/io/image_file.h"
 #include "mapless/io/limits.h"
+#include "mapless/route/manifest_text.h"
 
 namespace mapless::route {
 
@@ -91,18 +92,17 @@ void AppearanceRouteWriter::WriteManifest() const {
   j["low_width"] = header_.low_width;
   j["low_height"] = header_.low_height;
   j["complete"] = header_.complete;
-  nlohmann::json images = nlohmann::json::array();
-  for (std::size_t i = 0; i < entries_.size(); ++i) {
+  for (std::size_t i = entry_text_.size(); i < entries_.size(); ++i) {
     const StoredAppearanceImage& e = entries_[i];
-    images.push_back({{"index", i},
-                      {"distance_m", e.distance_m},
-                      {"x_m", e.odometry.x_m},
-                      {"y_m", e.odometry.y_m},
-                      {"theta_rad", e.odometry.theta_rad},
-                      {"file", ImageFile(static_cast<int>(i))}});
+    entry_text_.push_back(EntryText({{"index", i},
+                                     {"distance_m", e.distance_m},
+                                     {"x_m", e.odometry.x_m},
+                                     {"y_m", e.odometry.y_m},
+                                     {"theta_rad", e.odometry.theta_rad},
+                                     {"file", ImageFile(static_cast<int>(i))}}));
   }
-  j["images"] = images;
-  io::WriteFileAtomic((fs::path(dir_) / kManifest).string(), j.dump(1) + "\n");
+  io::WriteFileAtomic((fs::path(dir_) / kManifest).string(),
+                      ManifestText(j, "images", entry_text_));
 }
 
 std::string AppearanceImageFile(int index) { return ImageFile(index); }

@@ -64,8 +64,9 @@ class AppearanceRouteWriter {
   void WriteManifest() const;
   std::string dir_;
   StoredAppearanceRoute header_;
-  std::vector<StoredAppearanceImage> entries_;  // low images dropped after writing
-  std::vector<std::string> pending_;            // written, not yet flushed
+  std::vector<StoredAppearanceImage> entries_;   // low images dropped after writing
+  mutable std::vector<std::string> entry_text_;  // their parts of the manifest, made once
+  std::vector<std::string> pending_;             // written, not yet flushed
 };
 
 // A route image's manifest entry without its file (distance and odometry), as a JSON object, and

@@ -18,6 +18,7 @@
 #include "mapless/io/image_file.h"
 #include "mapless/io/limits.h"
 #include "mapless/io/yaml_reader.h"
+#include "mapless/route/manifest_text.h"
 
 namespace mapless::route {
 namespace {
@@ -171,34 +172,19 @@ void RouteWriter::WriteManifest() const {
   j["image_width"] = width_;
   j["image_height"] = height_;
   j["complete"] = complete_;
-  j["keyframes"] = nlohmann::json::array();
-  std::string text = j.dump(1);
-  if (!entries_.empty()) {
-    // The keyframes' array as nlohmann writes it (dump(1): one space per level), each entry's
-    // text made once: a follower appends one keyframe at a time, and writing every entry's JSON
-    // again each time grew with the route (issue 41). The same bytes as dumping it whole.
-    std::string keyframes = "[\n";
-    for (std::size_t k = 0; k < entries_.size(); ++k) {
-      const Entry& e = entries_[k];
-      if (e.text.empty()) {
-        const nlohmann::json entry = {{"index", e.index},
-                                      {"t_s", e.t_s},
-                                      {"data", KeyframeStem(e.index) + ".yml"},
-                                      {"thumbnail", KeyframeStem(e.index) + ".png"}};
-        std::string dumped = entry.dump(1);
-        e.text = "  ";
-        for (const char c : dumped) e.text += c == '\n' ? std::string("\n  ") : std::string(1, c);
-      }
-      keyframes += e.text;
-      keyframes += k + 1 < entries_.size() ? ",\n" : "\n";
+  std::vector<std::string> entries;
+  entries.reserve(entries_.size());
+  for (const Entry& e : entries_) {
+    if (e.text.empty()) {
+      e.text = EntryText({{"index", e.index},
+                          {"t_s", e.t_s},
+                          {"data", KeyframeStem(e.index) + ".yml"},
+                          {"thumbnail", KeyframeStem(e.index) + ".png"}});
     }
-    keyframes += " ]";
-    const std::string empty = "\"keyframes\": []";
-    const std::size_t at = text.find(empty);
-    MAPLESS_CHECK(at != std::string::npos, "RouteWriter: no keyframes in the manifest");
-    text.replace(at + empty.size() - 2, 2, keyframes);
+    entries.push_back(e.text);
   }
-  io::WriteFileAtomic((std::filesystem::path(dir_) / "manifest.json").string(), text + "\n");
+  io::WriteFileAtomic((std::filesystem::path(dir_) / "manifest.json").string(),
+                      ManifestText(j, "keyframes", entries));
 }
 
 Manifest ParseManifest(const std::string& text, const std::string& name) {

@@ -11,6 +11,7 @@
 #include "mapless/core/rng.h"
 #include "mapless/core/testing.h"
 #include "mapless/io/atomic_file.h"
+#include "mapless/route/appearance_store.h"
 
 namespace mapless::route {
 namespace {
@@ -93,6 +94,28 @@ TEST(RouteStore, TheManifestIsWhatTheWholeDocumentDumpsTo) {
   writer.Finish();
   check("finished");
   EXPECT_EQ(LoadRoute(dir).keyframes.size(), 4u);
+  // The appearance route's manifest, the same way, also after a reopened writer goes on.
+  const std::string adir = FreshDir("manifest_text_appearance");
+  const auto check_appearance = [&](const std::string& when) {
+    const std::string text = io::ReadFile(adir + "/appearance.json", 1 << 20);
+    EXPECT_EQ(text, nlohmann::json::parse(text).dump(1) + "\n") << when;
+  };
+  const auto image = [](int i) {
+    return StoredAppearanceImage{cv::Mat(64, 64, CV_8UC1, cv::Scalar(3 * i)), 0.25 * i,
+                                 Pose2{0.25 * i, 0.01 * i, 0.003 * i}};
+  };
+  {
+    AppearanceRouteWriter images(adir, 320, 240, 64, 64);
+    check_appearance("empty");
+    for (int i = 0; i < 3; ++i) images.Append(image(i));
+    check_appearance("3 images");
+  }
+  std::unique_ptr<AppearanceRouteWriter> reopened = AppearanceRouteWriter::Reopen(adir);
+  reopened->Append(image(3));
+  check_appearance("reopened, 4 images");
+  reopened->Finish();
+  check_appearance("finished");
+  EXPECT_EQ(LoadAppearanceRoute(adir).images.size(), 4u);
 }
 
 TEST(RouteStore, AnUnfinishedTeachLoadsWithItsCompletedKeyframes) {
