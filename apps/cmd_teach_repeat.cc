@@ -287,7 +287,10 @@ static void AddRouteCommand(CLI::App* app) {
     j["image_width"] = route.image_width;
     j["image_height"] = route.image_height;
     j["keypoints"] = keypoints;
-    j["duration_s"] = route.keyframes.empty() ? 0.0 : ToSeconds(route.keyframes.back().t_ns);
+    // From the first keyframe to the last: a robot's keyframes carry the ROS clock's time.
+    j["duration_s"] = route.keyframes.empty()
+                          ? 0.0
+                          : ToSeconds(route.keyframes.back().t_ns - route.keyframes.front().t_ns);
     if (i->json) {
       std::cout << j.dump() << "\n";
     } else {

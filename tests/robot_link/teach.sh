@@ -44,9 +44,15 @@ wait "$T1"; R1=$?
 wait "$T2"; R2=$?
 kill -INT "$DRIVER" 2>/dev/null
 FAILS=0
+# The route's duration runs from its first keyframe to its last (a robot's keyframes carry the ROS
+# clock's time: it was reported as 1.8e9 s).
+duration_ok() {
+  awk -v d="$(grep -o '"duration_s": *[0-9.e+-]*' "$1" | sed 's/.*: *//')" \
+    'BEGIN { exit !(d != "" && d + 0 > 0 && d + 0 < 600) }'
+}
 if [ "$R1" = 130 ] && "$BIN" route info "$OUT/funnel" --json >"$OUT/info.json" 2>"$OUT/info.err" &&
-   grep -q '"complete": *true' "$OUT/info.json"; then
-  echo "ok   teach --robot (funnel): exit 130, complete route: $(grep -o '"keyframes": *[0-9]*' "$OUT/info.json")"
+   grep -q '"complete": *true' "$OUT/info.json" && duration_ok "$OUT/info.json"; then
+  echo "ok   teach --robot (funnel): exit 130, complete route: $(grep -o '"keyframes": *[0-9]*' "$OUT/info.json"), $(grep -o '"duration_s": *[0-9.]*' "$OUT/info.json")"
 else
   echo "FAIL teach --robot (funnel): exit $R1"; tail -3 "$OUT/t1.log" "$OUT/info.err" 2>/dev/null; FAILS=$((FAILS + 1))
 fi

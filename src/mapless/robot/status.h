@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <string>
+#include <vector>
 
 #include "mapless/robot/method.h"
 
@@ -16,6 +17,10 @@ namespace mapless::robot {
 // fields}. `frame` is the frame's number in the run.
 nlohmann::json StatusJson(const char* method, int frame, const Observation& observation,
                           const Decision& decision);
+
+// `text` in lines of the debug picture's font no wider than `max_width_px`, broken between words
+// (a word wider than that is cut), at most `max_lines` (the last then ends in "...").
+std::vector<std::string> WrapText(const std::string& text, int max_width_px, int max_lines);
 
 // `v` with `digits` decimals, for the debug picture's text.
 std::string FixedText(double v, int digits);

@@ -176,6 +176,35 @@ TEST(RunLayer, TheMethodDrawsItsOwnDebugPicture) {
   EXPECT_GT(cv::countNonZero(picture.reshape(1)), 0);
 }
 
+// The debug picture's text stays within the picture (a 320-pixel picture cut the reason off).
+TEST(RunLayer, TheDebugPicturesTextFitsItsWidth) {
+  const std::string reason =
+      "blocked: obstacle ahead (34% of the ground ahead does not move like the ground): stopped, "
+      "waiting for the way to be free";
+  const auto width = [](const std::string& line) {
+    int baseline = 0;
+    return cv::getTextSize(line, cv::FONT_HERSHEY_PLAIN, 0.9, 1, &baseline).width;
+  };
+  ASSERT_GT(width(reason), 312);
+  const std::vector<std::string> lines = robot::WrapText(reason, 312, 4);
+  ASSERT_GE(lines.size(), 2u);
+  std::string joined;
+  for (const std::string& line : lines) {
+    EXPECT_LE(width(line), 312) << line;
+    joined += (joined.empty() ? "" : " ") + line;
+  }
+  EXPECT_EQ(joined, reason);  // every word, in order
+  const std::vector<std::string> two = robot::WrapText(reason, 312, 2);
+  ASSERT_EQ(two.size(), 2u);
+  EXPECT_EQ(two[1].substr(two[1].size() - 3), "...");
+  EXPECT_LE(width(two[1]), 312);
+  robot::Observation obs;
+  obs.image = cv::Mat(240, 320, CV_8UC1, cv::Scalar(128));
+  robot::Decision d;
+  d.reason = reason;
+  EXPECT_EQ(robot::DebugImage(obs, d).cols, 320);
+}
+
 TEST(LinkKinds, StandardKindsTellSourcesApartAndRefuseWhatTheyCannotOpen) {
   const robot::MiddlewareRegistry none;
   LinkKinds kinds = StandardLinkKinds(none);
