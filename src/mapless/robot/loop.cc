@@ -18,6 +18,8 @@ void LoopOptions::Validate() const {
   MAPLESS_CHECK(
       std::isfinite(give_up_without_frames_s) && give_up_without_frames_s >= 0.0,
       "LoopOptions.give_up_without_frames_s = " << give_up_without_frames_s << "; must be >= 0");
+  MAPLESS_CHECK(std::isfinite(max_blocked_s) && max_blocked_s >= 0.0,
+                "LoopOptions.max_blocked_s = " << max_blocked_s << "; must be >= 0");
 }
 
 Twist2 LimitCommand(const Twist2& command, const LoopOptions& options) {
@@ -46,6 +48,8 @@ LoopResult RunLoop(Method& method, RobotLink& link, const LoopOptions& options,
   LoopResult result;
   bool have_frame_time = false;
   Timestamp last_frame_ns = 0;
+  bool blocked = false;  // by an obstacle, since blocked_since_ns
+  Timestamp blocked_since_ns = 0;
   auto end = [&](bool finished, const std::string& reason) {
     result.finished = finished;
     result.failed = !finished;
@@ -99,6 +103,16 @@ LoopResult RunLoop(Method& method, RobotLink& link, const LoopOptions& options,
     decision.command = LimitCommand(decision.command, options);
     ++result.frames;
     if (observer && !observer(obs, decision)) return end(true, "the run's goal was reached");
+    if (decision.blocked && !blocked) blocked_since_ns = obs.t_ns;
+    blocked = decision.blocked;
+    if (blocked && options.max_blocked_s > 0.0 &&
+        ToSeconds(obs.t_ns - blocked_since_ns) > options.max_blocked_s) {
+      link.Send(Twist2{}, obs, decision);
+      return end(false, "blocked for " + Seconds(ToSeconds(obs.t_ns - blocked_since_ns)) + " (" +
+                            decision.reason +
+                            "): clear the way and start again, or raise safety.max_blocked_s in "
+                            "the robot file");
+    }
     if (decision.done()) {
       link.Send(Twist2{}, obs, decision);  // the final decision reaches the status, with a zero
       return end(decision.state == MethodState::kFinished,

@@ -26,6 +26,10 @@ struct LoopOptions {
   // No frame for this long (link clock, counted from the last frame): the run fails. 0: wait for
   // ever (the robot stays stopped).
   double give_up_without_frames_s = 0.0;
+  // The method blocked by an obstacle (Decision::blocked) this long without a break (link clock):
+  // the run fails with a reason that says what the user can do. 0: wait for ever (the suites: the
+  // scenario decides when the way is free).
+  double max_blocked_s = 0.0;
   void Validate() const;
 };
 

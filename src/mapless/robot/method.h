@@ -50,9 +50,10 @@ class DecisionDetail {
 // What the method decided on one frame.
 struct Decision {
   MethodState state = MethodState::kStopped;
-  Twist2 command;      // zero unless kDriving
-  std::string status;  // the method's own state name ("driving", "searching", "waiting", ...)
-  std::string reason;  // why it stopped, finished or failed
+  Twist2 command;        // zero unless kDriving
+  std::string status;    // the method's own state name ("driving", "searching", "waiting", ...)
+  std::string reason;    // why it stopped, finished or failed
+  bool blocked = false;  // held by an obstacle on the way (kStopped), going on when it is gone
   std::shared_ptr<const DecisionDetail> detail;  // null: nothing beyond the above
   bool done() const { return state == MethodState::kFinished || state == MethodState::kFailed; }
   // The detail as the method's own type (null when it is another or none).

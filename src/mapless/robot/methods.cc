@@ -109,6 +109,7 @@ Decision RepeatMethod::Step(const Observation& observation) {
       break;
   }
   Decision d = Make(state, step.command, navigation::RepeatStatusName(step.status), step.reason);
+  d.blocked = step.status == navigation::RepeatStatus::kBlocked;
   d.detail = std::make_shared<RepeatDetail>(std::move(step));
   return d;
 }
@@ -180,6 +181,7 @@ Decision FollowMethod::Step(const Observation& observation) {
       break;
   }
   Decision d = Make(state, step.command, navigation::FollowerStateName(step.state), step.reason);
+  d.blocked = step.obstacle.blocked && state == MethodState::kStopped;
   d.detail = std::make_shared<FollowerDetail>(std::move(step));
   return d;
 }

@@ -71,6 +71,7 @@ LoopOptions RobotFile::Loop() const {
   o.max_turn_rate_radps = max_turn_rate_radps;
   o.max_frame_age_s = max_frame_age_s;
   o.give_up_without_frames_s = give_up_without_frames_s;
+  o.max_blocked_s = max_blocked_s;
   return o;
 }
 
@@ -193,8 +194,8 @@ RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
     }
     if (map.Has("safety")) {
       const io::YamlMap s = map.GetMap("safety");
-      s.CheckKnownKeys(
-          {"camera_timeout_s", "max_frame_age_s", "give_up_without_frames_s", "connect_timeout_s"});
+      s.CheckKnownKeys({"camera_timeout_s", "max_frame_age_s", "give_up_without_frames_s",
+                        "connect_timeout_s", "max_blocked_s"});
       r.camera_timeout_s = Positive(s, "camera_timeout_s", r.camera_timeout_s, 10.0);
       r.max_frame_age_s = Positive(s, "max_frame_age_s", r.max_frame_age_s, 60.0);
       r.give_up_without_frames_s =
@@ -203,6 +204,9 @@ RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
           r.give_up_without_frames_s > 3600.0)
         s.Fail("give_up_without_frames_s", "must be in [0, 3600] (0: wait for ever)");
       r.connect_timeout_s = Positive(s, "connect_timeout_s", r.connect_timeout_s, 600.0);
+      r.max_blocked_s = s.GetDouble("max_blocked_s", r.max_blocked_s);
+      if (!std::isfinite(r.max_blocked_s) || r.max_blocked_s < 0.0 || r.max_blocked_s > 86400.0)
+        s.Fail("max_blocked_s", "must be in [0, 86400] (0: wait for ever)");
     }
     if (map.Has("obstacles")) ParseObstacles(map.GetMap("obstacles"), &r);
     r.use_sim_time = map.GetBool("use_sim_time", false);

@@ -47,6 +47,9 @@ struct RobotFile {
   double max_frame_age_s = 0.5;
   // No frame for this long: the run ends (exit 1). 0: the robot waits stopped for ever.
   double give_up_without_frames_s = 30.0;
+  // Stopped for an obstacle this long without a break: the run ends with exit 1 and the reason
+  // (safety.max_blocked_s; 0: wait for ever).
+  double max_blocked_s = 60.0;
   // The obstacle watch of `repeat` (section `obstacles`): on_obstacle stop (default) or off, and
   // the image region the robot drives through next, for this robot's camera.
   navigation::ObstacleWatchOptions obstacle;

@@ -38,6 +38,14 @@ void ExpectError(const std::string& text, const std::string& needle) {
   }
 }
 
+TEST(RobotFile, HowLongABlockedRobotWaitsIsASetting) {
+  EXPECT_EQ(ParseRobotFile("{}", "r.yaml").Loop().max_blocked_s, 60.0);
+  EXPECT_EQ(ParseRobotFile("safety: {max_blocked_s: 0}\n", "r.yaml").Loop().max_blocked_s, 0.0);
+  EXPECT_EQ(ParseRobotFile("safety: {max_blocked_s: 300}\n", "r.yaml").max_blocked_s, 300.0);
+  ExpectError("safety: {max_blocked_s: -1}\n", "max_blocked_s");
+  ExpectError("safety: {max_blocked_s: .nan}\n", "max_blocked_s");
+}
+
 TEST(RobotFile, BadFieldsAreNamed) {
   ExpectError("topic: {image: x}\n", "topic");
   ExpectError("topics: {imagee: x}\n", "imagee");

@@ -176,6 +176,47 @@ TEST(RunLayer, TheMethodDrawsItsOwnDebugPicture) {
   EXPECT_GT(cv::countNonZero(picture.reshape(1)), 0);
 }
 
+// A method held by an obstacle that never goes: the run ends after max_blocked_s (issue 42: a
+// blocked repeat waited until Ctrl-C), with a reason that says what to do; a break restarts the
+// count.
+class BlockedMethod : public robot::Method {
+ public:
+  explicit BlockedMethod(int free_at) : free_at_(free_at) {}
+  const char* name() const override { return "blocked"; }
+  bool needs_odometry() const override { return false; }
+  cv::Size image_size() const override { return {}; }
+  robot::Decision Step(const robot::Observation&) override {
+    robot::Decision d;
+    d.state = robot::MethodState::kStopped;
+    d.status = "blocked";
+    d.reason = "obstacle ahead";
+    d.blocked = ++frames_ != free_at_;
+    return d;
+  }
+
+ private:
+  int free_at_;
+  int frames_ = 0;
+};
+
+TEST(RunLayer, ABlockedRobotStopsWaitingAfterMaxBlocked) {
+  ListLink link(100);       // 10 frames a second
+  BlockedMethod method(5);  // one frame free at 0.4 s: the count starts again at 0.5 s
+  RunOptions options;
+  options.loop.max_blocked_s = 1.0;
+  options.interrupted = [] { return false; };
+  const RunOutcome outcome = RunMethod(method, link, options);
+  EXPECT_FALSE(outcome.loop.finished);
+  EXPECT_EQ(outcome.loop.frames, 17);  // blocked from 0.5 s, more than 1 s at 1.6 s
+  EXPECT_EQ(outcome.loop.reason.rfind("blocked for 1.10 s (obstacle ahead): clear the way", 0), 0u)
+      << outcome.loop.reason;
+  for (const Twist2& c : link.sent) EXPECT_EQ(c.v_mps, 0.0);
+  ListLink forever(100);
+  BlockedMethod again(-1);
+  options.loop.max_blocked_s = 0.0;  // wait for ever: the link's end ends it
+  EXPECT_EQ(RunMethod(again, forever, options).loop.reason, "end of the list");
+}
+
 // The debug picture's text stays within the picture (a 320-pixel picture cut the reason off).
 TEST(RunLayer, TheDebugPicturesTextFitsItsWidth) {
   const std::string reason =
