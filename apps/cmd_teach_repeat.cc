@@ -4,17 +4,14 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
-#include <optional>
 
 #include "cli_common.h"
 #include "interrupt.h"
 #include "mapless/core/check.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/io/frame_source.h"
-#include "mapless/io/output_dir.h"
 #include "mapless/recording/recording_link.h"
 #include "mapless/robot/methods.h"
 #include "mapless/robot/robot_file.h"
@@ -23,7 +20,6 @@
 #include "mapless/run/decision_log.h"
 #include "mapless/run/link_kinds.h"
 #include "mapless/run/sim_episode.h"
-#include "mapless/run/teach.h"
 #include "recording_args.h"
 #include "robot_run.h"
 #include "teach.h"
@@ -67,7 +63,7 @@ void RepeatOnSim(const RepeatArgs& r, const std::shared_ptr<route::Route>& route
   const auto recorder = OpenRecorder(r.record, recording::CameraInfoOf(scenario.camera.model));
   JsonLines log(r.log);
   StopCleanlyOnInterrupt();
-  const run::SimEpisode episode = run::FollowEpisode(scenario, run::RouteKind::kFunnel, r.seed,
+  const run::SimEpisode episode = run::FollowEpisode(scenario, fleet::RouteKind::kFunnel, r.seed,
                                                      r.motion_noise, /*live_leader=*/false);
   eval::TaughtRoute taught;
   taught.route = route;
