@@ -137,8 +137,8 @@ static void AddTeachCommand(CLI::App* app) {
   CLI::App* teach = app->add_subcommand(
       "teach",
       "Teach a route: keyframes from a video, an image folder, a camera or sim:SCENARIO. Ctrl-C "
-      "stops it cleanly (exit 130): a camera teach ends there with a complete route, any other "
-      "keeps its finished keyframes marked incomplete");
+      "ends a camera or robot teach with a complete route (exit 0); any other it stops cleanly "
+      "(exit 130), its finished keyframes kept, marked incomplete");
   CLI::Option* teach_source = teach->add_option(
       "--source", t->source, "sim:SCENARIO, a video file, an image folder, camera:N");
   teach

@@ -23,8 +23,9 @@ namespace mapless::app {
 // Teaching writes the route as it goes into ROUTE (a new or empty directory), or, with
 // --overwrite over an existing route, into a staging directory that replaces ROUTE when the teach
 // is done (io::OutputDirectory). Ctrl-C ends the teach cleanly: a camera or robot teach ends there
-// with a complete route; a recording or simulator teach keeps what it stored in ROUTE marked
-// incomplete (in place), or leaves the old route untouched (--overwrite).
+// with a complete route, exit 0 (its normal end); a recording or simulator teach keeps what it
+// stored in ROUTE marked incomplete (in place), or leaves the old route untouched (--overwrite),
+// exit 130.
 void Teach(const TeachArgs& t) {
   const bool eigenspace = t.method == "eigenspace";
   if (!eigenspace && t.method != "funnel")
@@ -126,8 +127,9 @@ void Teach(const TeachArgs& t) {
                     (out.staged() ? "put in place of the old one" : "marked complete"));
   }
   out.Commit();
-  spdlog::info("teach: route of {} {} written to {}", teacher.stored(), teacher.unit(), t.out);
-  if (outcome.interrupted) throw Interrupted(InterruptSignal());
+  spdlog::info(
+      "teach: route of {} {} written to {}{}", teacher.stored(), teacher.unit(), t.out,
+      outcome.interrupted ? " (ended by Ctrl-C, as a teach on a camera or robot ends)" : "");
 }
 
 }  // namespace mapless::app
