@@ -46,6 +46,13 @@ section_basics() {
     grep -qi "usage" "$TMP/out"; check "help text: mapless $sub" $?
   done
 
+  # The image codecs, video I/O and FFmpeg are opened on first use, not linked: a start of the
+  # command does not load their 200 libraries (io/lazy_libraries.h).
+  if command -v readelf >/dev/null; then
+    ! readelf -d "$MAPLESS" | grep NEEDED | grep -Eq "opencv_imgcodecs|opencv_videoio|libav|libswscale"
+    check "mapless links no image codec, video I/O or FFmpeg library" $?
+  fi
+
   # sim list: one name per line, the paper scenarios among them.
   expect_exit "sim list" 0 "$MAPLESS" sim list
   [ "$(wc -l <"$TMP/out")" -ge 15 ]; check "sim list has >= 15 scenarios" $?

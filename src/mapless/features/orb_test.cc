@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "mapless/io/image_file.h"
 #include "mapless/sim/simulation.h"
 
 namespace mapless::features {
@@ -100,7 +101,7 @@ TEST(OrbDetector, GivesOpenCvsOrbOnSimulatorFrames) {
 TEST(OrbDetector, GivesOpenCvsOrbOnCameraImagesAndOtherSizes) {
   const std::string dir = std::string(MAPLESS_SOURCE_DIR) + "/tests/data/stromovka/";
   for (const char* name : {"0101.png", "0103.png", "0601.png", "1203.png"}) {
-    const cv::Mat image = cv::imread(dir + name, cv::IMREAD_GRAYSCALE);
+    const cv::Mat image = io::ReadImage(dir + name, cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(image.empty()) << dir + name;
     ExpectSameAsOpenCv(image, 500, 10, name);
     ExpectSameAsOpenCv(image, 1000, 20, std::string(name) + " 1000 features");
@@ -112,7 +113,7 @@ TEST(OrbDetector, GivesOpenCvsOrbOnCameraImagesAndOtherSizes) {
     ExpectSameAsOpenCv(small, 500, 10, std::string(name) + " at 90x70");
   }
   cv::Mat colour;
-  cv::cvtColor(cv::imread(dir + "0101.png", cv::IMREAD_GRAYSCALE), colour, cv::COLOR_GRAY2BGR);
+  cv::cvtColor(io::ReadImage(dir + "0101.png", cv::IMREAD_GRAYSCALE), colour, cv::COLOR_GRAY2BGR);
   ExpectSameAsOpenCv(colour, 500, 10, "a colour image (cv::ORB's own path)");
   cv::Mat noise(240, 320, CV_8U);
   cv::RNG rng(7);
@@ -121,7 +122,7 @@ TEST(OrbDetector, GivesOpenCvsOrbOnCameraImagesAndOtherSizes) {
   ExpectSameAsOpenCv(cv::Mat(240, 320, CV_8U, cv::Scalar(128)), 500, 10, "flat");
   ExpectSameAsOpenCv(cv::Mat(40, 50, CV_8U, cv::Scalar(0)), 500, 10, "too small for any keypoint");
   // Very few features: the geometric split gives none to most levels, the one to the last.
-  const cv::Mat stromovka = cv::imread(dir + "0101.png", cv::IMREAD_GRAYSCALE);
+  const cv::Mat stromovka = io::ReadImage(dir + "0101.png", cv::IMREAD_GRAYSCALE);
   ExpectSameAsOpenCv(stromovka, 1, 10, "one feature");
   ExpectSameAsOpenCv(stromovka, 12, 10, "12 features");
 }

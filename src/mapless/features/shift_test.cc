@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "mapless/io/image_file.h"
 #include "mapless/sim/simulation.h"
 
 namespace mapless::features {
@@ -70,7 +71,7 @@ double FractionWithin(const Stromovka& data, double tolerance_px) {
   for (const auto& [key, dx] : data.offset) {
     char name[32];
     std::snprintf(name, sizeof(name), "/%02d%02d.png", key.second, key.first);
-    const cv::Mat img = cv::imread(data.dir + name, cv::IMREAD_GRAYSCALE);
+    const cv::Mat img = io::ReadImage(data.dir + name, cv::IMREAD_GRAYSCALE);
     EXPECT_FALSE(img.empty()) << data.dir + name;
     features[key] = extractor.Extract(img);
   }

@@ -13,6 +13,7 @@
 #include "mapless/core/testing.h"
 #include "mapless/io/atomic_file.h"
 #include "mapless/io/flo.h"
+#include "mapless/io/image_file.h"
 
 namespace mapless::flow {
 namespace {
@@ -135,8 +136,8 @@ TEST(DenseLucasKanade, RubberWhaleEndPointError) {
   const std::string dir = std::string(MAPLESS_SOURCE_DIR) + "/../shared/data/flow";
   if (!std::filesystem::exists(dir + "/rubberwhale_gt.flo"))
     GTEST_SKIP() << "shared data not found at " << dir;
-  const cv::Mat a = cv::imread(dir + "/rubberwhale1.png", cv::IMREAD_GRAYSCALE);
-  const cv::Mat b = cv::imread(dir + "/rubberwhale2.png", cv::IMREAD_GRAYSCALE);
+  const cv::Mat a = io::ReadImage(dir + "/rubberwhale1.png", cv::IMREAD_GRAYSCALE);
+  const cv::Mat b = io::ReadImage(dir + "/rubberwhale2.png", cv::IMREAD_GRAYSCALE);
   const cv::Mat truth = io::ReadFlo(dir + "/rubberwhale_gt.flo");
   FlowOptions dis;
   const double dis_epe = EndPointError(ComputeFlow(a, b, dis), truth).mean_epe_px;

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "mapless/flow/flow.h"
+#include "mapless/io/image_file.h"
 
 namespace mapless::ground {
 namespace {
@@ -118,9 +119,9 @@ TEST(DetectDominantPlane, CamVidGroundIoU) {
   double sum = 0.0;
   double sum_paper = 0.0;
   for (std::size_t i = 0; i + 1 < names.size(); ++i) {
-    const cv::Mat a = cv::imread(dir + "/frames/" + names[i], cv::IMREAD_GRAYSCALE);
-    const cv::Mat b = cv::imread(dir + "/frames/" + names[i + 1], cv::IMREAD_GRAYSCALE);
-    const cv::Mat truth = cv::imread(dir + "/ground/" + names[i], cv::IMREAD_GRAYSCALE) > 127;
+    const cv::Mat a = io::ReadImage(dir + "/frames/" + names[i], cv::IMREAD_GRAYSCALE);
+    const cv::Mat b = io::ReadImage(dir + "/frames/" + names[i + 1], cv::IMREAD_GRAYSCALE);
+    const cv::Mat truth = io::ReadImage(dir + "/ground/" + names[i], cv::IMREAD_GRAYSCALE) > 127;
     const cv::Mat field = flow::ComputeFlow(a, b, flow_options);
     const cv::Rect bottom(0, a.rows / 2, a.cols, a.rows - a.rows / 2);
     sum += MaskIoU(DetectDominantPlane(field, options).mask, truth, bottom);

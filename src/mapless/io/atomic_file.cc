@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "mapless/core/check.h"
+#include "mapless/io/lazy_libraries.h"
 
 namespace mapless::io {
 
@@ -92,11 +93,12 @@ void SyncFile(const std::string& path) {
   ::close(fd);
 }
 
-std::string EncodeImage(const cv::Mat& image, const std::string& ext, const std::string& name) {
+std::string EncodeImage(const cv::Mat& image, const std::string& ext, const std::string& name,
+                        const std::vector<int>& params) {
   std::vector<uchar> buffer;
   bool ok = false;
   try {
-    ok = cv::imencode(ext, image, buffer);
+    ok = lazy::ImEncode(ext, image, &buffer, params);
   } catch (const cv::Exception&) {
     ok = false;
   }

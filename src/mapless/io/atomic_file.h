@@ -31,8 +31,10 @@ void SyncFile(const std::string& path);
 // are on at once (syncfs: one journal commit instead of one per file).
 void SyncFiles(const std::vector<std::string>& paths);
 
-// An image encoded as `ext` (".png", ...); throws InputError naming `name` when it cannot be.
-std::string EncodeImage(const cv::Mat& image, const std::string& ext, const std::string& name);
+// An image encoded as `ext` (".png", ".jpg", ...) with cv::imencode's `params`
+// (cv::IMWRITE_*); throws InputError naming `name` when it cannot be.
+std::string EncodeImage(const cv::Mat& image, const std::string& ext, const std::string& name,
+                        const std::vector<int>& params = {});
 
 // Encodes an image by the extension of `path` (.png, .jpg, ...) and writes it atomically.
 void WriteImageAtomic(const std::string& path, const cv::Mat& image);

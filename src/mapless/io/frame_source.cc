@@ -3,13 +3,12 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 #include <vector>
 
 #include "mapless/core/check.h"
 #include "mapless/io/image_file.h"
+#include "mapless/io/lazy_libraries.h"
 #include "mapless/io/limits.h"
 #include "mapless/io/video_file.h"
 
@@ -74,16 +73,16 @@ class CameraSource : public FrameSource {
   CameraSource(const std::string& spec, bool by_number, int device) : spec_(spec) {
     bool ok = false;
     try {
-      ok = by_number ? capture_.open(device, cv::CAP_V4L2) : capture_.open(spec, cv::CAP_V4L2);
+      ok = by_number ? capture_.Open(device, cv::CAP_V4L2) : capture_.Open(spec, cv::CAP_V4L2);
     } catch (const cv::Exception&) {
       ok = false;
     }
-    if (!ok || !capture_.isOpened()) throw InputError(spec + ": cannot open camera");
-    fps_ = capture_.get(cv::CAP_PROP_FPS);
+    if (!ok || !capture_.IsOpened()) throw InputError(spec + ": cannot open camera");
+    fps_ = capture_.Get(cv::CAP_PROP_FPS);
     if (!(fps_ > 0.0 && fps_ < 1000.0)) fps_ = 30.0;
     // The container's declared size, checked before the first frame is decoded.
-    const double width = capture_.get(cv::CAP_PROP_FRAME_WIDTH);
-    const double height = capture_.get(cv::CAP_PROP_FRAME_HEIGHT);
+    const double width = capture_.Get(cv::CAP_PROP_FRAME_WIDTH);
+    const double height = capture_.Get(cv::CAP_PROP_FRAME_HEIGHT);
     if (width > 0.0 && height > 0.0 && width < 1e9 && height < 1e9) {
       CheckFrameSize(static_cast<int>(width), static_cast<int>(height), spec);
     }
@@ -91,7 +90,7 @@ class CameraSource : public FrameSource {
   bool Next(Frame* frame) override {
     cv::Mat img;
     try {
-      if (!capture_.read(img) || img.empty()) return false;
+      if (!capture_.Read(&img) || img.empty()) return false;
     } catch (const cv::Exception&) {
       throw InputError(spec_ + ": frame " + std::to_string(index_) + " does not decode");
     }
@@ -116,7 +115,7 @@ class CameraSource : public FrameSource {
 
  private:
   std::string spec_;
-  cv::VideoCapture capture_;
+  lazy::VideoCapture capture_;
   double fps_ = 30.0;
   long index_ = 0;
   cv::Size size_;

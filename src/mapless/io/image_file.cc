@@ -12,6 +12,7 @@
 
 #include "mapless/core/check.h"
 #include "mapless/io/atomic_file.h"
+#include "mapless/io/lazy_libraries.h"
 #include "mapless/io/limits.h"
 
 namespace mapless::io {
@@ -255,7 +256,7 @@ cv::Mat DecodeImage(std::string_view bytes, const std::string& name, int flags, 
       // imdecode does not write to its input.
       const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8UC1,
                            const_cast<char*>(bytes.data()));
-      image = cv::imdecode(buffer, flags);
+      image = lazy::ImDecode(buffer, flags);
     } catch (const cv::Exception&) {
       image.release();
     }

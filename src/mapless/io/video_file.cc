@@ -1,14 +1,5 @@
 #include "mapless/io/video_file.h"
 
-extern "C" {
-#include <libavcodec/avcodec.h>
-#include <libavformat/avformat.h>
-#include <libavutil/dict.h>
-#include <libavutil/log.h>
-#include <libavutil/mem.h>
-#include <libswscale/swscale.h>
-}
-
 #include <sys/stat.h>
 
 #include <cstdarg>
@@ -17,10 +8,13 @@ extern "C" {
 
 #include "mapless/core/check.h"
 #include "mapless/io/image_file.h"
+#include "mapless/io/lazy_ffmpeg.h"
 #include "mapless/io/limits.h"
 
 namespace mapless::io {
 namespace {
+
+const lazy::Ffmpeg& Ff() { return lazy::LoadFfmpeg(); }
 
 // FFmpeg prints its own messages ("moov atom not found") to stderr; a file that cannot be read is
 // reported as one InputError instead, so they are dropped.
@@ -33,8 +27,8 @@ constexpr std::size_t kMaxFfmpegAllocation = std::size_t{256} << 20;
 void ConfigureFfmpeg() {
   static std::once_flag once;
   std::call_once(once, [] {
-    av_log_set_callback(QuietFfmpegLog);
-    av_max_alloc(kMaxFfmpegAllocation);
+    Ff().av_log_set_callback(QuietFfmpegLog);
+    Ff().av_max_alloc(kMaxFfmpegAllocation);
   });
 }
 
@@ -46,19 +40,19 @@ constexpr const char* kCodecs =
     "msmpeg4v2,msmpeg4v3,wmv1,wmv2,wmv3,vc1,h263,flv,png,ffv1";
 
 struct FormatCloser {
-  void operator()(AVFormatContext* f) const { avformat_close_input(&f); }
+  void operator()(AVFormatContext* f) const { Ff().avformat_close_input(&f); }
 };
 struct DecoderFreer {
-  void operator()(AVCodecContext* c) const { avcodec_free_context(&c); }
+  void operator()(AVCodecContext* c) const { Ff().avcodec_free_context(&c); }
 };
 struct PacketFreer {
-  void operator()(AVPacket* p) const { av_packet_free(&p); }
+  void operator()(AVPacket* p) const { Ff().av_packet_free(&p); }
 };
 struct FrameFreer {
-  void operator()(AVFrame* f) const { av_frame_free(&f); }
+  void operator()(AVFrame* f) const { Ff().av_frame_free(&f); }
 };
 struct ScalerFreer {
-  void operator()(SwsContext* s) const { sws_freeContext(s); }
+  void operator()(SwsContext* s) const { Ff().sws_freeContext(s); }
 };
 
 // Decoding a hostile file must end: packets read per decoded frame are bounded.
@@ -74,34 +68,34 @@ class FfmpegVideo : public FrameSource {
       Fail(": not a regular file (a video file must be one; cameras are camera:N or /dev/videoN)");
     }
     AVDictionary* options = nullptr;
-    av_dict_set(&options, "format_whitelist", kContainers, 0);
-    av_dict_set(&options, "codec_whitelist", kCodecs, 0);
+    Ff().av_dict_set(&options, "format_whitelist", kContainers, 0);
+    Ff().av_dict_set(&options, "codec_whitelist", kCodecs, 0);
     AVFormatContext* format = nullptr;  // freed by avformat_open_input when it fails
-    const int opened = avformat_open_input(&format, path.c_str(), nullptr, &options);
-    av_dict_free(&options);
+    const int opened = Ff().avformat_open_input(&format, path.c_str(), nullptr, &options);
+    Ff().av_dict_free(&options);
     if (opened < 0) {
       Fail(
           ": cannot open video (missing file, or not a video in a container mapless reads: "
           "AVI, MP4/MOV, MKV/WebM, MPEG-TS/PS, FLV, Ogg, ASF, raw MJPEG/H.264/H.265)");
     }
     format_.reset(format);
-    if (avformat_find_stream_info(format_.get(), nullptr) < 0) {
+    if (Ff().avformat_find_stream_info(format_.get(), nullptr) < 0) {
       Fail(": cannot read the video's streams");
     }
     const AVCodec* codec = nullptr;
-    stream_ = av_find_best_stream(format_.get(), AVMEDIA_TYPE_VIDEO, -1, -1, &codec, 0);
+    stream_ = Ff().av_find_best_stream(format_.get(), AVMEDIA_TYPE_VIDEO, -1, -1, &codec, 0);
     if (stream_ < 0 || codec == nullptr) Fail(": no video stream that FFmpeg can decode");
     const AVStream* stream = format_->streams[stream_];
     CheckFrameSize(stream->codecpar->width, stream->codecpar->height, path_);
-    decoder_.reset(avcodec_alloc_context3(codec));
-    if (!decoder_ || avcodec_parameters_to_context(decoder_.get(), stream->codecpar) < 0) {
+    decoder_.reset(Ff().avcodec_alloc_context3(codec));
+    if (!decoder_ || Ff().avcodec_parameters_to_context(decoder_.get(), stream->codecpar) < 0) {
       Fail(": cannot set up the video decoder");
     }
     decoder_->thread_count = 1;  // deterministic, and mapless runs one thread per method
     AVDictionary* codec_options = nullptr;
-    av_dict_set(&codec_options, "codec_whitelist", kCodecs, 0);
-    const int decoder_open = avcodec_open2(decoder_.get(), codec, &codec_options);
-    av_dict_free(&codec_options);
+    Ff().av_dict_set(&codec_options, "codec_whitelist", kCodecs, 0);
+    const int decoder_open = Ff().avcodec_open2(decoder_.get(), codec, &codec_options);
+    Ff().av_dict_free(&codec_options);
     if (decoder_open < 0) {
       Fail(": cannot decode its video codec '" + std::string(codec->name) + "' (mapless reads " +
            kCodecs + ")");
@@ -110,8 +104,8 @@ class FfmpegVideo : public FrameSource {
         stream->avg_frame_rate.num > 0 ? stream->avg_frame_rate : stream->r_frame_rate;
     const double fps = rate.den > 0 ? av_q2d(rate) : 0.0;
     fps_ = fps > 0.0 && fps < 1000.0 ? fps : 30.0;
-    packet_.reset(av_packet_alloc());
-    frame_.reset(av_frame_alloc());
+    packet_.reset(Ff().av_packet_alloc());
+    frame_.reset(Ff().av_frame_alloc());
     if (!packet_ || !frame_) Fail(": out of memory");
   }
 
@@ -127,16 +121,16 @@ class FfmpegVideo : public FrameSource {
     }
     size_ = size;
     // Converted at the decoded frame's own size, into a buffer of that size.
-    scaler_.reset(sws_getCachedContext(scaler_.release(), frame_->width, frame_->height,
-                                       static_cast<AVPixelFormat>(frame_->format), frame_->width,
-                                       frame_->height, AV_PIX_FMT_GRAY8, SWS_BILINEAR, nullptr,
-                                       nullptr, nullptr));
+    scaler_.reset(Ff().sws_getCachedContext(scaler_.release(), frame_->width, frame_->height,
+                                            static_cast<AVPixelFormat>(frame_->format),
+                                            frame_->width, frame_->height, AV_PIX_FMT_GRAY8,
+                                            SWS_BILINEAR, nullptr, nullptr, nullptr));
     if (!scaler_) throw InputError(name + ": a pixel format mapless cannot convert");
     cv::Mat grey(frame_->height, frame_->width, CV_8UC1);
     std::uint8_t* planes[4] = {grey.data, nullptr, nullptr, nullptr};
     const int strides[4] = {static_cast<int>(grey.step), 0, 0, 0};
-    if (sws_scale(scaler_.get(), frame_->data, frame_->linesize, 0, frame_->height, planes,
-                  strides) != frame_->height) {
+    if (Ff().sws_scale(scaler_.get(), frame_->data, frame_->linesize, 0, frame_->height, planes,
+                       strides) != frame_->height) {
       throw InputError(name + ": the frame does not convert to grey");
     }
     out->image = grey;
@@ -155,7 +149,7 @@ class FfmpegVideo : public FrameSource {
   // decode is skipped, as players do; a file that yields nothing decodable ends.
   bool Decode() {
     for (int packets = 0; packets < kMaxPacketsPerFrame; ++packets) {
-      const int received = avcodec_receive_frame(decoder_.get(), frame_.get());
+      const int received = Ff().avcodec_receive_frame(decoder_.get(), frame_.get());
       if (received == 0) return true;
       if (received == AVERROR_EOF) return false;
       if (received != AVERROR(EAGAIN)) {
@@ -163,14 +157,14 @@ class FfmpegVideo : public FrameSource {
         continue;
       }
       if (flushing_) return false;
-      const int read = av_read_frame(format_.get(), packet_.get());
+      const int read = Ff().av_read_frame(format_.get(), packet_.get());
       if (read < 0) {
         flushing_ = true;
-        avcodec_send_packet(decoder_.get(), nullptr);  // drain the decoder
+        Ff().avcodec_send_packet(decoder_.get(), nullptr);  // drain the decoder
         continue;
       }
-      if (packet_->stream_index == stream_) avcodec_send_packet(decoder_.get(), packet_.get());
-      av_packet_unref(packet_.get());
+      if (packet_->stream_index == stream_) Ff().avcodec_send_packet(decoder_.get(), packet_.get());
+      Ff().av_packet_unref(packet_.get());
     }
     throw InputError(path_ + ": no frame decodes from " + std::to_string(kMaxPacketsPerFrame) +
                      " packets");

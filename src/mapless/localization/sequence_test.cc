@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 
+#include "mapless/io/image_file.h"
+
 namespace mapless::localization {
 namespace {
 
@@ -25,8 +27,8 @@ bool LoadNordland(Nordland* data) {
     names.push_back(e.path().filename().string());
   std::sort(names.begin(), names.end());
   for (const std::string& n : names) {
-    data->summer.push_back(cv::imread((root / "summer" / n).string(), cv::IMREAD_GRAYSCALE));
-    data->winter.push_back(cv::imread((root / "winter" / n).string(), cv::IMREAD_GRAYSCALE));
+    data->summer.push_back(io::ReadImage((root / "summer" / n).string(), cv::IMREAD_GRAYSCALE));
+    data->winter.push_back(io::ReadImage((root / "winter" / n).string(), cv::IMREAD_GRAYSCALE));
   }
   return !data->summer.empty();
 }

@@ -4,6 +4,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "mapless/core/check.h"
+#include "mapless/io/lazy_libraries.h"
 #include "mapless/rosmsg/definitions.h"
 
 namespace mapless::recording {
@@ -82,7 +83,7 @@ void RunRecorder::Image(Timestamp t_ns, const cv::Mat& grey) {
         options_.images == "jpeg"
             ? std::vector<int>{cv::IMWRITE_JPEG_QUALITY, options_.jpeg_quality}
             : std::vector<int>{};
-    cv::imencode(options_.images == "jpeg" ? ".jpg" : ".png", grey, encoded, params);
+    io::lazy::ImEncode(options_.images == "jpeg" ? ".jpg" : ".png", grey, &encoded, params);
     rosmsg::CompressedImageFields m;
     m.header = header;
     m.format = options_.images;

@@ -3,6 +3,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "mapless/core/check.h"
+#include "mapless/io/lazy_libraries.h"
 #include "mapless/report/svg.h"
 
 namespace mapless::report {
@@ -56,7 +57,7 @@ bool LooksNumeric(const std::string& s) {
 
 std::string PngDataUri(const cv::Mat& image) {
   std::vector<unsigned char> png;
-  if (image.empty() || !cv::imencode(".png", image, png))
+  if (image.empty() || !io::lazy::ImEncode(".png", image, &png, {}))
     throw InputError("report: an image could not be encoded as PNG");
   return "data:image/png;base64," + Base64(png);
 }

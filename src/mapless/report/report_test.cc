@@ -3,6 +3,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "mapless/io/lazy_libraries.h"
 #include "mapless/report/html.h"
 #include "mapless/report/pictures.h"
 #include "mapless/report/svg.h"
@@ -91,8 +92,8 @@ TEST(Report, HtmlIsSelfContainedAndImagesDecode) {
   const auto at = html.find(prefix);
   ASSERT_NE(at, std::string::npos);
   const auto start = at + prefix.size();
-  const cv::Mat back =
-      cv::imdecode(FromBase64(html.substr(start, html.find('"', start) - start)), cv::IMREAD_COLOR);
+  const cv::Mat back = io::lazy::ImDecode(
+      cv::Mat(FromBase64(html.substr(start, html.find('"', start) - start))), cv::IMREAD_COLOR);
   ASSERT_FALSE(back.empty());
   EXPECT_EQ(cv::norm(back, img, cv::NORM_INF), 0.0);
 }

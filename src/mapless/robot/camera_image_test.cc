@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "mapless/core/check.h"
+#include "mapless/io/lazy_libraries.h"
 
 namespace mapless::robot {
 namespace {
@@ -65,7 +66,7 @@ TEST(CameraImage, DecodesCompressedAndPreparesFrames) {
   cv::Mat grey(48, 64, CV_8UC1);
   cv::randu(grey, 0, 255);
   std::vector<uchar> png;
-  cv::imencode(".png", grey, png);
+  io::lazy::ImEncode(".png", grey, &png, {});
   const cv::Mat back = GreyFromCompressed("png", std::string(png.begin(), png.end()));
   EXPECT_EQ(cv::norm(back, grey, cv::NORM_INF), 0);
   EXPECT_THROW(GreyFromCompressed("png", "not a png at all"), InputError);

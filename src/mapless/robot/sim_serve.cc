@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <thread>
 
+#include "mapless/io/lazy_libraries.h"
 #include "mapless/robot/inbox.h"
 #include "mapless/robot/sim_link.h"
 
@@ -21,7 +22,7 @@ CameraMessage EncodeCamera(const cv::Mat& grey, const std::string& enc, cv::Size
   if (enc == "jpeg" || enc == "png") {
     msg.compressed = true;
     std::vector<uchar> bytes;
-    cv::imencode(enc == "png" ? ".png" : ".jpg", frame, bytes);
+    io::lazy::ImEncode(enc == "png" ? ".png" : ".jpg", frame, &bytes, {});
     msg.data.assign(bytes.begin(), bytes.end());
     return msg;
   }

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "mapless/core/check.h"
+#include "mapless/io/atomic_file.h"
 
 namespace mapless::sim {
 namespace {
@@ -50,7 +51,7 @@ TEST(Texture, ImageFileTextureIsLoadedAsGreyAndResized) {
   const std::string path = ::testing::TempDir() + "mapless_texture.png";
   cv::Mat colour(40, 60, CV_8UC3, cv::Scalar(0, 0, 0));
   cv::rectangle(colour, cv::Rect(0, 0, 30, 40), cv::Scalar(255, 255, 255), cv::FILLED);
-  ASSERT_TRUE(cv::imwrite(path, colour));
+  io::WriteImageAtomic(path, colour);
   TextureSpec spec;
   spec.type = TextureType::kImage;
   spec.file = path;
