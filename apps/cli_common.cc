@@ -142,12 +142,4 @@ cv::Mat ReadImageOrThrow(const std::string& path, int flags) {
   return io::ReadImage(path, flags, io::kMinImageSide);
 }
 
-void RequireSameSize(const cv::Mat& image, const std::string& path, const cv::Mat& reference,
-                     const std::string& reference_path) {
-  if (image.size() == reference.size()) return;
-  throw InputError(path + ": size " + std::to_string(image.cols) + "x" +
-                   std::to_string(image.rows) + " differs from " + reference_path + " (" +
-                   std::to_string(reference.cols) + "x" + std::to_string(reference.rows) + ")");
-}
-
 }  // namespace mapless::app

@@ -2,6 +2,8 @@
 // mapping of YAML onto the library's options structs. main() lives in main.cc.
 #pragma once
 
+#include <spdlog/spdlog.h>
+
 #include <CLI/CLI.hpp>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -62,6 +64,18 @@ sim::DriveSummary DriveToDirectory(const sim::Scenario& scenario, const sim::Dri
 
 // A CLI11 check for seeds: a whole number 0 .. 2^64 - 1 (CLI11 would wrap "-1" round).
 CLI::Validator SeedCheck();
+
+// The old name of a renamed option (one meaning per name, issue 42): hidden from --help, it sets
+// the same value and warns that the option is now `new_name`. Returns it for its checks.
+template <typename T>
+CLI::Option* AddOldName(CLI::App* cmd, const std::string& old_name, const std::string& new_name,
+                        T* value) {
+  return cmd->add_option(old_name, *value)
+      ->group("")
+      ->each([old_name, new_name](const std::string&) {
+        spdlog::warn("{} is now {} here; the old name will go", old_name, new_name);
+      });
+}
 // A CLI11 check: a finite number in [lo, hi] (CLI::Range lets nan through).
 CLI::Validator FiniteIn(double lo, double hi);
 // 0 (a rate's "as fast as it can"), or a finite number in [lo, hi] (a rate of 1e-300 would
@@ -82,14 +96,12 @@ void AddEvalCommand(CLI::App* app);
 void AddSoakCommand(CLI::App* app);
 void AddTeachRepeatCommands(CLI::App* app);
 void AddFollowCommand(CLI::App* app);
+void AddTeleopCommand(CLI::App* app);
 void AddFlowCommand(CLI::App* app);
 void AddGroundCommand(CLI::App* app);
 void AddNavigateCommand(CLI::App* app);
 void AddLocalizeCommand(CLI::App* app);
 // Reads an image or throws InputError naming the file.
 cv::Mat ReadImageOrThrow(const std::string& path, int flags);
-// Throws InputError naming `path` and both sizes unless `image` has `reference`'s size.
-void RequireSameSize(const cv::Mat& image, const std::string& path, const cv::Mat& reference,
-                     const std::string& reference_path);
 
 }  // namespace mapless::app

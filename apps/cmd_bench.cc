@@ -1,28 +1,14 @@
 // `mapless bench`: the options, then the benches of src/mapless/bench (bench.h) and their table.
 #include <iostream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "builtin_middlewares.h"
 #include "cli_common.h"
 #include "mapless/bench/bench.h"
 #include "mapless/core/check.h"
+#include "mapless/io/image_file.h"
 
 namespace mapless::app {
-
-namespace {
-
-cv::Size ParseFrameSize(const std::string& text) {
-  if (text.empty()) return {};
-  int w = 0, h = 0;
-  char x = 0;
-  std::istringstream in(text);
-  if (!(in >> w >> x >> h) || x != 'x' || !in.eof() || w < 64 || h < 48 || w > 4096 || h > 4096)
-    throw InputError("--size '" + text + "': expected WxH, 64x48 to 4096x4096");
-  return {w, h};
-}
-
-}  // namespace
 
 void AddBenchCommand(CLI::App* app) {
   struct Args {
@@ -68,7 +54,7 @@ void AddBenchCommand(CLI::App* app) {
       bench::StageOptions options;
       options.repeats = args->repeats;
       if (!args->scenario.empty()) options.scenarios = {args->scenario};
-      options.frame = ParseFrameSize(args->size);
+      if (!args->size.empty()) options.frame = io::ParseFrameSize(args->size, "--size", {64, 48});
       j = bench::BenchStages(options);
     }
     if (args->ros1) bench::BenchMiddleware(BuiltinMiddlewares(), "ros1", &j);

@@ -99,13 +99,15 @@ void AddDemoCommand(CLI::App* app) {
     spdlog::info("demo: visual potential: {}", results.back().status);
 
     report::HtmlReport html("mapless demo");
+    html.Byline(run::ReportByline());
     html.Paragraph("The three methods of mapless on the built-in simulator, seed " +
                    std::to_string(args->seed) +
                    ". Every picture and plot is in this file; nothing is loaded from elsewhere.");
     html.Heading("Results");
     std::vector<std::vector<std::string>> rows;
     for (const run::DemoResult& r : results) rows.push_back(r.row);
-    html.Table({"method", "scenario", "success", "final error (m)", "detail"}, rows);
+    html.Table({"method", "scenario", "success", "final error (m)", "detail", "success means"},
+               rows);
     std::vector<run::RunSection> sections;
     for (const run::DemoResult& r : results) {
       run::AddRunSection(&html, r.section);

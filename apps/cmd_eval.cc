@@ -46,15 +46,16 @@ void AddSuiteOptions(CLI::App* cmd, SuiteArgs* a) {
 }
 
 // Checks the report directory before any work, shows progress on a terminal, runs, prints.
-void RunSuite(const std::string& name, SuiteArgs a,
+void RunSuite(const std::string& /*name*/, SuiteArgs a,
               const std::function<run::SuiteOutput(const run::SuiteOptions&)>& suite) {
   if (!a.suite.report_dir.empty()) {
     RefuseOutputOverInputs(a.suite.report_dir, "--report", {});
     run::CheckReportDir(a.suite.report_dir, "--report");
   }
   std::unique_ptr<Progress> progress;
-  a.suite.on_start = [&progress](int total) {
-    progress = std::make_unique<Progress>("eval", total);
+  const auto start = std::chrono::steady_clock::now();  // teaching comes before the runs
+  a.suite.on_start = [&progress, start](int total) {
+    progress = std::make_unique<Progress>("eval", total, start);
   };
   a.suite.on_entry_done = [&progress](const std::string& line) {
     spdlog::info("eval: {}", line);
@@ -66,7 +67,6 @@ void RunSuite(const std::string& name, SuiteArgs a,
   if (a.json) std::cout << out.json.dump() << "\n";
   if (!a.suite.report_dir.empty())
     spdlog::info("eval: report in {}/index.html", a.suite.report_dir);
-  (void)name;
 }
 
 // table1, funnel-scenarios, obstacles: the funnel-lane repeat and its options.
@@ -132,9 +132,10 @@ void AddFleetEvalOptions(CLI::App* eval, run::FleetEvalOptions* a) {
   eval->add_option("--method", a->method, "funnel or eigenspace")->capture_default_str();
   eval->add_option("--scenario", a->scenario,
                    "scenario (default table1_almost_straight / office_aliasing)");
-  eval->add_option("--rate", a->rate, "simulated seconds per wall-clock second")
+  eval->add_option("--real-time-factor", a->rate, "simulated seconds per wall-clock second")
       ->capture_default_str()
       ->check(FiniteIn(0.1, 20.0));
+  AddOldName(eval, "--rate", "--real-time-factor", &a->rate)->check(FiniteIn(0.1, 20.0));
   eval->add_option("--start-after", a->start_after_s,
                    "followers start this many seconds after the leader")
       ->capture_default_str()

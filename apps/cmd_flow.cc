@@ -11,6 +11,7 @@
 #include "mapless/core/check.h"
 #include "mapless/flow/flow.h"
 #include "mapless/io/flo.h"
+#include "mapless/io/image_file.h"
 
 namespace mapless::app {
 
@@ -27,8 +28,9 @@ void AddFlowCommand(CLI::App* app) {
   cmd->add_option("A", args->first, "First image")->required();
   cmd->add_option("B", args->second, "Second image")->required();
   cmd->add_option("--out", args->out, "Write the flow as Middlebury .flo");
-  cmd->add_option("--method", args->method, "dis (DIS fast), dis_medium, farneback or lk")
+  cmd->add_option("--flow", args->method, "dis (DIS fast), dis_medium, farneback or lk")
       ->capture_default_str();
+  AddOldName(cmd, "--method", "--flow", &args->method);
   cmd->add_option("--gt", args->truth,
                   "Ground truth (.flo, or KITTI .png): print the end-point error as JSON");
   cmd->callback([args] {
@@ -37,7 +39,7 @@ void AddFlowCommand(CLI::App* app) {
     options.method = flow::ParseFlowMethod(args->method);
     const cv::Mat a = ReadImageOrThrow(args->first, cv::IMREAD_GRAYSCALE);
     const cv::Mat b = ReadImageOrThrow(args->second, cv::IMREAD_GRAYSCALE);
-    RequireSameSize(b, args->second, a, args->first);
+    io::RequireSameSize(b, args->second, a, args->first);
     const cv::Mat field = flow::ComputeFlow(a, b, options);
     if (!args->out.empty()) {
       io::WriteFlo(args->out, field);
@@ -46,7 +48,7 @@ void AddFlowCommand(CLI::App* app) {
     if (!args->truth.empty()) {
       cv::Mat valid;
       const cv::Mat truth = io::ReadFlowFile(args->truth, &valid);
-      RequireSameSize(truth, args->truth, a, args->first);
+      io::RequireSameSize(truth, args->truth, a, args->first);
       const flow::FlowError e = flow::EndPointError(field, truth, valid);
       nlohmann::json j;
       j["method"] = args->method;

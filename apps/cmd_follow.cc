@@ -71,10 +71,11 @@ void AddFollowCommand(CLI::App* app) {
   cmd->add_option("--connect", a->fleet.connect,
                   "Follow the route a leader serves (mapless lead --bind), while it is taught: "
                   "funnel or eigenspace, as the leader teaches");
-  cmd->add_option("--rate", a->fleet.rate,
+  cmd->add_option("--real-time-factor", a->fleet.rate,
                   "With --connect on the simulator: simulated seconds per wall-clock second")
       ->capture_default_str()
       ->check(ZeroOrIn(0.01, 100.0));
+  AddOldName(cmd, "--rate", "--real-time-factor", &a->fleet.rate)->check(ZeroOrIn(0.01, 100.0));
   cmd->add_option("--summary", a->fleet.summary, "With --connect on the simulator: a JSON summary");
   cmd->add_option("--curve-key", a->fleet.curve_key, "CURVE: this follower's key file");
   cmd->add_option("--curve-leader", a->fleet.curve_leader, "CURVE: the leader's public key file");
@@ -84,13 +85,12 @@ void AddFollowCommand(CLI::App* app) {
   AddRecordOptions(cmd, &a->record);
   cmd->add_option("--robot", a->robot, "Drive a robot: its robot file (YAML)")->excludes(source);
   cmd->add_option("--log", a->log, "Per-frame decisions as JSON lines (- for stdout)");
-  AddOnObstacleOption(cmd, &a->on_obstacle);
+  AddOnObstacleOption(cmd, &a->on_obstacle, false);
   cmd->add_option("--carry-on-m", a->carry_on_m,
                   "Where no route image near the localization fits (the view has changed): try "
                   "the images up to 2 m further on, then drive the leader's odometry at most "
                   "this many metres until one fits (0: neither, the paper's follower; "
-                  "docs/appearance_route_following.md#recovery-where-the-route-images-no-longer-"
-                  "fit-issue-21-not-in-the-paper)")
+                  "docs/appearance_route_following.md, Recovery)")
       ->capture_default_str()
       ->check(FiniteIn(0.0, 100.0));
   cmd->add_option("--seed", a->seed, "Simulator: seed of the motion noise")

@@ -4,9 +4,6 @@
 // against the frame --step frames later, one JSON line per frame and, with --out-dir, the masks.
 #include <spdlog/spdlog.h>
 
-#include <cstdio>
-#include <deque>
-#include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -17,7 +14,9 @@
 #include "mapless/flow/flow.h"
 #include "mapless/ground/dominant_plane.h"
 #include "mapless/io/atomic_file.h"
+#include "mapless/io/image_file.h"
 #include "mapless/io/output_dir.h"
+#include "mapless/run/ground_source.h"
 #include "recording_args.h"
 
 namespace mapless::app {
@@ -64,7 +63,7 @@ void GroundOfTwoFiles(const GroundArgs& args) {
   const ground::DominantPlaneOptions options = PlaneOptions(args);
   const cv::Mat a = ReadImageOrThrow(args.first, cv::IMREAD_GRAYSCALE);
   const cv::Mat b = ReadImageOrThrow(args.second, cv::IMREAD_GRAYSCALE);
-  RequireSameSize(b, args.second, a, args.first);
+  io::RequireSameSize(b, args.second, a, args.first);
   const cv::Mat field = flow::ComputeFlow(a, b, flow_options);
   const ground::DominantPlane plane = ground::DetectDominantPlane(field, options);
   if (!plane.found) {
@@ -74,7 +73,7 @@ void GroundOfTwoFiles(const GroundArgs& args) {
   if (!args.out.empty()) io::WriteImageAtomic(args.out, plane.mask);
   if (!args.truth.empty()) {
     const cv::Mat truth = ReadImageOrThrow(args.truth, cv::IMREAD_GRAYSCALE);
-    RequireSameSize(truth, args.truth, a, args.first);
+    io::RequireSameSize(truth, args.truth, a, args.first);
     const cv::Mat gt = truth > 127;
     const int top = static_cast<int>(args.iou_top * a.rows);
     nlohmann::json j;
@@ -96,9 +95,11 @@ void GroundOfSource(const GroundArgs& args) {
   RefuseOutputOverInputs(args.log == "-" ? "" : args.log, "--log",
                          {args.source, args.playback.poses});
   RefuseOutputOverInputs(args.out_dir, "--out-dir", {args.source, args.playback.poses});
-  flow::FlowOptions flow_options;
-  flow_options.method = flow::ParseFlowMethod(args.method);
-  const ground::DominantPlaneOptions options = PlaneOptions(args);
+  run::GroundSourceOptions options;
+  options.flow.method = flow::ParseFlowMethod(args.method);
+  options.plane = PlaneOptions(args);
+  options.step = args.step;
+  options.max_frames = args.max_frames;
   recording::PlaybackOptions playback = args.playback;
   playback.fps = args.fps;
   const std::unique_ptr<io::FrameSource> source = recording::OpenSource(args.source, playback);
@@ -108,49 +109,14 @@ void GroundOfSource(const GroundArgs& args) {
   }
   JsonLines log(args.log);
   StopCleanlyOnInterrupt();
-  std::deque<io::Frame> window;  // the last `step` + 1 frames
-  int index = 0;
-  int done = 0;
-  int found = 0;
-  double fraction_sum = 0.0;
-  io::Frame frame;
-  while ((args.max_frames == 0 || done < args.max_frames) && source->Next(&frame)) {
-    ThrowIfInterrupted();
-    if (!window.empty() && frame.image.size() != window.front().image.size())
-      throw InputError(args.source + ": frame " + frame.name + " changes the image size");
-    window.push_back(frame);
-    if (static_cast<int>(window.size()) <= args.step) continue;
-    const io::Frame& a = window.front();
-    const cv::Mat field = flow::ComputeFlow(a.image, window.back().image, flow_options);
-    const ground::DominantPlane plane = ground::DetectDominantPlane(field, options);
-    nlohmann::json j;
-    j["frame"] = index;
-    j["name"] = a.name;
-    j["t_s"] = ToSeconds(a.t_ns);
-    j["found"] = plane.found;
-    j["plane_fraction"] = plane.roi_fraction;
-    if (out) {
-      char name[32];
-      std::snprintf(name, sizeof(name), "%06d.png", index);
-      io::WriteImageAtomic((std::filesystem::path(out->path()) / name).string(), plane.mask);
-      j["mask"] = name;
-    }
-    log.Write(j);
-    found += plane.found ? 1 : 0;
-    fraction_sum += plane.roi_fraction;
-    ++done;
-    ++index;
-    window.pop_front();
-  }
-  if (done == 0) {
-    throw InputError(args.source + ": fewer than " + std::to_string(args.step + 1) +
-                     " frames, so no frame has one " + std::to_string(args.step) + " later");
-  }
+  const run::GroundSourceResult r = run::GroundOverSource(
+      *source, args.source, options, out.get(), [&log](const nlohmann::json& j) { log.Write(j); },
+      ThrowIfInterrupted);
   if (out) out->Commit();
   spdlog::info(
       "ground: {} frames, dominant plane found in {} ({:.0f}%), mean {:.0f}% of the "
       "region of interest",
-      done, found, 100.0 * found / done, 100.0 * fraction_sum / done);
+      r.frames, r.found, 100.0 * r.found / r.frames, 100.0 * r.mean_fraction);
 }
 
 }  // namespace
@@ -164,8 +130,9 @@ void AddGroundCommand(CLI::App* app) {
   cmd->add_option("F0", args->first, "Frame at time t");
   cmd->add_option("F1", args->second, "Frame at time t+1");
   cmd->add_option("--out", args->out, "Write the mask (PNG, F0's size)");
-  cmd->add_option("--method", args->method, "Flow: dis, dis_medium, farneback or lk")
+  cmd->add_option("--flow", args->method, "Optical flow: dis, dis_medium, farneback or lk")
       ->capture_default_str();
+  AddOldName(cmd, "--method", "--flow", &args->method);
   cmd->add_option("--model", args->model, "Planar flow model: homography or affine (the paper's)")
       ->capture_default_str();
   cmd->add_option("--epsilon", args->epsilon_px, "Tolerance |u - u_hat| in pixels (Eq. 5)")

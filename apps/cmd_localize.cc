@@ -78,8 +78,9 @@ void AddLocalizeCommand(CLI::App* app) {
   cmd->add_option("--start", args->playback.start_s, "Begin this many seconds into each source")
       ->capture_default_str()
       ->check(FiniteIn(0.0, 1e9));
-  cmd->add_option("--method", args->method, "nn (nearest projection) or markov")
+  cmd->add_option("--localizer", args->method, "nn (nearest projection) or markov")
       ->capture_default_str();
+  AddOldName(cmd, "--method", "--localizer", &args->method);
   cmd->add_option("--pca", args->pca, "incremental or batch")->capture_default_str();
   cmd->add_option("--dimensions", args->dimensions, "Eigenspace dimensions K")
       ->capture_default_str()

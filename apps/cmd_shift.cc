@@ -10,6 +10,7 @@
 #include "cli_common.h"
 #include "mapless/core/check.h"
 #include "mapless/features/shift.h"
+#include "mapless/io/image_file.h"
 
 namespace mapless::app {
 
@@ -42,7 +43,7 @@ void AddShiftCommand(CLI::App* app) {
     const cv::Mat reference = ReadImageOrThrow(args->reference, cv::IMREAD_GRAYSCALE);
     const cv::Mat current = ReadImageOrThrow(args->current, cv::IMREAD_GRAYSCALE);
     // A shift in pixels compares the same image grid: different sizes have no common one.
-    RequireSameSize(current, args->current, reference, args->reference);
+    io::RequireSameSize(current, args->current, reference, args->reference);
     const features::ShiftEstimate e = features::EstimateShift(reference, current, options);
     if (!e.ok) spdlog::warn("shift: not ok: too few consistent matches ({})", e.matches);
     if (args->json) {

@@ -4,7 +4,6 @@
 #include <spdlog/spdlog.h>
 
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "builtin_middlewares.h"
 #include "cli_common.h"
@@ -12,6 +11,7 @@
 #include "mapless/core/check.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/io/atomic_file.h"
+#include "mapless/io/image_file.h"
 #include "mapless/robot/robot_file.h"
 #include "mapless/robot/sim_serve.h"
 #include "mapless/run/sim_episode.h"
@@ -40,15 +40,8 @@ struct ServeArgs {
 
 void Serve(const ServeArgs& a) {
   RefuseOutputOverInputs(a.summary, "--summary", {a.robot, a.scenario});
-  cv::Size size;
-  if (!a.size.empty()) {
-    int w = 0, h = 0;
-    char x = 0;
-    std::istringstream in(a.size);
-    if (!(in >> w >> x >> h) || x != 'x' || w < 16 || h < 16 || w > 4096 || h > 4096 || !in.eof())
-      throw InputError("--size " + a.size + ": expected WIDTHxHEIGHT, 16 to 4096 a side");
-    size = cv::Size(w, h);
-  }
+  const cv::Size size =
+      a.size.empty() ? cv::Size() : io::ParseFrameSize(a.size, "--size", {16, 16});
   const robot::RobotFile file = robot::LoadRobotFile(a.robot);
   const sim::Scenario scenario = sim::LoadScenario(a.scenario);
   const eval::SimSetup setup =

@@ -211,11 +211,10 @@ static void AddRepeatCommand(CLI::App* app) {
           "--carry-on-m", r->carry_on_m,
           "When no keyframe matches and recovery finds none: drive the taught path by "
           "odometry for at most this many metres, matching the following keyframes "
-          "(needs a route taught with odometry; 0: off; "
-          "docs/teach_and_repeat.md#carrying-on-along-the-taught-odometry-keyframe_car_gone)")
+          "(needs a route taught with odometry; 0: off; docs/teach_and_repeat.md, Carrying on)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 100.0));
-  AddOnObstacleOption(repeat, &r->on_obstacle);
+  AddOnObstacleOption(repeat, &r->on_obstacle, true);
   repeat->add_option("--log", r->log,
                      "Per-frame decisions as JSON lines to this file (default: stdout; on a robot: "
                      "none, - for stdout)");

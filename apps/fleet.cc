@@ -30,18 +30,6 @@ namespace {
 
 void FleetLog(const std::string& line) { spdlog::info("{}", line); }
 
-fleet::LeaderSecurity LeaderKeys(const std::string& key, const std::vector<std::string>& allow) {
-  fleet::LeaderSecurity security;
-  if (key.empty()) {
-    if (!allow.empty()) throw InputError("--curve-allow needs --curve-key (the leader's key)");
-    return security;
-  }
-  security.key = fleet::LoadCurveKey(key, true);
-  for (const std::string& file : allow)
-    security.allowed_public.push_back(fleet::LoadCurveKey(file, false).public_key);
-  return security;
-}
-
 struct LeadArgs {
   std::string source;
   std::string robot;
@@ -53,38 +41,6 @@ struct LeadArgs {
   std::vector<std::string> curve_allow;
   double rate = 1.0;
 };
-
-// A leader restarted on its route goes on where it stopped: the teacher has the route so far, and
-// on the simulator the frames up to there are driven, not rendered (the returned test).
-std::function<bool(const sim::DriveFrame&)> ResumeLeader(const fleet::RouteCopy& copy,
-                                                         fleet::RouteKind kind,
-                                                         run::Teacher* teacher) {
-  if (copy.next_sequence() == 0 || copy.complete()) return {};
-  const int stored = static_cast<int>(copy.next_sequence()) - 1;  // record 0 is the header
-  if (stored == 0) {
-    teacher->Resume(0, nullptr, std::nullopt);
-    return {};
-  }
-  if (kind == fleet::RouteKind::kEigenspace) {
-    // The model as the interrupted leader had it.
-    const route::StoredAppearanceRoute images = route::LoadAppearanceRoute(copy.dir());
-    teacher->Resume(stored, &images, std::nullopt);
-    const Pose2 last = images.images.back().odometry;
-    auto rendering = std::make_shared<bool>(false);
-    return [last, rendering](const sim::DriveFrame& f) {
-      if (*rendering) return false;
-      if (f.odometry.x_m == last.x_m && f.odometry.y_m == last.y_m &&
-          f.odometry.theta_rad == last.theta_rad)
-        *rendering = true;  // from the next frame on
-      return true;
-    };
-  }
-  // The last stored keyframe's time (read back from its file).
-  const std::vector<fleet::Record> last = copy.RecordsFrom(copy.next_sequence() - 1, 1);
-  const Timestamp last_t_ns = route::ParseKeyframe(last.at(0).parts.at(0), copy.dir()).t_ns;
-  teacher->Resume(stored, nullptr, last_t_ns);
-  return [last_t_ns](const sim::DriveFrame& f) { return f.t_ns < last_t_ns; };
-}
 
 void Lead(const LeadArgs& a) {
   const fleet::RouteKind kind = run::ParseTeachMethod(a.method);
@@ -101,7 +57,7 @@ void Lead(const LeadArgs& a) {
   }
   fleet::ServerOptions server_options;
   server_options.bind = a.bind;
-  server_options.security = LeaderKeys(a.curve_key, a.curve_allow);
+  server_options.security = fleet::LoadLeaderSecurity(a.curve_key, a.curve_allow);
   fleet::RouteCopy copy(a.route);  // resumes an interrupted leader's route
   if (copy.header() && copy.header()->kind != kind)
     throw InputError(a.route + ": holds a " +
@@ -121,7 +77,7 @@ void Lead(const LeadArgs& a) {
     spdlog::info("lead: {} is a complete route of {} records; serving it", a.route,
                  copy.next_sequence());
   } else {
-    const auto skip = ResumeLeader(copy, kind, &teacher);
+    const auto skip = run::ResumeLeader(copy, kind, &teacher);
     if (copy.next_sequence() > 1)
       spdlog::info("lead: resuming the route in {} after record {}", a.route,
                    copy.next_sequence() - 1);
@@ -335,10 +291,11 @@ void AddLeadCommand(CLI::App* app) {
       ->required();
   cmd->add_option("--method", a->method, "funnel | eigenspace")->capture_default_str();
   cmd->add_option("--detector", a->detector, "funnel: feature detector")->capture_default_str();
-  cmd->add_option("--rate", a->rate,
+  cmd->add_option("--real-time-factor", a->rate,
                   "Simulator: simulated seconds per second of wall clock (0: as fast as it can)")
       ->capture_default_str()
       ->check(ZeroOrIn(0.01, 100.0));
+  AddOldName(cmd, "--rate", "--real-time-factor", &a->rate)->check(ZeroOrIn(0.01, 100.0));
   cmd->add_option("--curve-key", a->curve_key, "CURVE: the leader's key file (fleet keygen)");
   cmd->add_option("--curve-allow", a->curve_allow,
                   "CURVE: public key files of the followers admitted (default: any that has the "

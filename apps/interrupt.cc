@@ -22,6 +22,12 @@ long long MonotonicNs() {
   return static_cast<long long>(ts.tv_sec) * 1000000000LL + ts.tv_nsec;
 }
 
+const char* Name(int signal) {
+  return signal == SIGTERM  ? "terminated (SIGTERM)"
+         : signal == SIGHUP ? "hung up (SIGHUP)"
+                            : "interrupted (SIGINT)";
+}
+
 void Write(const char* text) {
   // write(2) is async-signal-safe; the result does not matter on the way out.
   const ssize_t unused = ::write(STDERR_FILENO, text, std::strlen(text));
@@ -38,15 +44,13 @@ extern "C" void OnSignal(int signal) {
   // the command and to the command's process group), not the user insisting: a robot must still
   // get its zero velocity.
   if (!first && g_cooperative.load() && now - g_first_ns.load() < 1000000000LL) return;
-  Write(signal == SIGTERM ? "mapless: terminated (SIGTERM)\n" : "mapless: interrupted (SIGINT)\n");
+  Write("mapless: "), Write(Name(signal)), Write("\n");
   ::_exit(128 + signal);
 }
 
 }  // namespace
 
-Interrupted::Interrupted(int signal)
-    : std::runtime_error(signal == SIGTERM ? "terminated (SIGTERM)" : "interrupted (SIGINT)"),
-      signal_(signal) {}
+Interrupted::Interrupted(int signal) : std::runtime_error(Name(signal)), signal_(signal) {}
 
 void InstallInterruptHandlers() {
   struct sigaction action {};
@@ -55,6 +59,7 @@ void InstallInterruptHandlers() {
   action.sa_flags = SA_RESTART;
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
+  sigaction(SIGHUP, &action, nullptr);  // the terminal closed: the robot stops as on Ctrl-C
 }
 
 void StopCleanlyOnInterrupt() { g_cooperative.store(true); }

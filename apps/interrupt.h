@@ -1,4 +1,4 @@
-// Ctrl-C (SIGINT) and SIGTERM for the `mapless` command line.
+// Ctrl-C (SIGINT), SIGTERM and SIGHUP (the terminal closed) for the `mapless` command line.
 //
 // A command that writes while it runs (teach, repeat, navigate, sim drive, demo) calls
 // StopCleanlyOnInterrupt() and then ThrowIfInterrupted() once per frame: the first signal makes

@@ -2,6 +2,7 @@
 // exceptions into one clear error line and an exit code (0 ok, 1 run failed, 2 bad input/usage).
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -16,6 +17,8 @@
 #include "interrupt.h"
 #include "mapless/core/check.h"
 #include "mapless/core/warning.h"
+#include "mapless/run/report.h"
+#include "mapless/run/text.h"
 
 namespace {
 
@@ -43,6 +46,37 @@ std::string OneLine(const std::string& text) {
   return out;
 }
 
+// --help in 100 columns: CLI11 2.1 does not wrap, and descriptions ran to 393 characters.
+class WrappingFormatter : public CLI::Formatter {
+ public:
+  std::string make_option(const CLI::Option* opt, bool is_positional) const override {
+    return Wrap(make_option_name(opt, is_positional) + make_option_opts(opt),
+                make_option_desc(opt));
+  }
+  std::string make_description(const CLI::App* app) const override {
+    std::string out;
+    for (const std::string& line :
+         mapless::run::WrapWords(CLI::Formatter::make_description(app), 100))
+      out += line + "\n";
+    return out.substr(0, out.size() - 1);  // the text ended with a newline
+  }
+  std::string make_subcommand(const CLI::App* sub) const override {
+    return Wrap(sub->get_display_name(), sub->get_description());
+  }
+
+ private:
+  std::string Wrap(const std::string& left, const std::string& text) const {
+    const std::size_t column = column_width_;
+    std::string out = "  " + left;
+    out += out.size() >= column ? "\n" + std::string(column, ' ')
+                                : std::string(column - out.size(), ' ');
+    const auto lines = mapless::run::WrapWords(text, 100 - column);
+    for (std::size_t k = 0; k < lines.size(); ++k)
+      out += (k > 0 ? "\n" + std::string(column, ' ') : "") + lines[k];
+    return out + "\n";
+  }
+};
+
 // `mapless --version`: the version and the robot links this build has.
 std::string VersionText() {
   std::string links;
@@ -59,21 +93,25 @@ std::string VersionText() {
 int main(int argc, char** argv) {
   CLI::App app{"mapless: appearance-based robot navigation from one uncalibrated camera, no map"};
   app.require_subcommand(1);
+  app.formatter(std::make_shared<WrappingFormatter>());
   app.set_version_flag("--version", VersionText());
   // Logs go to stderr: stdout carries only results (JSON, tables, lists).
   spdlog::set_default_logger(spdlog::stderr_color_mt("mapless"));
-  spdlog::set_pattern("%^[%l]%$ %v");
+  // On a terminal each log line first erases the line, where a progress line may stand.
+  spdlog::set_pattern(::isatty(STDERR_FILENO) == 1 ? "\r\033[K%^[%l]%$ %v" : "%^[%l]%$ %v");
   cv::setNumThreads(1);
   // OpenCV's own log lines (video back ends probing a file) would break "one error line": every
   // failure reaches the user as mapless's own message instead.
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
   mapless::app::InstallInterruptHandlers();
+  mapless::run::SetInvocation(MAPLESS_VERSION, argc, argv);
   mapless::SetWarningSink([](const std::string& line) { spdlog::warn("{}", line); });
   mapless::app::AddDemoCommand(&app);
   mapless::app::AddSimCommands(&app);
   mapless::app::AddTeachRepeatCommands(&app);
   mapless::app::AddFollowCommand(&app);
   mapless::app::AddLeadCommand(&app);
+  mapless::app::AddTeleopCommand(&app);
   mapless::app::AddFleetCommand(&app);
   mapless::app::AddShiftCommand(&app);
   mapless::app::AddFlowCommand(&app);

@@ -18,11 +18,8 @@ std::string Duration(double s) {
 
 }  // namespace
 
-Progress::Progress(std::string label, int total)
-    : label_(std::move(label)),
-      total_(total),
-      tty_(::isatty(STDERR_FILENO) == 1),
-      start_(std::chrono::steady_clock::now()) {}
+Progress::Progress(std::string label, int total, std::chrono::steady_clock::time_point start)
+    : label_(std::move(label)), total_(total), tty_(::isatty(STDERR_FILENO) == 1), start_(start) {}
 
 Progress::~Progress() {
   if (printed_) std::fputs("\033[K", stderr);

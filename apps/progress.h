@@ -11,7 +11,9 @@ namespace mapless::app {
 
 class Progress {
  public:
-  Progress(std::string label, int total);
+  // `start`: when the work began (the time in the final line counts from there).
+  Progress(std::string label, int total,
+           std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now());
   ~Progress();  // clears the line
   Progress(const Progress&) = delete;
   Progress& operator=(const Progress&) = delete;

@@ -8,6 +8,7 @@
 #include "cli_common.h"
 #include "interrupt.h"
 #include "mapless/core/check.h"
+#include "mapless/run/status_line.h"
 
 namespace mapless::app {
 
@@ -45,15 +46,14 @@ navigation::ObstacleWatchOptions ObstacleWatchFor(const std::string& robot_path,
   return o;
 }
 
-void AddOnObstacleOption(CLI::App* cmd, std::string* on_obstacle) {
-  cmd->add_option("--on-obstacle", *on_obstacle,
-                  "Obstacle watch: stop (halt before something new on the way ahead, status "
-                  "blocked or stopped with the reason, go on when it is gone), avoid (teach & "
-                  "repeat: go round it by odometry and rejoin the route; "
-                  "docs/teach_and_repeat.md#avoid) or off (the paper's method). Default: the "
-                  "robot file's obstacles.on_obstacle, else stop "
-                  "(docs/teach_and_repeat.md#obstacle-watch)")
-      ->check(CLI::IsMember({"stop", "avoid", "off"}));
+void AddOnObstacleOption(CLI::App* cmd, std::string* on_obstacle, bool can_avoid) {
+  cmd->add_option(
+         "--on-obstacle", *on_obstacle,
+         std::string("Obstacle watch: stop (halt before something new ahead, go on when "
+                     "it is gone)") +
+             (can_avoid ? ", avoid (go round it by odometry; docs/teach_and_repeat.md)" : "") +
+             " or off (the paper's method). Default: the robot file's, else stop")
+      ->check(can_avoid ? CLI::IsMember({"stop", "avoid", "off"}) : CLI::IsMember({"stop", "off"}));
 }
 
 namespace {
@@ -75,13 +75,18 @@ void RunOnRobot(robot::Method& method, const std::string& path, const SourceRunA
   std::unique_ptr<robot::RobotLink> link = Links().Named("robot").open(path, request);
   spdlog::info("{}: on {} ({}), commands to {}", method.name(), file.name, file.middleware,
                file.Resolve(file.topics.cmd_vel));
+  run::StatusLine status;
   run::RunOptions options;
   options.loop = file.Loop();
-  if (log) options.log = [&log](const nlohmann::json& j) { log->Write(j); };
-  options.say = Say;
+  options.log = [&log, &status](const nlohmann::json& j) {
+    if (log) log->Write(j);
+    status.Show(j);
+  };
+  options.say = [&status](const std::string& line) { status.Clear(), Say(line); };
   options.recorder = recorder.get();
   const run::RunOutcome outcome = run::RunMethod(method, *link, options);
   link.reset();  // zero velocity published, then off the graph
+  status.Clear();
   spdlog::info("{}: {} after {} frames: {}", method.name(),
                outcome.loop.finished ? "finished" : "stopped", outcome.loop.frames,
                outcome.loop.reason);
@@ -103,9 +108,11 @@ void RunOnRecording(robot::Method& method, const std::string& source, const Sour
   std::unique_ptr<robot::RobotLink> link = Links().Open(source, request);
   JsonLines log(args.log);
   StopCleanlyOnInterrupt();
+  run::StatusLine status(!args.log.empty() && args.log != "-");  // not between JSON lines
   run::RunOptions options;
-  options.log = [&log](const nlohmann::json& j) { log.Write(j); };
+  options.log = [&log, &status](const nlohmann::json& j) { log.Write(j), status.Show(j); };
   const run::RunOutcome outcome = run::RunMethod(method, *link, options);
+  status.Clear();
   ThrowIfInterrupted();
   spdlog::info("{} (open loop on {}): {} frames, {}", method.name(), source, outcome.loop.frames,
                outcome.loop.reason);

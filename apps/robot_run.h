@@ -59,7 +59,8 @@ navigation::ObstacleWatchOptions ObstacleWatchFor(const std::string& robot_path,
 // leader's odometry at most `carry_on_m` metres; 0 switches both off (the paper's follower).
 void SetFollowerRecovery(double carry_on_m, navigation::AppearanceFollowerOptions* follower);
 // `--on-obstacle` of `repeat` and `follow` (stop, avoid, off).
-void AddOnObstacleOption(CLI::App* cmd, std::string* on_obstacle);
+// --on-obstacle; `can_avoid`: avoid is offered (teach & repeat), else stop and off only.
+void AddOnObstacleOption(CLI::App* cmd, std::string* on_obstacle, bool can_avoid);
 
 // `mapless sim serve`.
 void AddSimServeCommand(CLI::App* sim);

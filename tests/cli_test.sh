@@ -40,10 +40,11 @@ need_drive() {  # $TMP/d1: a recorded drive of rotation_in_place (frames, poses)
 
 section_basics() {
   # Every subcommand answers --help with exit 0 and a usage text.
-  for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench" "shift" "teach" "repeat" "route" "route info" "eval" "soak" "flow" "ground" "navigate" "localize" "follow" "sim serve"; do
+  for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench" "shift" "teach" "repeat" "route" "route info" "eval" "eval table1" "eval obstacles" "soak" "flow" "ground" "navigate" "localize" "follow" "sim serve" "teleop" "lead" "fleet"; do
     # shellcheck disable=SC2086
     expect_exit "help: mapless $sub --help" 0 "$MAPLESS" $sub --help
     grep -qi "usage" "$TMP/out"; check "help text: mapless $sub" $?
+    ! awk 'length > 100 { bad = 1 } END { exit !bad }' "$TMP/out"; check "help of mapless $sub fits 100 columns" $?
   done
 
   # The image codecs, video I/O and FFmpeg are opened on first use, not linked: a start of the
@@ -113,13 +114,14 @@ section_basics() {
   # Optical flow and the dominant plane on two simulator frames of the downward-looking corridor.
   expect_exit "render f0" 0 "$MAPLESS" sim render --scenario corridor_straight_3p5m --pose 0,0,0 --out "$TMP/f0.png"
   expect_exit "render f1" 0 "$MAPLESS" sim render --scenario corridor_straight_3p5m --pose 0.05,0,0 --out "$TMP/f1.png"
-  expect_exit "flow --out" 0 "$MAPLESS" flow "$TMP/f0.png" "$TMP/f1.png" --out "$TMP/f.flo" --method lk
+  expect_exit "flow --out" 0 "$MAPLESS" flow "$TMP/f0.png" "$TMP/f1.png" --out "$TMP/f.flo" --flow lk
   expect_exit "flow against its own output" 0 "$MAPLESS" flow "$TMP/f0.png" "$TMP/f1.png" --method lk --gt "$TMP/f.flo"
+  grep -q -- "--method is now --flow here" "$TMP/err"; check "flow --method still works and says it is now --flow" $?
   grep -q '"epe_px":0' "$TMP/out"; check "flow EPE against its own output is 0" $?
   head -c 100 "$TMP/f.flo" > "$TMP/short.flo"
   expect_exit "truncated .flo exits 2" 2 "$MAPLESS" flow "$TMP/f0.png" "$TMP/f1.png" --gt "$TMP/short.flo"
   grep -q "short.flo: truncated" "$TMP/err"; check "flow names the truncated .flo" $?
-  expect_exit "unknown flow method exits 2" 2 "$MAPLESS" flow "$TMP/f0.png" "$TMP/f1.png" --out "$TMP/g.flo" --method magic
+  expect_exit "unknown flow method exits 2" 2 "$MAPLESS" flow "$TMP/f0.png" "$TMP/f1.png" --out "$TMP/g.flo" --flow magic
   grep -q "unknown flow method 'magic'" "$TMP/err"; check "flow names the unknown method" $?
   expect_exit "ground --out" 0 "$MAPLESS" ground "$TMP/f0.png" "$TMP/f1.png" --out "$TMP/ground.png" --roi-top 0
   [ -s "$TMP/ground.png" ]; check "ground wrote a mask" $?
@@ -147,18 +149,18 @@ section_localize_eval() {
   # localize: Nordland winter queries on the summer route (100 places, tests/data/nordland).
   NL="$HERE/data/nordland"
   within5() { awk -F'"index":' '{split($2,a,","); d=a[1]-(NR-1); if (d<0) d=-d; if (d<=5) ok++} END {print ok+0}' "$1"; }
-  expect_exit "localize markov" 0 "$MAPLESS" localize --database "$NL/summer" --query "$NL/winter" --method markov --json
+  expect_exit "localize markov" 0 "$MAPLESS" localize --database "$NL/summer" --query "$NL/winter" --localizer markov --json
   cp "$TMP/out" "$TMP/loc_markov.jsonl"
   [ "$(wc -l <"$TMP/loc_markov.jsonl")" -eq 100 ]; check "localize: one line per query" $?
   head -1 "$TMP/loc_markov.jsonl" | grep -Eq '^\{"query":"images-04010.png","index":[0-9]+,"probability":[0-9.e-]+\}$'; check "localize: query, index, probability" $?
-  expect_exit "localize nn" 0 "$MAPLESS" localize --database "$NL/summer" --query "$NL/winter" --method nn --json
+  expect_exit "localize nn" 0 "$MAPLESS" localize --database "$NL/summer" --query "$NL/winter" --localizer nn --json
   cp "$TMP/out" "$TMP/loc_nn.jsonl"
   m5=$(within5 "$TMP/loc_markov.jsonl"); n5=$(within5 "$TMP/loc_nn.jsonl")
   echo "     localize within +-5 places: markov $m5/100, nn $n5/100"
   [ "$m5" -ge 90 ] && [ "$m5" -gt "$n5" ]; check "localize: markov >= 90/100 within 5 places and better than nn" $?
   expect_exit "localize with a missing folder exits 2" 2 "$MAPLESS" localize --database "$TMP/none" --query "$NL/winter"
   grep -q -- "--database $TMP/none: not a folder of images" "$TMP/err"; check "localize names the missing folder" $?
-  expect_exit "localize with a bad method exits 2" 2 "$MAPLESS" localize --database "$NL/summer" --query "$NL/winter" --method best
+  expect_exit "localize with a bad method exits 2" 2 "$MAPLESS" localize --database "$NL/summer" --query "$NL/winter" --localizer best
   grep -q "'best' is unknown" "$TMP/err"; check "localize names the bad method" $?
 
   expect_exit "eval eigenspace with an unknown scenario exits 2" 2 "$MAPLESS" eval eigenspace --only nowhere --runs 1
@@ -212,7 +214,9 @@ section_routes() {
   expect_exit "eval potential refuses --carry-on-m" 2 "$MAPLESS" eval potential --runs 1 --carry-on-m 2
   # --on-obstacle avoid: teach & repeat only; the follower refuses it in one line.
   expect_exit "follow refuses --on-obstacle avoid" 2 "$MAPLESS" follow --route "$TMP/eroute" --source "$TMP/d1/frames" --poses "$TMP/d1/odometry.tum" --on-obstacle avoid
-  grep -q "avoid is built for teach & repeat only" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "follow names --on-obstacle avoid in one line" $?
+  grep -q -- "--on-obstacle.*avoid" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "follow names --on-obstacle avoid in one line" $?
+  "$MAPLESS" follow --help >"$TMP/out" 2>&1
+  ! grep -A2 -- "--on-obstacle" "$TMP/out" | grep -q "avoid"; check "follow --help does not offer --on-obstacle avoid" $?
   expect_exit "follow: a negative --carry-on-m exits 2" 2 "$MAPLESS" follow --route "$TMP/eroute" --source "$TMP/d1/frames" --poses "$TMP/d1/odometry.tum" --carry-on-m -1
   grep -q -- "--carry-on-m" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "follow names a bad --carry-on-m in one line" $?
   expect_exit "an unknown --on-obstacle exits 2" 2 "$MAPLESS" repeat --route "$TMP/route" --source "$TMP/d1/frames" --on-obstacle swerve

@@ -29,7 +29,7 @@ cleanup() {
 trap cleanup EXIT
 fail() { echo "FAIL: $*"; for f in "$work"/run/*.log "$work"/*.log; do [ -f "$f" ] && { echo "== $f"; tail -20 "$f"; }; done; exit 1; }
 
-args=(eval fleet --followers 3 --method "$method" --rate 6 --start-after 2 --json --keep "$work/run")
+args=(eval fleet --followers 3 --method "$method" --real-time-factor 6 --start-after 2 --json --keep "$work/run")
 if [ "$faults" = --faults ]; then
   # Mid-route for each: the funnel route is taught in about 6 s of wall clock at 6x, the
   # eigenspace route in about 13 s.
@@ -70,7 +70,7 @@ for _ in $(seq 50); do grep -q "serving it" "$work/lead.log" && break; sleep 0.1
 grep -q "serving it" "$work/lead.log" || fail "the leader did not serve the taught route"
 follow() {  # KEY COPY: follow for 4 s (the robot never gets a route with a wrong key)
   timeout -s INT 4 "$mapless" follow --connect "tcp://127.0.0.1:$port" --source sim:table1_almost_straight \
-    --route "$2" --rate 4 --curve-key "$1" --curve-leader "$work/leader.key.pub" > "$2.log" 2>&1 || true
+    --route "$2" --real-time-factor 4 --curve-key "$1" --curve-leader "$work/leader.key.pub" > "$2.log" 2>&1 || true
 }
 follow "$work/stranger.key" "$work/stranger_copy"
 [ -z "$(ls -A "$work/stranger_copy" 2>/dev/null)" ] || fail "a follower with a wrong key received records"

@@ -325,7 +325,7 @@ probe "follow --connect with a key but no leader key" 2 "--curve-key and --curve
 probe "fleet keygen over an existing file" 2 "fleet.key: exists" -- "$MAPLESS" fleet keygen "$FX/fleet.key"
 probe "navigate --robot without a calibration" 2 "needs --calibration" -- "$MAPLESS" navigate --robot "$FX/robot_ros3.yaml" --destination 1,1
 probe "sim serve --like an unknown run" 2 "--like dance" -- "$MAPLESS" sim serve --scenario table1_almost_straight --robot "$FX/robot_ok.yaml" --like dance
-probe "sim serve --size too small" 2 "--size 8x8" -- "$MAPLESS" sim serve --scenario table1_almost_straight --robot "$FX/robot_ok.yaml" --size 8x8
+probe "sim serve --size too small" 2 "--size '8x8'" -- "$MAPLESS" sim serve --scenario table1_almost_straight --robot "$FX/robot_ok.yaml" --size 8x8
 
 # ---------------------------------------------------------------------------------------------
 echo "# two writers, and Ctrl-C"

@@ -73,10 +73,10 @@ for rate in 1e-300 1e-9 -1 nan 1e300 1001; do
   probe "teach --rate $rate" 2 "--rate" -- "$MAPLESS" teach --source "$FX/frames" --out "$NEW/r3t4" --rate "$rate"
 done
 probe "repeat --rate 1e-300" 2 "--rate: '1e-300'" -- "$MAPLESS" repeat --route "$FX/route" --source "$FX/frames" --rate 1e-300
-probe "lead --rate 1e-300" 2 "--rate: '1e-300'" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/r3l2" --bind tcp://127.0.0.1:1 --rate 1e-300
-probe "follow --connect --rate 1e-9" 2 "--rate: '1e-9'" -- "$MAPLESS" follow --connect tcp://127.0.0.1:1 --source sim:table1_almost_straight --route "$NEW/r3c1" --rate 1e-9
-probe "follow --connect --rate 1e300" 2 "--rate: '1e300'" -- "$MAPLESS" follow --connect tcp://127.0.0.1:1 --source sim:table1_almost_straight --route "$NEW/r3c1" --rate 1e300
-probe "lead --rate 1e-9" 2 "--rate: '1e-9'" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/r3l2" --bind tcp://127.0.0.1:1 --rate 1e-9
+probe "lead --real-time-factor 1e-300" 2 "--real-time-factor: '1e-300'" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/r3l2" --bind tcp://127.0.0.1:1 --real-time-factor 1e-300
+probe "follow --connect --real-time-factor 1e-9" 2 "--real-time-factor: '1e-9'" -- "$MAPLESS" follow --connect tcp://127.0.0.1:1 --source sim:table1_almost_straight --route "$NEW/r3c1" --real-time-factor 1e-9
+probe "follow --connect --real-time-factor 1e300" 2 "--real-time-factor: '1e300'" -- "$MAPLESS" follow --connect tcp://127.0.0.1:1 --source sim:table1_almost_straight --route "$NEW/r3c1" --real-time-factor 1e300
+probe "lead --real-time-factor 1e-9" 2 "--real-time-factor: '1e-9'" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/r3l2" --bind tcp://127.0.0.1:1 --real-time-factor 1e-9
 for port in 99999 65536 -1 5x "" 1234567; do
   probe "lead --bind port '$port'" 2 "--bind tcp://127.0.0.1:$port: " -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/r3l3" --bind "tcp://127.0.0.1:$port"
   probe "follow --connect port '$port'" 2 "--connect tcp://127.0.0.1:$port: " -- "$MAPLESS" follow --connect "tcp://127.0.0.1:$port" --source sim:table1_almost_straight --route "$NEW/r3c2"
@@ -130,7 +130,7 @@ probe "fleet keygen onto a dangling link" 2 "r3_dangling.key: exists" -- "$MAPLE
 # ---------------------------------------------------------------------------------------------
 echo "# round 3: two writers"
 "$MAPLESS" lead --source sim:table1_almost_straight --method eigenspace --route "$NEW/r3lead" \
-  --bind tcp://127.0.0.1:0 --rate 0 >"$TMP/r3lead.out" 2>"$TMP/r3lead.err" &
+  --bind tcp://127.0.0.1:0 --real-time-factor 0 >"$TMP/r3lead.out" 2>"$TMP/r3lead.err" &
 r3lead=$!
 for _ in $(seq 1 200); do grep -q "route complete" "$TMP/r3lead.err" && break; sleep 0.05; done
 grep -q "route complete" "$TMP/r3lead.err"; check "round 3 fixture: a leader serving its route" $?
@@ -156,11 +156,11 @@ echo "# round 3: silent waits"
 "$MAPLESS" fleet keygen "$FX/r3_leader.key" >/dev/null 2>&1
 "$MAPLESS" fleet keygen "$FX/r3_other.key" >/dev/null 2>&1
 "$MAPLESS" lead --source sim:table1_almost_straight --method eigenspace --route "$NEW/r3curve" \
-  --bind tcp://127.0.0.1:0 --rate 0 --curve-key "$FX/r3_leader.key" --curve-allow "$FX/r3_other.key.pub" \
+  --bind tcp://127.0.0.1:0 --real-time-factor 0 --curve-key "$FX/r3_leader.key" --curve-allow "$FX/r3_other.key.pub" \
   >"$TMP/r3curve.out" 2>"$TMP/r3curve.err" &
 r3curve=$!
 "$MAPLESS" lead --source sim:table1_almost_straight --method eigenspace --route "$NEW/r3plain" \
-  --bind tcp://127.0.0.1:0 --rate 0 >"$TMP/r3plain.out" 2>"$TMP/r3plain.err" &
+  --bind tcp://127.0.0.1:0 --real-time-factor 0 >"$TMP/r3plain.out" 2>"$TMP/r3plain.err" &
 r3plain=$!
 endpoint() { grep -o 'lead: serving .* on tcp://127.0.0.1:[0-9]*' "$1" | grep -o 'tcp://.*' | head -1; }
 for _ in $(seq 1 200); do [ -n "$(endpoint "$TMP/r3curve.err")" ] && [ -n "$(endpoint "$TMP/r3plain.err")" ] && break; sleep 0.05; done

@@ -38,6 +38,24 @@ if "$CHECK" "$OUT/report.png"; then
 else
   echo "FAIL the screenshot does not show the plots"; FAILS=$((FAILS + 1))
 fi
+# What the browser made of the page (its DOM after parsing), for the checks of issue 42.
+timeout 120 "$CHROMIUM" --headless --no-sandbox --disable-gpu --no-first-run \
+  --user-data-dir="$OUT/profile" --dump-dom "file://$REPORT" >"$OUT/dom.html" 2>/dev/null
+DOM="$OUT/dom.html"
+# Under the title: the mapless version, the date and the command line.
+if grep -Eq '<p class="byline">mapless [0-9][^,]*, 20[0-9-]+ [0-9:]+ UTC: mapless demo( |<)' "$DOM"; then
+  echo "ok   the header names the version, the date and the command line"
+else
+  echo "FAIL no byline with the version and command line"; FAILS=$((FAILS + 1))
+fi
+# Every path on the maps has its own legend entry: as many entries with a path's line as paths.
+PATHS=$(grep -o '<polyline' "$DOM" | wc -l)
+ENTRIES=$(grep -o '<g class="legend-entry" data-kind="path">' "$DOM" | wc -l)
+if [ "$PATHS" -gt 0 ] && [ "$PATHS" = "$ENTRIES" ]; then
+  echo "ok   each of the $PATHS paths drawn has its own legend entry"
+else
+  echo "FAIL $PATHS paths drawn, $ENTRIES legend entries for paths"; FAILS=$((FAILS + 1))
+fi
 # Nothing outside the file: no http(s) link but the SVG namespace, no script.
 if grep -o 'https\?://[^"]*' "$REPORT" | grep -qv '^http://www.w3.org/2000/svg$' ||
    grep -q '<script' "$REPORT"; then

@@ -71,4 +71,16 @@ CurveKey GenerateCurveKey(const std::string& path) {
   return CurveKey{pub, sec};
 }
 
+LeaderSecurity LoadLeaderSecurity(const std::string& key, const std::vector<std::string>& allow) {
+  LeaderSecurity security;
+  if (key.empty()) {
+    if (!allow.empty()) throw InputError("--curve-allow needs --curve-key (the leader's key)");
+    return security;
+  }
+  security.key = LoadCurveKey(key, true);
+  for (const std::string& file : allow)
+    security.allowed_public.push_back(LoadCurveKey(file, false).public_key);
+  return security;
+}
+
 }  // namespace mapless::fleet

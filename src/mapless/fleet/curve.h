@@ -31,6 +31,11 @@ struct LeaderSecurity {
   std::vector<std::string> allowed_public;  // empty: any follower that knows the leader's key
   bool enabled() const { return !key.public_key.empty(); }
 };
+// A leader's security from its key file (`key`; empty: no CURVE) and the public key files of the
+// followers it admits (empty: any that knows the leader's key); InputError naming a bad file, or
+// followers given without the leader's key (--curve-allow needs --curve-key).
+LeaderSecurity LoadLeaderSecurity(const std::string& key, const std::vector<std::string>& allow);
+
 struct FollowerSecurity {
   CurveKey key;  // empty: no CURVE
   std::string leader_public;

@@ -277,4 +277,23 @@ cv::Mat ReadImage(const std::string& path, int flags, int min_side) {
   return DecodeImage(ReadFile(path, kMaxImageFileBytes), path, flags, min_side);
 }
 
+cv::Size ParseFrameSize(const std::string& text, const std::string& what, cv::Size min) {
+  int w = 0, h = 0;
+  char x = 0, rest = 0;
+  const bool parsed = std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &rest) == 3 && x == 'x';
+  if (!parsed || w < min.width || h < min.height || w > 4096 || h > 4096) {
+    throw InputError(what + " '" + text + "': expected WIDTHxHEIGHT, " + std::to_string(min.width) +
+                     "x" + std::to_string(min.height) + " to 4096x4096");
+  }
+  return {w, h};
+}
+
+void RequireSameSize(const cv::Mat& image, const std::string& path, const cv::Mat& reference,
+                     const std::string& reference_path) {
+  if (image.size() == reference.size()) return;
+  throw InputError(path + ": size " + std::to_string(image.cols) + "x" +
+                   std::to_string(image.rows) + " differs from " + reference_path + " (" +
+                   std::to_string(reference.cols) + "x" + std::to_string(reference.rows) + ")");
+}
+
 }  // namespace mapless::io

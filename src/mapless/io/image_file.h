@@ -34,4 +34,12 @@ cv::Mat ReadImage(const std::string& path, int flags, int min_side = 1);
 // (kMinImageSide .. kMaxImageSide, at most kMaxImagePixels).
 void CheckFrameSize(int width, int height, const std::string& name);
 
+// Throws InputError naming both files unless `image` has the size of `reference`.
+void RequireSameSize(const cv::Mat& image, const std::string& path, const cv::Mat& reference,
+                     const std::string& reference_path);
+
+// A frame size written WxH ("320x240"), from `min` up to 4096 a side; throws InputError naming
+// `what` (an option: "--size") and the text otherwise.
+cv::Size ParseFrameSize(const std::string& text, const std::string& what, cv::Size min);
+
 }  // namespace mapless::io

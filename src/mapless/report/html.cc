@@ -36,6 +36,7 @@ constexpr char kStyle[] = R"(
 body{font-family:sans-serif;margin:24px auto;max-width:1100px;color:#222;line-height:1.4}
 h1{font-size:1.6em;margin-bottom:0.2em}h2{font-size:1.3em;margin-top:1.6em;border-bottom:1px solid #ddd}
 h3{font-size:1.1em;margin-top:1.2em}
+.byline{color:#555;font-size:0.9em;margin-top:0;font-family:monospace}
 table{border-collapse:collapse;margin:0.6em 0;font-size:0.92em}
 th,td{border:1px solid #ccc;padding:3px 8px}th{background:#f2f2f2}td.n{text-align:right}
 figure{margin:0.8em 0;display:inline-block;vertical-align:top}
@@ -108,7 +109,9 @@ std::string HtmlReport::Html() const {
          "content=\"mapless\">\n<link "
          "rel=\"icon\" href=\"data:,\">\n<title>" +
          Escape(title_) + "</title>\n<style>" + kStyle + "</style>\n</head>\n<body>\n<h1>" +
-         Escape(title_) + "</h1>\n" + body_ + "</body>\n</html>\n";
+         Escape(title_) + "</h1>\n" +
+         (byline_.empty() ? "" : "<p class=\"byline\">" + Escape(byline_) + "</p>\n") + body_ +
+         "</body>\n</html>\n";
 }
 
 }  // namespace mapless::report

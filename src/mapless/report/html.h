@@ -15,6 +15,8 @@ class HtmlReport {
  public:
   explicit HtmlReport(std::string title);
 
+  // A line under the title: which mapless, when and how the report was made (plain text).
+  void Byline(const std::string& text) { byline_ = text; }
   void Heading(const std::string& text, int level = 2, const std::string& id = "");
   void Paragraph(const std::string& text);  // plain text (escaped)
   // A table; cells are plain text. `align_right`: numbers (every column but the first).
@@ -29,6 +31,7 @@ class HtmlReport {
 
  private:
   std::string title_;
+  std::string byline_;
   std::string body_;
 };
 

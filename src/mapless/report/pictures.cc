@@ -84,6 +84,52 @@ cv::Mat PlanePicture(const cv::Mat& image, const cv::Mat& plane_mask, double the
   return out;
 }
 
+namespace {
+
+void Label(cv::Mat* img, const std::string& text, cv::Point at, double scale = 0.38) {
+  cv::putText(*img, text, at, cv::FONT_HERSHEY_SIMPLEX, scale, cv::Scalar(40, 40, 40), 1,
+              cv::LINE_AA);
+}
+
+// The heat map inside axes: route image (upwards) against frame (to the right), with ticks, and a
+// colour bar from no belief to the frame's peak.
+cv::Mat WithBeliefAxes(const cv::Mat& map, int frames, int images) {
+  const int left = 46, bottom = 30, top = 8, right = 74;
+  cv::Mat out(map.rows + top + bottom, map.cols + left + right, CV_8UC3, cv::Scalar(255, 255, 255));
+  map.copyTo(out(cv::Rect(left, top, map.cols, map.rows)));
+  cv::rectangle(out, cv::Rect(left - 1, top - 1, map.cols + 2, map.rows + 2),
+                cv::Scalar(90, 90, 90));
+  for (int k = 0; k <= 4; ++k) {
+    const int frame = frames * k / 4;
+    const int x = left + static_cast<int>(static_cast<double>(map.cols) * k / 4.0);
+    cv::line(out, {x, top + map.rows}, {x, top + map.rows + 4}, cv::Scalar(90, 90, 90));
+    Label(&out, std::to_string(frame), {x - 8, top + map.rows + 15});
+    const int image = (images - 1) * k / 4;
+    const int y =
+        top + map.rows - 1 - static_cast<int>(static_cast<double>(map.rows - 1) * k / 4.0);
+    cv::line(out, {left - 4, y}, {left, y}, cv::Scalar(90, 90, 90));
+    Label(&out, std::to_string(image), {4, y + 4});
+  }
+  Label(&out, "frame", {left + map.cols / 2 - 14, top + map.rows + 27});
+  Label(&out, "image", {2, top + 10});
+  // The colour bar: viridis from 0 (no belief) to 1 (the frame's peak), square-root scaled.
+  const int bx = left + map.cols + 12;
+  cv::Mat ramp(map.rows, 1, CV_8UC1);
+  for (int r = 0; r < map.rows; ++r)
+    ramp.at<std::uint8_t>(r, 0) =
+        static_cast<std::uint8_t>(255 - 255 * r / std::max(1, map.rows - 1));
+  cv::Mat bar;
+  cv::applyColorMap(ramp, bar, cv::COLORMAP_VIRIDIS);
+  cv::resize(bar, bar, cv::Size(12, map.rows), 0, 0, cv::INTER_NEAREST);
+  bar.copyTo(out(cv::Rect(bx, top, 12, map.rows)));
+  Label(&out, "peak", {bx + 15, top + 8});
+  Label(&out, "0", {bx + 15, top + map.rows});
+  Label(&out, "sqrt", {bx + 15, top + map.rows / 2});
+  return out;
+}
+
+}  // namespace
+
 cv::Mat BeliefPicture(const std::vector<std::vector<float>>& beliefs, const std::vector<int>& truth,
                       int height_px) {
   std::size_t images = 1;
@@ -106,9 +152,11 @@ cv::Mat BeliefPicture(const std::vector<std::vector<float>>& beliefs, const std:
   cv::applyColorMap(grid, colour, cv::COLORMAP_VIRIDIS);
   const int width = std::clamp(cols * 2, 200, 900);
   cv::Mat out;
-  cv::resize(colour, out, cv::Size(width, height_px), 0, 0, cv::INTER_NEAREST);
+  // The heat map inside `height_px`: the axes' labels take 38 rows of it.
+  const int map_height = std::max(40, height_px - 38);
+  cv::resize(colour, out, cv::Size(width, map_height), 0, 0, cv::INTER_NEAREST);
   const double sx = static_cast<double>(width) / cols;
-  const double sy = static_cast<double>(height_px) / static_cast<double>(images);
+  const double sy = static_cast<double>(map_height) / static_cast<double>(images);
   for (std::size_t t = 0; t < truth.size() && t < static_cast<std::size_t>(cols); ++t) {
     if (truth[t] < 0) continue;
     cv::circle(out,
@@ -116,7 +164,7 @@ cv::Mat BeliefPicture(const std::vector<std::vector<float>>& beliefs, const std:
                          static_cast<int>((static_cast<double>(images) - 0.5 - truth[t]) * sy)),
                1, cv::Scalar(255, 255, 255), cv::FILLED);
   }
-  return out;
+  return WithBeliefAxes(out, cols, static_cast<int>(images));
 }
 
 cv::Mat LinePlotPicture(const PlotSpec& spec) {

@@ -27,7 +27,7 @@ cv::Mat PlanePicture(const cv::Mat& image, const cv::Mat& plane_mask, double the
 
 // The belief over route images (rows of `beliefs`, one per frame; rows may grow as the route
 // does) as a heat map: time to the right, route image upwards; `truth[i]` (route image nearest to
-// the robot, or -1) as a white dot.
+// the robot, or -1) as a white dot; with axes (frame, route image) and a colour bar.
 cv::Mat BeliefPicture(const std::vector<std::vector<float>>& beliefs, const std::vector<int>& truth,
                       int height_px = 240);
 

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 #include <sstream>
+#include <tuple>
 
 namespace mapless::report {
 namespace {
@@ -163,6 +164,68 @@ std::string LinePlotSvg(const PlotSpec& spec) {
   return o.str();
 }
 
+namespace {
+
+struct LegendEntry {
+  std::string text;
+  std::string color;
+  std::string kind;  // "path", "wall", "box", "cylinder", "poster", "star"
+};
+
+double LegendWidth(const LegendEntry& e) { return 36.0 + 6.2 * static_cast<double>(e.text.size()); }
+
+// The row of each entry when rows are at most `width` wide.
+std::vector<double> LegendRows(const std::vector<LegendEntry>& legend, double width) {
+  std::vector<double> rows;
+  double x = 0.0;
+  double row = 0.0;
+  for (const LegendEntry& e : legend) {
+    if (x > 0.0 && x + LegendWidth(e) > width) row += 1.0, x = 0.0;
+    rows.push_back(row);
+    x += LegendWidth(e);
+  }
+  return rows;
+}
+
+std::string LegendMark(const LegendEntry& e, double x, double y) {
+  std::ostringstream o;
+  const std::string c = Escape(e.color);
+  if (e.kind == "box") {
+    o << "<rect x=\"" << Num(x + 4) << "\" y=\"" << Num(y - 6)
+      << "\" width=\"12\" height=\"12\" fill=\"" << c << "\" stroke=\"#5a5a5a\"/>";
+  } else if (e.kind == "cylinder") {
+    o << "<circle cx=\"" << Num(x + 10) << "\" cy=\"" << Num(y) << "\" r=\"6\" fill=\"" << c
+      << "\" stroke=\"#5a5a5a\"/>";
+  } else if (e.kind == "star") {
+    o << "<text x=\"" << Num(x + 10) << "\" y=\"" << Num(y + 6)
+      << "\" font-size=\"16\" text-anchor=\"middle\" fill=\"" << c << "\">&#9733;</text>";
+  } else {
+    o << "<line x1=\"" << Num(x) << "\" x2=\"" << Num(x + 20) << "\" y1=\"" << Num(y) << "\" y2=\""
+      << Num(y) << "\" stroke=\"" << c << "\" stroke-width=\"3\"/>";
+  }
+  return o.str();
+}
+
+// The kinds of object the world has, each with its legend text and colour, in a fixed order.
+std::vector<std::tuple<std::string, std::string, std::string>> ObjectKinds(
+    const sim::World& world) {
+  bool wall = false, box = false, cylinder = false, poster = false;
+  for (const sim::WorldObject& obj : world.objects) {
+    wall |= obj.kind == sim::ObjectKind::kWall;
+    box |= obj.kind == sim::ObjectKind::kBox;
+    cylinder |= obj.kind == sim::ObjectKind::kCylinder;
+    poster |= obj.kind == sim::ObjectKind::kPoster;
+  }
+  std::vector<std::tuple<std::string, std::string, std::string>> kinds;
+  if (wall) kinds.emplace_back("wall", "wall", "#3c3c3c");
+  if (box) kinds.emplace_back("box", "box", "#d2beaa");
+  if (cylinder) kinds.emplace_back("cylinder", "cylinder", "#aac8b4");
+  if (poster) kinds.emplace_back("poster", "poster on a wall", "#c850c8");
+  return kinds;
+}
+
+}  // namespace
+
 std::string TopDownSvg(const sim::World& world, const std::vector<PathSpec>& paths,
                        const std::vector<Eigen::Vector2d>& markers, int max_side_px) {
   Eigen::Vector4d b = sim::FootprintBounds(world);
@@ -178,9 +241,18 @@ std::string TopDownSvg(const sim::World& world, const std::vector<PathSpec>& pat
   b += Eigen::Vector4d(-margin, -margin, margin, margin);
   const double span = std::max(b[2] - b[0], b[3] - b[1]);
   const double ppm = std::min(60.0, max_side_px / span);
-  const double w = std::max(200.0, std::ceil((b[2] - b[0]) * ppm));
+  const double w = std::max(320.0, std::ceil((b[2] - b[0]) * ppm));
   const double map_h = std::max(120.0, std::ceil((b[3] - b[1]) * ppm));
-  const double h = map_h + 30.0;
+  // The legend below the map, in rows as wide as the map: one entry per labelled path, then what
+  // the marks are.
+  std::vector<LegendEntry> legend;
+  for (const PathSpec& p : paths)
+    if (!p.label.empty()) legend.push_back({p.label, p.color, "path"});
+  for (const auto& [kind, text, colour] : ObjectKinds(world))
+    legend.push_back({text, colour, kind});
+  if (!markers.empty()) legend.push_back({"destination", "#008c00", "star"});
+  const std::vector<double> rows = LegendRows(legend, w - 70.0);
+  const double h = map_h + 22.0 + 18.0 * static_cast<double>(rows.empty() ? 1 : rows.back() + 1);
   const auto X = [&](double x) { return Num((x - b[0]) * ppm); };
   const auto Y = [&](double y) { return Num((b[3] - y) * ppm); };
   std::ostringstream o;
@@ -189,12 +261,22 @@ std::string TopDownSvg(const sim::World& world, const std::vector<PathSpec>& pat
   o << "<rect width=\"100%\" height=\"100%\" fill=\"#fafafa\"/>\n";
   double grid = 1.0;
   while (span / grid > 60.0) grid *= 10.0;
-  for (double x = std::ceil(b[0] / grid) * grid; x <= b[2]; x += grid)
+  // Coordinates (metres, the world frame) every `label_step` grid lines along the bottom and left.
+  const double label_step = NiceStep(span, 6) < grid ? grid : NiceStep(span, 6);
+  const auto labelled = [&](double v) {
+    return std::abs(std::remainder(v, label_step)) < 1e-6 * label_step;
+  };
+  for (double x = std::ceil(b[0] / grid) * grid; x <= b[2]; x += grid) {
     o << "<line x1=\"" << X(x) << "\" x2=\"" << X(x) << "\" y1=\"0\" y2=\"" << Num(map_h)
       << "\" stroke=\"#e8e8e8\"/>\n";
-  for (double y = std::ceil(b[1] / grid) * grid; y <= b[3]; y += grid)
+    if (labelled(x)) o << Text(std::stod(X(x)), map_h - 3, TickLabel(x, grid), "middle", 9);
+  }
+  for (double y = std::ceil(b[1] / grid) * grid; y <= b[3]; y += grid) {
     o << "<line x1=\"0\" x2=\"" << Num(w) << "\" y1=\"" << Y(y) << "\" y2=\"" << Y(y)
       << "\" stroke=\"#e8e8e8\"/>\n";
+    if (labelled(y)) o << Text(3, std::stod(Y(y)) - 2, TickLabel(y, grid), "start", 9);
+  }
+  o << Text(w - 4, map_h - 3, "x (m)", "end", 9) << Text(3, 10, "y (m)", "start", 9);
   for (const sim::WorldObject& obj : world.objects) {
     switch (obj.kind) {
       case sim::ObjectKind::kWall:
@@ -231,11 +313,14 @@ std::string TopDownSvg(const sim::World& world, const std::vector<PathSpec>& pat
     o << "<text x=\"" << X(m.x()) << "\" y=\"" << Num((b[3] - m.y()) * ppm + 6)
       << "\" font-size=\"18\" text-anchor=\"middle\" fill=\"#008c00\">&#9733;</text>\n";
   }
-  // The first path (usually the reference) is drawn last, on top.
-  for (auto it = paths.rbegin(); it != paths.rend(); ++it) {
+  // The first path (the reference) is drawn first, wide and translucent, and the driven paths on
+  // top of it: a path that follows the reference closely stays visible.
+  for (auto it = paths.begin(); it != paths.end(); ++it) {
     if (it->poses.empty()) continue;
+    const bool reference = it == paths.begin() && paths.size() > 1;
     o << "<polyline fill=\"none\" stroke=\"" << Escape(it->color) << "\" stroke-width=\""
-      << Num(it->width_px) << "\" stroke-linejoin=\"round\" points=\"";
+      << Num(reference ? std::max(5.0, 2.5 * it->width_px) : it->width_px) << "\""
+      << (reference ? " stroke-opacity=\"0.45\"" : "") << " stroke-linejoin=\"round\" points=\"";
     for (const Pose2& p : it->poses) o << X(p.x_m) << ',' << Y(p.y_m) << ' ';
     o << "\"/>\n";
     const Pose2& s = it->poses.front();
@@ -248,17 +333,18 @@ std::string TopDownSvg(const sim::World& world, const std::vector<PathSpec>& pat
       << "\" stroke-width=\"3\"/>\n";
   }
   double lx = 8;
-  for (const PathSpec& p : paths) {
-    if (p.label.empty()) continue;
-    o << "<line x1=\"" << Num(lx) << "\" x2=\"" << Num(lx + 20) << "\" y1=\"" << Num(h - 14)
-      << "\" y2=\"" << Num(h - 14) << "\" stroke=\"" << Escape(p.color)
-      << "\" stroke-width=\"3\"/>\n";
-    o << Text(lx + 24, h - 10, p.label, "start", 11);
-    lx += 36 + 6.2 * static_cast<double>(p.label.size());
+  for (std::size_t k = 0; k < legend.size(); ++k) {
+    if (k > 0 && rows[k] != rows[k - 1]) lx = 8;
+    const double ly = map_h + 18.0 + 18.0 * static_cast<double>(rows[k]);
+    o << "<g class=\"legend-entry\" data-kind=\"" << legend[k].kind << "\">"
+      << LegendMark(legend[k], lx, ly - 4) << Text(lx + 24, ly, legend[k].text, "start", 11)
+      << "</g>\n";
+    lx += LegendWidth(legend[k]);
   }
-  o << "<line x1=\"" << Num(w - 12 - ppm) << "\" x2=\"" << Num(w - 12) << "\" y1=\"" << Num(h - 14)
-    << "\" y2=\"" << Num(h - 14) << "\" stroke=\"#000\" stroke-width=\"3\"/>\n";
-  o << Text(w - 12 - ppm, h - 19, "1 m", "start", 10);
+  o << "<line x1=\"" << Num(w - 12 - ppm) << "\" x2=\"" << Num(w - 12) << "\" y1=\""
+    << Num(map_h + 14) << "\" y2=\"" << Num(map_h + 14)
+    << "\" stroke=\"#000\" stroke-width=\"3\"/>\n";
+  o << Text(w - 12 - ppm, map_h + 9, "1 m", "start", 10);
   o << "</svg>\n";
   return o.str();
 }

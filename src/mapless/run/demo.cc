@@ -51,8 +51,13 @@ DemoResult DemoRepeat(const sim::Scenario& scenario, const eval::TaughtRoute& ta
   trace.AddTo(&s);
   out.success = run.success;
   out.status = run.status;
-  out.row = {"teach & repeat (sloped funnel lane)", scenario.name, run.success ? "yes" : "no",
-             Fixed(run.final_error_m, 3), "lateral RMS " + Fixed(run.lateral_rms_m, 3) + " m"};
+  out.row = {"teach & repeat (sloped funnel lane)",
+             scenario.name,
+             run.success ? "yes" : "no",
+             Fixed(run.final_error_m, 3),
+             "lateral RMS " + Fixed(run.lateral_rms_m, 3) + " m",
+             "completes the route, no collision, ends within " +
+                 Fixed(options.success_radius_m, 1) + " m of the taught end"};
   return out;
 }
 
@@ -93,9 +98,13 @@ DemoResult DemoEigenspace(const std::string& scenario_name, std::uint64_t seed,
   trace.AddTo(&s);
   out.success = run.success;
   out.status = run.status;
-  out.row = {"eigenspace follower (leader still teaching)", scenario.name,
-             run.success ? "yes" : "no", Fixed(run.final_error_m, 3),
-             "localized within 1 image: " + Fixed(100.0 * run.localization_within_one, 0) + "%"};
+  out.row = {"eigenspace follower (leader still teaching)",
+             scenario.name,
+             run.success ? "yes" : "no",
+             Fixed(run.final_error_m, 3),
+             "localized within 1 image: " + Fixed(100.0 * run.localization_within_one, 0) + "%",
+             "arrives, no collision, within " + Fixed(options.arrive_tolerance_m, 1) +
+                 " m of the route's end"};
   return out;
 }
 
@@ -135,10 +144,14 @@ DemoResult DemoPotential(const std::string& scenario_name, std::uint64_t seed,
   trace.AddTo(&s);
   out.success = run.success;
   out.status = run.status;
-  out.row = {"visual potential (destination and home)", scenario.name, run.success ? "yes" : "no",
+  out.row = {"visual potential (destination and home)",
+             scenario.name,
+             run.success ? "yes" : "no",
              Fixed(run.final_error_m, 3),
              Fixed(run.duration_s, 1) + " s, " + std::to_string(run.no_plane_frames) +
-                 " frames without a plane"};
+                 " frames without a plane",
+             "reaches the destination and comes home, no collision, within " +
+                 Fixed(options.success_radius_m, 1) + " m"};
   return out;
 }
 

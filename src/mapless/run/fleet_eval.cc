@@ -80,9 +80,18 @@ Fleet Prepare(const FleetEvalOptions& a) {
                       work + "/leader.key.pub"};
   }
   const std::string rate = std::to_string(a.rate);
-  std::vector<std::string> lead_args = {"mapless",  "lead",           "--source", "sim:" + scenario,
-                                        "--route",  work + "/leader", "--bind",   endpoint,
-                                        "--method", a.method,         "--rate",   rate};
+  std::vector<std::string> lead_args = {"mapless",
+                                        "lead",
+                                        "--source",
+                                        "sim:" + scenario,
+                                        "--route",
+                                        work + "/leader",
+                                        "--bind",
+                                        endpoint,
+                                        "--method",
+                                        a.method,
+                                        "--real-time-factor",
+                                        rate};
   lead_args.insert(lead_args.end(), curve_leader.begin(), curve_leader.end());
   f.leader = Child(lead_args, work + "/leader.log", a.program);
   if (a.link_down_at_s > 0.0) {
@@ -93,13 +102,20 @@ Fleet Prepare(const FleetEvalOptions& a) {
     const std::string name = "follower" + std::to_string(i);
     const bool relayed = f.relay && i == a.followers;
     std::vector<std::string> args = {
-        "mapless",   "follow",
-        "--connect", relayed ? "tcp://127.0.0.1:" + std::to_string(f.relay_port) : endpoint,
-        "--source",  "sim:" + scenario,
-        "--route",   work + "/" + name,
-        "--rate",    rate,
-        "--summary", work + "/" + name + ".json",
-        "--seed",    std::to_string(a.seed + static_cast<std::uint64_t>(i))};
+        "mapless",
+        "follow",
+        "--connect",
+        relayed ? "tcp://127.0.0.1:" + std::to_string(f.relay_port) : endpoint,
+        "--source",
+        "sim:" + scenario,
+        "--route",
+        work + "/" + name,
+        "--real-time-factor",
+        rate,
+        "--summary",
+        work + "/" + name + ".json",
+        "--seed",
+        std::to_string(a.seed + static_cast<std::uint64_t>(i))};
     args.insert(args.end(), curve_follower.begin(), curve_follower.end());
     f.followers.emplace_back(args, work + "/" + name + ".log", a.program);
   }

@@ -2,9 +2,12 @@
 // the leader's own copy of the route (its route directory) and served to the followers at once.
 #pragma once
 
+#include <functional>
+
 #include "mapless/fleet/route_log.h"
 #include "mapless/fleet/server.h"
 #include "mapless/run/teach.h"
+#include "mapless/sim/simulation.h"
 
 namespace mapless::run {
 
@@ -24,5 +27,11 @@ class LeaderSink : public RouteSink {
   fleet::RouteCopy& copy_;
   fleet::LeaderServer& server_;
 };
+
+// A leader restarted on its route goes on where it stopped: `teacher` is given the route so far;
+// on the simulator, the returned test says which frames of the teach drive are driven again
+// without being rendered (empty: all are new).
+std::function<bool(const sim::DriveFrame&)> ResumeLeader(const fleet::RouteCopy& copy,
+                                                         fleet::RouteKind kind, Teacher* teacher);
 
 }  // namespace mapless::run

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 
@@ -18,12 +19,31 @@
 namespace mapless::run {
 namespace {
 
-// Colours of the runs of a suite entry: one hue, light to dark.
-std::string RunColour(std::size_t i, std::size_t n) {
-  const int shade = n <= 1 ? 120 : 60 + static_cast<int>(140 * i / (n - 1));
-  char buf[8];
-  std::snprintf(buf, sizeof(buf), "#%02x%02x%02x", 30, std::min(255, shade + 40), 30 + shade / 3);
-  return buf;
+// Colours of the runs of a suite entry, each its own (the reference is red).
+std::string RunColour(std::size_t i) {
+  static const char* const kColours[] = {"#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b",
+                                         "#e377c2", "#17becf", "#bcbd22", "#7f7f7f", "#393b79"};
+  return kColours[i % (sizeof(kColours) / sizeof(kColours[0]))];
+}
+
+// What the map from above shows, from what is in it.
+std::string TopDownCaption(const RunSection& section) {
+  std::string text = "From above, in metres (x to the right, y up): the world";
+  std::vector<std::string> labels;
+  for (const report::PathSpec& p : section.paths)
+    if (!p.label.empty()) labels.push_back(p.label);
+  if (!labels.empty()) {
+    text += " and the paths (";
+    for (std::size_t k = 0; k < labels.size(); ++k) text += (k > 0 ? ", " : "") + labels[k];
+    text += ")";
+  }
+  if (section.paths.size() > 1) {
+    text += "; the first path, wide and light, is the one the others are measured against";
+  }
+  if (!section.paths.empty())
+    text += "; a circle marks where a path starts, a bar its last heading";
+  if (!section.markers.empty()) text += "; a star is a destination";
+  return text + ".";
 }
 
 }  // namespace
@@ -50,12 +70,43 @@ report::Series ErrorAlongPath(const std::vector<Pose2>& reference, const std::ve
   return s;
 }
 
+namespace {
+std::string g_version = "?";
+std::string g_command_line;
+}  // namespace
+
+void SetInvocation(const std::string& version, int argc, const char* const* argv) {
+  g_version = version;
+  g_command_line.clear();
+  for (int i = 0; i < argc; ++i) {
+    std::string arg = i == 0 ? "mapless" : argv[i];
+    const bool plain = !arg.empty() && arg.find_first_not_of(
+                                           "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                           "0123456789-_./:=,+@%") == std::string::npos;
+    if (!plain) {
+      std::string quoted = "'";
+      for (char c : arg) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+      arg = quoted + "'";
+    }
+    g_command_line += (i > 0 ? " " : "") + arg;
+  }
+}
+
+std::string ReportByline() {
+  char when[32] = "";
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  if (gmtime_r(&now, &utc) != nullptr)
+    std::strftime(when, sizeof(when), "%Y-%m-%d %H:%M UTC", &utc);
+  return "mapless " + g_version + ", " + when + ": " +
+         (g_command_line.empty() ? std::string("(command line not recorded)") : g_command_line);
+}
+
 void AddRunSection(report::HtmlReport* html, const RunSection& section) {
   html->Heading(section.title, 2, section.slug);
   if (!section.summary.empty()) html->Paragraph(section.summary);
   html->Figure(report::TopDownSvg(section.world, section.paths, section.markers),
-               "From above: the world, the reference path and the driven path(s); circles mark "
-               "the starts, bars the final headings, stars the destinations.");
+               TopDownCaption(section));
   for (const report::PlotSpec& plot : section.plots) html->Figure(report::LinePlotSvg(plot), "");
   if (!section.pictures.empty()) html->Images(section.pictures, section.pictures_caption);
 }
@@ -109,6 +160,7 @@ void WriteSuiteReport(const std::string& dir, const std::string& suite, int runs
                       const std::vector<std::string>& experiments,
                       const std::vector<const RunTrace*>& traces) {
   report::HtmlReport html("mapless eval " + suite);
+  html.Byline(ReportByline());
   html.Paragraph("Runs per line: " + std::to_string(runs) +
                  "; first seed: " + std::to_string(seed) +
                  ". Each run has its own seed (motion and image noise, start perturbation).");
@@ -146,11 +198,11 @@ void WriteSuiteReport(const std::string& dir, const std::string& suite, int runs
                             640,
                             240};
     for (std::size_t i = 0; i < r.paths.size(); ++i) {
-      const std::string colour = RunColour(i, r.paths.size());
-      s.paths.push_back({r.paths[i], colour, i == 0 ? "runs" : "", 1.2});
+      const std::string colour = RunColour(i);
+      const std::string label = "run " + std::to_string(i + 1);
+      s.paths.push_back({r.paths[i], colour, label, 1.2});
       if (!r.reference_path.empty())
-        errors.series.push_back(
-            ErrorAlongPath(r.reference_path, r.paths[i], colour, i == 0 ? "runs" : ""));
+        errors.series.push_back(ErrorAlongPath(r.reference_path, r.paths[i], colour, label));
     }
     if (!errors.series.empty()) s.plots.push_back(errors);
     if (k < traces.size() && traces[k]) {

@@ -47,6 +47,11 @@ report::Series ErrorAlongPath(const std::vector<Pose2>& reference, const std::ve
 
 void AddRunSection(report::HtmlReport* html, const RunSection& section);
 
+// The mapless version and command line of this process (main() sets them once), for the line
+// under a report's title: "mapless 0.1.0, 2026-11-27 17:40 UTC: mapless demo --out x".
+void SetInvocation(const std::string& version, int argc, const char* const* argv);
+std::string ReportByline();
+
 // Writes DIR/index.html and every section's PNG twins (DIR/SLUG_topdown.png, DIR/SLUG_plotN.png),
 // each atomically; returns the path of index.html.
 std::string WriteReport(const std::string& dir, const report::HtmlReport& html,

@@ -11,6 +11,8 @@
 #include "mapless/robot/status.h"
 #include "mapless/run/link_kinds.h"
 #include "mapless/run/run_method.h"
+#include "mapless/run/status_line.h"
+#include "mapless/run/text.h"
 
 namespace mapless::run {
 namespace {
@@ -259,6 +261,45 @@ TEST(LinkKinds, StandardKindsTellSourcesApartAndRefuseWhatTheyCannotOpen) {
                             return std::unique_ptr<robot::RobotLink>();
                           }}),
                std::logic_error);
+}
+
+}  // namespace
+}  // namespace mapless::run
+
+namespace mapless::run {
+namespace {
+
+TEST(Text, WrapWordsKeepsLinesWithinTheWidth) {
+  const std::vector<std::string> lines =
+      WrapWords("the quick brown fox jumps over the lazy dog\nnext paragraph", 12);
+  const std::vector<std::string> want = {"the quick",    "brown fox", "jumps over",
+                                         "the lazy dog", "next",      "paragraph"};
+  EXPECT_EQ(lines, want);
+  EXPECT_EQ(WrapWords("averyveryverylongword x", 5),
+            (std::vector<std::string>{"averyveryverylongword", "x"}));
+  EXPECT_EQ(WrapWords("", 10), (std::vector<std::string>{""}));
+}
+
+TEST(StatusLine, SaysStateWhereAndWhatItSeesWithinTheWidth) {
+  nlohmann::json s = {{"method", "repeat"},  {"state", "driving"}, {"status", "driving"},
+                      {"destination", 12},   {"matches", 85},      {"v_mps", 0.2},
+                      {"omega_radps", 0.05}, {"t_s", 11.3}};
+  EXPECT_EQ(StatusLineText(s, 3.42, 11.3),
+            "repeat: driving | keyframe 12 | 85 matches | 0.20 m/s 0.05 rad/s | 3.4 m | 11.3 s");
+  s["state"] = "stopped";
+  s["status"] = "blocked";
+  s["reason"] = "obstacle ahead (34% of the ground ahead): stopped, waiting for the way to be free";
+  const std::string line = StatusLineText(s, 3.42, 11.3);
+  EXPECT_EQ(line.rfind("repeat: stopped (blocked) | keyframe 12", 0), 0u) << line;
+  EXPECT_LE(line.size(), 99u);
+  EXPECT_EQ(line.substr(line.size() - 3), "...");
+  // The distance is the commanded speed over the time between decisions.
+  StatusLine quiet(false);
+  quiet.Show({{"t_s", 0.0}, {"v_mps", 0.5}});
+  quiet.Show({{"t_s", 2.0}, {"v_mps", 0.5}});
+  quiet.Show({{"t_s", 3.0}, {"v_mps", -0.5}});  // backwards counts too
+  EXPECT_FALSE(quiet.enabled());
+  EXPECT_DOUBLE_EQ(quiet.driven_m(), 1.5);
 }
 
 }  // namespace

@@ -172,9 +172,8 @@ SuiteOutput RunEigenspaceSuite(const SuiteOptions& options) {
   });
   nlohmann::json j = SuiteJson("eigenspace", runs, seed);
   std::string table;
-  Appendf(&table, "%-19s %-16s %9s %5s %10s %11s %11s %9s %9s %6s %7s %9s\n", "scenario",
-          "experiment", "success", "coll", "final rms", "lateral rms", "lateral max", "loc +-1",
-          "nn +-1", "stops", "at obj", "clearance");
+  Appendf(&table, "%-19s %-16s %7s %4s %6s %7s %6s %6s %5s %6s %6s\n", "scenario", "experiment",
+          "success", "coll", "final", "lateral", "loc1", "nn1", "stops", "at obj", "clear");
   for (const auto& r : results) {
     nlohmann::json e = EntryJson(r);
     e["experiment"] = r.experiment;
@@ -184,12 +183,18 @@ SuiteOutput RunEigenspaceSuite(const SuiteOptions& options) {
     e["stop_frames"] = r.stops;
     j["results"].push_back(e);
     const std::string clearance =
-        std::isfinite(r.min_clearance_m) ? Fixed(r.min_clearance_m, 2) + "m" : "-";
-    Appendf(&table, "%-19s %-16s %4d/%-4d %5d %9.3fm %10.3fm %10.3fm %9.3f %9.3f %6d %7d %9s\n",
+        std::isfinite(r.min_clearance_m) ? Fixed(r.min_clearance_m, 2) : "-";
+    Appendf(&table, "%-19s %-16s %3d/%-3d %4d %6s %7.3f %6.3f %6.3f %5d %6d %6s\n",
             r.scenario.c_str(), r.experiment.c_str(), r.successes, r.runs, r.collisions,
-            r.final_error_m_rms, r.lateral_rms_m, r.lateral_rms_m_max, r.localization_within_one,
-            r.nearest_within_one, r.obstacle_stops, r.stops_at_added_object, clearance.c_str());
+            r.successes > 0 ? Fixed(r.final_error_m_rms, 3).c_str() : "-", r.lateral_rms_m,
+            r.localization_within_one, r.nearest_within_one, r.obstacle_stops,
+            r.stops_at_added_object, clearance.c_str());
   }
+  table +=
+      "final: RMS distance to the route's end (m; - when no run succeeded); lateral: RMS distance "
+      "to the\nleader's path (m); loc1, nn1: frames localized within one route image (Markov, "
+      "nearest projection);\nstops: runs the obstacle watch stopped; at obj: ... while an added "
+      "object stood there; clear:\nthe closest the robot came to it (m).\n";
   if (!report_dir.empty()) {
     std::vector<const eval::EntryResult*> entries_out;
     std::vector<std::string> experiments;
@@ -241,18 +246,24 @@ SuiteOutput RunRepeatSuite(const std::string& suite, const SuiteOptions& options
   nlohmann::json j = SuiteJson(suite, options.runs, options.seed);
   j.update(settings);
   std::string table;
-  Appendf(&table, "%-30s %-9s %9s %10s %10s %10s %10s %5s %6s %7s %9s %6s\n", "scenario", "control",
-          "success", "final rms", "final std", "final max", "lateral", "coll", "stops", "at obj",
-          "clearance", "round");
+  Appendf(&table, "%-29s %-8s %7s %6s %6s %7s %4s %5s %6s %6s %5s\n", "scenario", "control",
+          "success", "final", "max", "lateral", "coll", "stops", "at obj", "clear", "round");
   for (const auto& r : results) {
     j["results"].push_back(EntryJson(r));
     const std::string clearance =
-        std::isfinite(r.min_clearance_m) ? Fixed(r.min_clearance_m, 2) + "m" : "-";
-    Appendf(&table, "%-30s %-9s %4d/%-4d %9.2fm %9.2fm %9.2fm %9.2fm %5d %6d %7d %9s %6d\n",
-            r.scenario.c_str(), r.controller.c_str(), r.successes, r.runs, r.final_error_m_rms,
-            r.final_error_m_std, r.final_error_m_max, r.lateral_rms_m, r.collisions,
+        std::isfinite(r.min_clearance_m) ? Fixed(r.min_clearance_m, 2) : "-";
+    const bool any = r.successes > 0;
+    Appendf(&table, "%-29s %-8s %3d/%-3d %6s %6s %7.2f %4d %5d %6d %6s %5d\n", r.scenario.c_str(),
+            r.controller.c_str(), r.successes, r.runs,
+            any ? Fixed(r.final_error_m_rms, 2).c_str() : "-",
+            any ? Fixed(r.final_error_m_max, 2).c_str() : "-", r.lateral_rms_m, r.collisions,
             r.obstacle_stops, r.stops_at_added_object, clearance.c_str(), r.went_round);
   }
+  table +=
+      "final, max: RMS and largest distance to the taught end (m; - when no run succeeded); "
+      "lateral: RMS\ndistance to the taught path (m); coll: runs that collided; stops: runs the "
+      "obstacle watch stopped;\nat obj: ... while an added object stood there; clear: the closest "
+      "the robot came to it (m); round:\nruns that went round it (--on-obstacle avoid).\n";
   if (!options.report_dir.empty()) {
     std::vector<const eval::EntryResult*> entries_out;
     for (const auto& r : results) entries_out.push_back(&r);

@@ -1,5 +1,6 @@
 #include "mapless/run/text.h"
 
+#include <algorithm>
 #include <cstdarg>
 #include <cstdio>
 #include <vector>
@@ -32,6 +33,29 @@ void Appendf(std::string* out, const char* format, ...) {
   va_start(args, format);
   *out += VFormat(format, args);
   va_end(args);
+}
+
+std::vector<std::string> WrapWords(const std::string& text, std::size_t width) {
+  std::vector<std::string> lines;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t end = std::min(text.find('\n', start), text.size());
+    std::string line;
+    std::size_t i = start;
+    while (i < end) {
+      const std::size_t space = std::min(text.find(' ', i), end);
+      const std::string word = text.substr(i, space - i);
+      if (!line.empty() && line.size() + 1 + word.size() > width) {
+        lines.push_back(line);
+        line.clear();
+      }
+      if (!word.empty()) line += (line.empty() ? "" : " ") + word;
+      i = space + 1;
+    }
+    lines.push_back(line);
+    start = end + 1;
+  }
+  return lines;
 }
 
 }  // namespace mapless::run

@@ -91,7 +91,8 @@ void EigenspaceTrace::AddTo(RunSection* section) const {
   section->plots.push_back(prob);
   section->pictures.push_back({report::BeliefPicture(beliefs_, {}), "the belief over time"});
   section->pictures_caption =
-      "The Markov belief over the route images (upwards) against time (to the right); brighter "
+      "The Markov belief over the route images (upwards, by index) against the frame (to the "
+      "right), each frame's column scaled to its own peak (square root: the colour bar); brighter "
       "is more likely. The route grows while the leader teaches.";
 }
 
