@@ -313,14 +313,14 @@ std::string TopDownSvg(const sim::World& world, const std::vector<PathSpec>& pat
     o << "<text x=\"" << X(m.x()) << "\" y=\"" << Num((b[3] - m.y()) * ppm + 6)
       << "\" font-size=\"18\" text-anchor=\"middle\" fill=\"#008c00\">&#9733;</text>\n";
   }
-  // The first path (the reference) is drawn first, wide and translucent, and the driven paths on
-  // top of it: a path that follows the reference closely stays visible.
+  // The first path (the reference) is drawn first and wide, and the driven paths on top of it: a
+  // path that follows the reference closely stays visible, with the reference on both sides.
   for (auto it = paths.begin(); it != paths.end(); ++it) {
     if (it->poses.empty()) continue;
     const bool reference = it == paths.begin() && paths.size() > 1;
     o << "<polyline fill=\"none\" stroke=\"" << Escape(it->color) << "\" stroke-width=\""
-      << Num(reference ? std::max(5.0, 2.5 * it->width_px) : it->width_px) << "\""
-      << (reference ? " stroke-opacity=\"0.45\"" : "") << " stroke-linejoin=\"round\" points=\"";
+      << Num(reference ? std::max(6.0, 3.0 * it->width_px) : it->width_px) << "\""
+      << " stroke-linejoin=\"round\" points=\"";
     for (const Pose2& p : it->poses) o << X(p.x_m) << ',' << Y(p.y_m) << ' ';
     o << "\"/>\n";
     const Pose2& s = it->poses.front();

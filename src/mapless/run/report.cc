@@ -38,7 +38,7 @@ std::string TopDownCaption(const RunSection& section) {
     text += ")";
   }
   if (section.paths.size() > 1) {
-    text += "; the first path, wide and light, is the one the others are measured against";
+    text += "; the first path, wide and underneath, is the one the others are measured against";
   }
   if (!section.paths.empty())
     text += "; a circle marks where a path starts, a bar its last heading";
