@@ -101,9 +101,9 @@ void NavigateOnSim(const NavigateArgs& a, bool by_index) {
   const std::string area_text =
       fmt::format("[{:.1f}, {:.1f}] x [{:.1f}, {:.1f}] m", area[0], area[2], area[1], area[3]);
   if (!a.start.empty()) {
-    scenario.teach_start = ParsePoseDeg(a.start, "--start");
+    scenario.teach_start = ParsePoseDeg(a.start, "--start-pose");
     if (!in_area(scenario.teach_start.x_m, scenario.teach_start.y_m))
-      throw InputError("--start " + a.start + ": outside the scenario's area " + area_text);
+      throw InputError("--start-pose " + a.start + ": outside the scenario's area " + area_text);
   }
   eval::PotentialRunOptions o;
   o.seed = a.seed;
@@ -182,7 +182,8 @@ void AddNavigateCommand(CLI::App* app) {
   cmd->add_option("--destination-index", a->destination_index,
                   "Use the scenario's destination number N (0-based)");
   cmd->add_flag("--homing", a->homing, "At the destination turn round and come back");
-  cmd->add_option("--start", a->start, "X,Y,THETA_DEG (default: the scenario's teach start)");
+  cmd->add_option("--start-pose", a->start, "X,Y,THETA_DEG (default: the scenario's teach start)");
+  AddOldName(cmd, "--start", "--start-pose", &a->start);
   cmd->add_option("--calibration", a->calibration,
                   "Planar-flow calibration file to use (default: calibrate by driving first)");
   cmd->add_option("--save-calibration", a->save_calibration,

@@ -17,7 +17,7 @@ void AddTeleopCommand(CLI::App* app) {
       "teleop", "Drive a robot from the keyboard, to teach a route: keys here, cmd_vel out");
   cmd->add_option("--robot", a->robot, "The robot file (YAML): middleware, topics, speed limits")
       ->required();
-  cmd->add_option("--speed", a->keys.speed_fraction,
+  cmd->add_option("--speed-fraction", a->keys.speed_fraction,
                   "Starting speed, a fraction of the robot file's limits (+ and - change it)")
       ->capture_default_str();
   cmd->add_option("--hold", a->keys.hold_s, "Seconds a key drives after its last repeat")
@@ -29,9 +29,7 @@ void AddTeleopCommand(CLI::App* app) {
     run::Keyboard keyboard;
     robot::TeleopMethod method(a->keys, [&keyboard] { return keyboard.Read(); });
     spdlog::info("teleop: {}", robot::TeleopKeysHelp());
-    SourceRunArgs run;
-    run.robot = true;
-    RunOnSource(method, a->robot, run);
+    RunOnSource(method, a->robot, SourceRunArgs{{}, {}, nullptr, {}, /*robot=*/true});
   });
 }
 

@@ -54,6 +54,18 @@ section_basics() {
     check "mapless links no image codec, video I/O or FFmpeg library" $?
   fi
 
+  # docs/cli.md lists every option a command offers (one meaning per name, issue 42).
+  if [ -f "$HERE/../docs/cli.md" ]; then
+    missing=""
+    for sub in demo "sim render" "sim drive" "sim serve" bench shift teach lead repeat "route info" "eval table1" "eval potential" "eval eigenspace" "eval obstacles" "eval fleet" soak flow ground navigate localize follow teleop "fleet keygen"; do
+      # shellcheck disable=SC2086
+      for opt in $("$MAPLESS" $sub --help | grep -oE '^  --[a-z0-9-]+' | tr -d ' '); do
+        [ "$opt" = --help ] || grep -q "^| \`$opt\` |" "$HERE/../docs/cli.md" || missing="$missing $sub:$opt"
+      done
+    done
+    [ -z "$missing" ]; check "docs/cli.md lists every option${missing:+; missing:$missing}" $?
+  fi
+
   # sim list: one name per line, the paper scenarios among them.
   expect_exit "sim list" 0 "$MAPLESS" sim list
   [ "$(wc -l <"$TMP/out")" -ge 15 ]; check "sim list has >= 15 scenarios" $?

@@ -216,7 +216,7 @@ probe "teach speed 1e-300 m/s" 2 "slow_teach.yaml" -- "$MAPLESS" sim drive --sce
 probe "a rotation of 1e300 degrees" 2 "endless_rotation.yaml" -- "$MAPLESS" sim drive --scenario "$FX/endless_rotation.yaml" --out "$NEW/d6"
 probe "a path point 1e9 m away" 2 "far_path.yaml: Scenario.teach.path[1]: beyond" -- "$MAPLESS" repeat --route "$FX/route" --source "sim:$FX/far_path.yaml"
 probe "navigate to a destination outside the world" 2 "--destination 1e6,1e6: outside the scenario's area" -- "$MAPLESS" navigate --scenario obstacle_field --destination 1e6,1e6
-probe "navigate from a start outside the world" 2 "--start 5000,0,0: outside the scenario's area" -- "$MAPLESS" navigate --scenario obstacle_field --start 5000,0,0
+probe "navigate from a start outside the world" 2 "--start-pose 5000,0,0: outside the scenario's area" -- "$MAPLESS" navigate --scenario obstacle_field --start-pose 5000,0,0
 probe "render 1e12 m from the origin" 2 "--pose 1e12,0,0: beyond" -- "$MAPLESS" sim render --scenario table1_almost_straight --pose 1e12,0,0 --out "$NEW/r.png"
 
 echo "# raw library errors: sizes checked first"

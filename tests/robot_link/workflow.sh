@@ -42,7 +42,7 @@ serve teach serve_teach.log
 TEACH=$!; PIDS+=("$TEACH")
 sleep 2
 { sleep 1; for _ in $(seq 1 120); do printf w; sleep 0.1; done; printf '\004'; } |
-  timeout 60 script -q -e -c "$BIN teleop --robot $OUT/teleop.yaml --speed 1" /dev/null \
+  timeout 60 script -q -e -c "$BIN teleop --robot $OUT/teleop.yaml --speed-fraction 1" /dev/null \
     >"$OUT/teleop.log" 2>&1
 check "teleop from a pseudo-terminal: keys in, exit 0 on Ctrl-D" $?
 grep -q "teleop: finished" "$OUT/teleop.log" && grep -q "ended from the keyboard" "$OUT/teleop.log"

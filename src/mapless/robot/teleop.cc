@@ -41,8 +41,9 @@ void TeleopOptions::Validate() const {
   MAPLESS_CHECK(
       max_turn_rate_radps > 0.0 && max_turn_rate_radps <= 10.0,
       "teleop: max_turn_rate_radps = " << max_turn_rate_radps << ": must be in (0, 10] rad/s");
-  MAPLESS_CHECK(speed_fraction >= 0.1 && speed_fraction <= 1.0,
-                "--speed " << speed_fraction << ": must be in [0.1, 1] (a fraction of the limits)");
+  MAPLESS_CHECK(
+      speed_fraction >= 0.1 && speed_fraction <= 1.0,
+      "--speed-fraction " << speed_fraction << ": must be in [0.1, 1] (a fraction of the limits)");
   MAPLESS_CHECK(hold_s >= 0.1 && hold_s <= 5.0,
                 "--hold " << hold_s << ": must be in [0.1, 5] seconds");
 }
