@@ -224,6 +224,26 @@ std::vector<std::tuple<std::string, std::string, std::string>> ObjectKinds(
   return kinds;
 }
 
+// The legend's entries in their rows below the map, and the 1 m scale bar.
+std::string LegendSvg(const std::vector<LegendEntry>& legend, const std::vector<double>& rows,
+                      double map_h, double w, double ppm) {
+  std::ostringstream o;
+  double lx = 8;
+  for (std::size_t k = 0; k < legend.size(); ++k) {
+    if (k > 0 && rows[k] != rows[k - 1]) lx = 8;
+    const double ly = map_h + 18.0 + 18.0 * static_cast<double>(rows[k]);
+    o << "<g class=\"legend-entry\" data-kind=\"" << legend[k].kind << "\">"
+      << LegendMark(legend[k], lx, ly - 4) << Text(lx + 24, ly, legend[k].text, "start", 11)
+      << "</g>\n";
+    lx += LegendWidth(legend[k]);
+  }
+  o << "<line x1=\"" << Num(w - 12 - ppm) << "\" x2=\"" << Num(w - 12) << "\" y1=\""
+    << Num(map_h + 14) << "\" y2=\"" << Num(map_h + 14)
+    << "\" stroke=\"#000\" stroke-width=\"3\"/>\n";
+  o << Text(w - 12 - ppm, map_h + 9, "1 m", "start", 10);
+  return o.str();
+}
+
 }  // namespace
 
 std::string TopDownSvg(const sim::World& world, const std::vector<PathSpec>& paths,
@@ -332,19 +352,7 @@ std::string TopDownSvg(const sim::World& world, const std::vector<PathSpec>& pat
       << Y(e.y_m + 0.35 * std::sin(e.theta_rad)) << "\" stroke=\"" << Escape(it->color)
       << "\" stroke-width=\"3\"/>\n";
   }
-  double lx = 8;
-  for (std::size_t k = 0; k < legend.size(); ++k) {
-    if (k > 0 && rows[k] != rows[k - 1]) lx = 8;
-    const double ly = map_h + 18.0 + 18.0 * static_cast<double>(rows[k]);
-    o << "<g class=\"legend-entry\" data-kind=\"" << legend[k].kind << "\">"
-      << LegendMark(legend[k], lx, ly - 4) << Text(lx + 24, ly, legend[k].text, "start", 11)
-      << "</g>\n";
-    lx += LegendWidth(legend[k]);
-  }
-  o << "<line x1=\"" << Num(w - 12 - ppm) << "\" x2=\"" << Num(w - 12) << "\" y1=\""
-    << Num(map_h + 14) << "\" y2=\"" << Num(map_h + 14)
-    << "\" stroke=\"#000\" stroke-width=\"3\"/>\n";
-  o << Text(w - 12 - ppm, map_h + 9, "1 m", "start", 10);
+  o << LegendSvg(legend, rows, map_h, w, ppm);
   o << "</svg>\n";
   return o.str();
 }
