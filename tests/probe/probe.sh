@@ -12,6 +12,10 @@ MAPLESS="$1"
 RUN="$2"
 MAX_RSS_MB="$3"
 TIMEOUT_S="${4:-10}"
+# The fixtures are inputs, not what is probed: made with MAPLESS_FIXTURES (the release build's
+# mapless, which computes them identically) when scripts/test.sh gives it, else with MAPLESS.
+FIXTURES="${MAPLESS_FIXTURES:-$MAPLESS}"
+[ -x "$FIXTURES" ] || FIXTURES="$MAPLESS"
 TMP=$(mktemp -d)
 cleanup() {
   # Background runs this script started (the lock and signal cases) never outlive it.
@@ -88,13 +92,13 @@ probe() {
 
 # ---------------------------------------------------------------------------------------------
 # Fixtures, made by mapless itself or written byte by byte here.
-"$MAPLESS" teach --source sim:table1_almost_straight --out "$FX/route" >/dev/null 2>&1
+"$FIXTURES" teach --source sim:table1_almost_straight --out "$FX/route" >/dev/null 2>&1
 check "fixture: a taught route" $?
-"$MAPLESS" sim render --scenario table1_almost_straight --pose 0,0,0 --out "$FX/f0.png" 2>/dev/null
-"$MAPLESS" sim render --scenario table1_almost_straight --pose 0.05,0,0 --out "$FX/f1.png" 2>/dev/null
+"$FIXTURES" sim render --scenario table1_almost_straight --pose 0,0,0 --out "$FX/f0.png" 2>/dev/null
+"$FIXTURES" sim render --scenario table1_almost_straight --pose 0.05,0,0 --out "$FX/f1.png" 2>/dev/null
 mkdir -p "$FX/frames" "$FX/black" "$FX/tiny_frames" "$FX/small_frames" "$FX/huge_frames" "$FX/notroute"
 for i in 0 1 2 3; do
-  "$MAPLESS" sim render --scenario table1_almost_straight --pose "0.$((2 * i)),0,0" --out "$FX/frames/$i.png" 2>/dev/null
+  "$FIXTURES" sim render --scenario table1_almost_straight --pose "0.$((2 * i)),0,0" --out "$FX/frames/$i.png" 2>/dev/null
 done
 [ -s "$FX/f0.png" ] && [ -s "$FX/frames/3.png" ]; check "fixture: rendered frames" $?
 pgm() {  # pgm FILE W H: a grey PGM of zeros
@@ -296,10 +300,10 @@ printf 'topics: {imag: camera/image_raw}\n' >"$FX/robot_unknown.yaml"
 printf 'middleware: ros3\n' >"$FX/robot_ros3.yaml"
 printf '{}\n' >"$FX/robot_ok.yaml"
 printf 'limits: {max_speed_mps: .nan}\n' >"$FX/robot_nan.yaml"
-"$MAPLESS" teach --source sim:table1_almost_straight --method eigenspace --out "$FX/aroute" >/dev/null 2>&1
+"$FIXTURES" teach --source sim:table1_almost_straight --method eigenspace --out "$FX/aroute" >/dev/null 2>&1
 cp -r "$FX/aroute" "$FX/aroute_bad_manifest" && printf '{"format": "mapless-appearance-route", "version": 1, "images": 3}' >"$FX/aroute_bad_manifest/appearance.json"
 cp -r "$FX/aroute" "$FX/aroute_cut_image" && head -c 60 "$FX/aroute/images/000001.png" >"$FX/aroute_cut_image/images/000001.png"
-cp -r "$FX/aroute" "$FX/aroute_wrong_size" && "$MAPLESS" sim render --scenario table1_almost_straight --pose 0,0,0 --out "$FX/aroute_wrong_size/images/000002.png" >/dev/null 2>&1
+cp -r "$FX/aroute" "$FX/aroute_wrong_size" && "$FIXTURES" sim render --scenario table1_almost_straight --pose 0,0,0 --out "$FX/aroute_wrong_size/images/000002.png" >/dev/null 2>&1
 probe "robot file with an unknown field" 2 "robot_unknown.yaml:1:16: topics.imag: unknown field" -- "$MAPLESS" repeat --route "$FX/route" --robot "$FX/robot_unknown.yaml"
 probe "robot file with an unknown middleware" 2 "middleware: 'ros3' is not one of ros1, ros2" -- "$MAPLESS" follow --route "$FX/aroute" --robot "$FX/robot_ros3.yaml"
 probe "robot file with a nan speed limit" 2 "limits.max_speed_mps: expected a number" -- "$MAPLESS" teach --robot "$FX/robot_nan.yaml" --out "$NEW/rt1"
@@ -313,7 +317,7 @@ probe "follow a route with a cut image" 2 "000001.png" -- "$MAPLESS" follow --ro
 probe "follow a route with an image of the wrong size" 2 "000002.png: 320x240, the route's images are 64x64" -- "$MAPLESS" follow --route "$FX/aroute_wrong_size" --source sim:table1_almost_straight
 # The fleet (issue 19): leaders and followers refuse bad endpoints, keys and directories up front.
 printf 'public_key: "short"\nsecret_key: "short"\n' >"$FX/bad.key"
-"$MAPLESS" fleet keygen "$FX/fleet.key" >/dev/null 2>&1
+"$FIXTURES" fleet keygen "$FX/fleet.key" >/dev/null 2>&1
 probe "lead with an endpoint that is not one" 2 "--bind nonsense" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/l1" --bind nonsense
 probe "lead with an unknown --method" 2 "--method dense: must be funnel or eigenspace" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/l2" --bind tcp://127.0.0.1:1 --method dense
 probe "lead with a key file that is not a key" 2 "bad.key: public_key: not a CURVE key" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/l3" --bind tcp://127.0.0.1:1 --curve-key "$FX/bad.key"

@@ -86,7 +86,7 @@ probe "follow --connect with no host" 2 "no host" -- "$MAPLESS" follow --connect
 probe "lead --bind udp://" 2 "expected tcp://HOST:PORT or ipc://PATH" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/r3l4" --bind udp://127.0.0.1:5600
 probe "lead --bind ipc:// with no path" 2 "ipc:// needs a path" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/r3l5" --bind ipc://
 # A recording of a short simulated teach (camera and odometry), and the route taught with it.
-"$MAPLESS" teach --source "sim:$FX/ok.yaml" --out "$TMP/r3route" --record "$FX/r3_odom.mcap" >/dev/null 2>&1
+"$FIXTURES" teach --source "sim:$FX/ok.yaml" --out "$TMP/r3route" --record "$FX/r3_odom.mcap" >/dev/null 2>&1
 [ -s "$FX/r3_odom.mcap" ] && [ -s "$TMP/r3route/manifest.json" ]; check "round 3 fixtures: a recording and its route" $?
 probe "follow on a recording without odometry" 1 "stopped on all" -- "$MAPLESS" follow --route "$FX/aroute" --source "$FX/r3_odom.mcap" --odom-topic none --log "$NEW/r3f.jsonl"
 corrupt_length() {  # corrupt_length NAME LOG2: r3_odom.mcap with its second record's length 2^LOG2
@@ -153,8 +153,8 @@ kill -INT "$r3teach"; wait "$r3teach" 2>/dev/null
 
 # ---------------------------------------------------------------------------------------------
 echo "# round 3: silent waits"
-"$MAPLESS" fleet keygen "$FX/r3_leader.key" >/dev/null 2>&1
-"$MAPLESS" fleet keygen "$FX/r3_other.key" >/dev/null 2>&1
+"$FIXTURES" fleet keygen "$FX/r3_leader.key" >/dev/null 2>&1
+"$FIXTURES" fleet keygen "$FX/r3_other.key" >/dev/null 2>&1
 "$MAPLESS" lead --source sim:table1_almost_straight --method eigenspace --route "$NEW/r3curve" \
   --bind tcp://127.0.0.1:0 --real-time-factor 0 --curve-key "$FX/r3_leader.key" --curve-allow "$FX/r3_other.key.pub" \
   >"$TMP/r3curve.out" 2>"$TMP/r3curve.err" &

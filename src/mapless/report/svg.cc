@@ -105,9 +105,22 @@ std::string LinePlotSvg(const PlotSpec& spec) {
   const double pw = w - left - right, ph = h - top - bottom;
   const auto X = [&](double x) { return left + (x - xr.lo) / (xr.hi - xr.lo) * pw; };
   const auto Y = [&](double y) { return top + (yr.hi - y) / (yr.hi - yr.lo) * ph; };
+  // The legend in rows as wide as the plot (ten runs' labels do not fit one); each row after the
+  // first makes the picture 16 px taller.
+  std::vector<double> legend_rows;
+  double legend_x = 0.0, legend_row = 0.0;
+  for (const Series& s : spec.series) {
+    if (s.label.empty()) continue;
+    const double width = 34 + 6.0 * static_cast<double>(s.label.size());
+    if (legend_x > 0.0 && legend_x + width > pw) legend_row += 1.0, legend_x = 0.0;
+    legend_rows.push_back(legend_row);
+    legend_x += width;
+  }
+  const double total_h = h + 16.0 * legend_row;
   std::ostringstream o;
-  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << w << "\" height=\"" << h
-    << "\" viewBox=\"0 0 " << w << ' ' << h << "\" font-family=\"sans-serif\" role=\"img\">\n";
+  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << w << "\" height=\"" << total_h
+    << "\" viewBox=\"0 0 " << w << ' ' << total_h
+    << "\" font-family=\"sans-serif\" role=\"img\">\n";
   o << "<rect width=\"100%\" height=\"100%\" fill=\"#fff\"/>\n";
   if (!spec.title.empty()) o << Text(left, 16, spec.title, "start", 13, " font-weight=\"bold\"");
   for (double y = yr.lo; y <= yr.hi + 1e-9 * y_step; y += y_step) {
@@ -151,9 +164,11 @@ std::string LinePlotSvg(const PlotSpec& spec) {
       << "\" stroke-width=\"1.6\"" << (s.dashed ? " stroke-dasharray=\"5,3\"" : "") << "/>\n";
   }
   double lx = left;
+  std::size_t entry = 0;
   for (const Series& s : spec.series) {
     if (s.label.empty()) continue;
-    const double ly = h - 8;
+    if (entry > 0 && legend_rows[entry] != legend_rows[entry - 1]) lx = left;
+    const double ly = h - 8 + 16.0 * legend_rows[entry++];
     o << "<line x1=\"" << Num(lx) << "\" x2=\"" << Num(lx + 18) << "\" y1=\"" << Num(ly - 4)
       << "\" y2=\"" << Num(ly - 4) << "\" stroke=\"" << Escape(s.color) << "\" stroke-width=\"3\""
       << (s.dashed ? " stroke-dasharray=\"5,3\"" : "") << "/>\n";

@@ -9,7 +9,9 @@
 #include <fstream>
 
 #include "mapless/core/check.h"
+#include "mapless/eval/eigenspace.h"
 #include "mapless/eval/potential.h"
+#include "mapless/eval/teach_repeat.h"
 #include "mapless/io/atomic_file.h"
 #include "mapless/report/pictures.h"
 #include "mapless/run/traces.h"
@@ -24,6 +26,19 @@ std::string RunColour(std::size_t i) {
   static const char* const kColours[] = {"#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b",
                                          "#e377c2", "#17becf", "#bcbd22", "#7f7f7f", "#393b79"};
   return kColours[i % (sizeof(kColours) / sizeof(kColours[0]))];
+}
+
+// What counts as a success in a suite's table (the defaults of eval/*.h).
+std::string SuccessMeans(const std::string& suite) {
+  if (suite == "potential")
+    return "A run succeeds when the robot reaches the destination (and home, where the entry "
+           "homes) without a collision, within " +
+           Fixed(eval::PotentialRunOptions{}.success_radius_m, 1) + " m.";
+  if (suite == "eigenspace")
+    return "A run succeeds when the follower arrives without a collision, within " +
+           Fixed(eval::EigenspaceRunOptions{}.arrive_tolerance_m, 1) + " m of the route's end.";
+  return "A run succeeds when the robot completes the route without a collision and ends within " +
+         Fixed(eval::RepeatRunOptions{}.success_radius_m, 1) + " m of the taught end.";
 }
 
 // What the map from above shows, from what is in it.
@@ -163,7 +178,8 @@ void WriteSuiteReport(const std::string& dir, const std::string& suite, int runs
   html.Byline(ReportByline());
   html.Paragraph("Runs per line: " + std::to_string(runs) +
                  "; first seed: " + std::to_string(seed) +
-                 ". Each run has its own seed (motion and image noise, start perturbation).");
+                 ". Each run has its own seed (motion and image noise, start perturbation). " +
+                 SuccessMeans(suite));
   html.Heading("Results");
   std::vector<std::vector<std::string>> rows;
   for (std::size_t k = 0; k < entries.size(); ++k) {
