@@ -102,6 +102,11 @@ void PrintStageTable(const nlohmann::json& j) {
   std::printf("%-34s %10.2f  (issue 21: <= 1.5; ORB-500 timed after each step)\n",
               "repeat_step_default / orb500 interl.",
               j["repeat_step_default_over_orb_interleaved"].get<double>());
+  std::printf("%-34s %10.2f  (issue 44: <= 2.0; ORB-500 timed after each step)\n",
+              "teach_step / orb500 interl.", j["teach_step_over_orb_interleaved"].get<double>());
+  std::printf("%-34s %10.2f  (issue 44: <= 1.5; ORB-500 timed after each step)\n",
+              "repeat_step_with_watch / orb500 int.",
+              j["repeat_step_default_with_watch_over_orb_interleaved"].get<double>());
   std::printf("%-34s %10.2f  (same keypoints and descriptors)\n",
               "orb_detector / opencv same settings",
               j["orb_detector_over_opencv_same_settings"].get<double>());

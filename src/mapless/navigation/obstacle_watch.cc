@@ -73,6 +73,8 @@ void ObstacleWatchOptions::Validate() const {
                 "ObstacleWatchOptions.max_age_s = " << max_age_s << "; must be > 0");
   MAPLESS_CHECK(region_top >= 0.0 && region_top < 1.0,
                 "ObstacleWatchOptions.region_top = " << region_top << "; must be in [0, 1)");
+  MAPLESS_CHECK(region_far_m > 0.0,
+                "ObstacleWatchOptions.region_far_m = " << region_far_m << "; must be > 0");
   MAPLESS_CHECK(region_width > 0.0 && region_width <= 1.0,
                 "ObstacleWatchOptions.region_width = " << region_width << "; must be in (0, 1]");
   MAPLESS_CHECK(region_half_width_m > 0.0, "ObstacleWatchOptions.region_half_width_m = "
@@ -135,17 +137,23 @@ cv::Rect ObstacleWatch::Region(cv::Size size) const {
 bool ObstacleWatch::InRegion(cv::Point2f p, cv::Size size) const {
   if (p.y < options_.region_top * size.height) return false;
   const double horizon = options_.horizon * size.height;
+  // Ground farther than the route goes: rows above the one at route_left_m_.
+  if (p.y < horizon + (options_.region_top * size.height - horizon) * options_.region_far_m /
+                          route_left_m_)
+    return false;
   const double half =
       0.5 * options_.region_width * size.width * (p.y - horizon) / (size.height - horizon);
   return std::abs(p.x - 0.5 * size.width) <= half;
 }
 
 ObstacleCheck ObstacleWatch::Update(const cv::Mat& grey, Timestamp t_ns, double forward_m,
-                                    double turned_rad, const std::vector<cv::Point2f>& known_px) {
+                                    double turned_rad, const std::vector<cv::Point2f>& known_px,
+                                    double route_left_m) {
   MAPLESS_CHECK(!grey.empty() && grey.type() == CV_8UC1,
                 "ObstacleWatch: expected a non-empty 8-bit grey image");
   ObstacleCheck check;
   if (!options_.enabled) return check;
+  route_left_m_ = std::max(route_left_m, 1e-3);
   forward_m_ += std::max(0.0, forward_m);
   // The heading, not the turning's total: the standard funnel lane turns +-R every frame, and
   // the sum of |turning| ruled out every pair of frames 8 cm apart (it never looked).

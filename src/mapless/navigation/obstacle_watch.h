@@ -38,6 +38,7 @@
 #pragma once
 
 #include <deque>
+#include <limits>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -69,6 +70,12 @@ struct ObstacleWatchOptions {
   double region_top = 0.72;
   double region_width = 0.5;
   double horizon = 0.5;
+  // The ground's distance at region_top (2.1 m for the simulator's camera, see above). With the
+  // horizon row it gives every row's distance (a level pinhole camera: distance ~ 1 / (row -
+  // horizon)), so that near the route's end the region stops where the route does (Update's
+  // route_left_m): what stood beyond the end at teach time is not in the way (issue 42: a chair
+  // 0.5 m past the end stopped the robot for good).
+  double region_far_m = 2.1;
   double fit_top = 0.55;  // the ground is fitted on the points below this row fraction ...
   double draw_top = 0.8;  // ... RANSAC drawing its samples below this one (see FitGround)
   // At most this many RANSAC hypotheses; fewer when the best one so far makes more very unlikely
@@ -130,9 +137,12 @@ class ObstacleWatch {
 
   // One frame (8-bit grey) at t_ns, after the robot drove `forward_m` and turned `turned_rad`
   // (commanded, since the previous frame). `known_px`: pixels of this view that belong to the
-  // taught scene (features matching the route, from the previous frame).
+  // taught scene (features matching the route, from the previous frame). `route_left_m`: at most
+  // this much ground ahead will be driven over (the rest of the route and a margin; infinite when
+  // unknown): the region ends there.
   ObstacleCheck Update(const cv::Mat& grey, Timestamp t_ns, double forward_m, double turned_rad,
-                       const std::vector<cv::Point2f>& known_px = {});
+                       const std::vector<cv::Point2f>& known_px = {},
+                       double route_left_m = std::numeric_limits<double>::infinity());
   bool blocked() const { return blocked_; }
   // Drops a confirmed obstacle and the frames seen so far: the robot is going round it (avoid),
   // and the next check needs a new baseline.
@@ -165,6 +175,7 @@ class ObstacleWatch {
   std::deque<Frame> history_;
   double forward_m_ = 0.0;
   double turned_rad_ = 0.0;
+  double route_left_m_ = std::numeric_limits<double>::infinity();  // this frame's (Update)
   int votes_ = 0;
   bool blocked_ = false;
   cv::Mat blocked_image_;  // the frame when the robot had stopped

@@ -58,6 +58,8 @@ const char* RepeatStatusName(RepeatStatus s) {
 }
 
 void RepeatOptions::Validate() const {
+  MAPLESS_CHECK(route_end_margin_m >= 0.0,
+                "RepeatOptions.route_end_margin_m = " << route_end_margin_m << "; must be >= 0");
   features.Validate();
   matching.Validate();
   klt.Validate();
@@ -229,6 +231,7 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns,
   const double dt = have_last_t_ ? std::max(0.0, ToSeconds(t_ns - last_t_ns_)) : 0.0;
   // Keyframe recovery's measure of progress: the time spent with a moving command.
   if (last_command_.v_mps != 0.0 || last_command_.omega_radps != 0.0) driven_since_switch_s_ += dt;
+  driven_since_switch_m_ += std::max(0.0, last_command_.v_mps * dt);
   last_t_ns_ = t_ns;
   have_last_t_ = true;
   // Grey once: the camera check, the watch and the method all read the grey frame.
@@ -244,7 +247,7 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns,
     // Going round an obstacle, the last frame's match with the route is stale: no known scene.
     const ObstacleCheck obstacle =
         watch_.Update(grey, t_ns, last_command_.v_mps * dt, last_command_.omega_radps * dt,
-                      detour_ ? std::vector<cv::Point2f>{} : scene_px_);
+                      detour_ ? std::vector<cv::Point2f>{} : scene_px_, RouteLeftM());
     const bool started = !detour_ && obstacle.blocked && StartDetour(obstacle, grey.size());
     if (detour_) {
       // Going round it (--on-obstacle avoid) until back on the route; the obstacle that started

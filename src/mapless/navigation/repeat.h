@@ -113,6 +113,11 @@ struct RepeatOptions {
   // no longer matches with recovery_min_features, the nearest following keyframe within
   // carry_on_keyframes that does.
   ObstacleWatchOptions obstacle;
+  // Near the end of a complete route taught with odometry, the watch looks no farther than the
+  // route goes: the taught path left (from the keyframe before the destination, less the commanded
+  // forward motion since the switch) and this margin. What stands beyond the end was there at
+  // teach time or is not in the way (issue 42).
+  double route_end_margin_m = 0.3;
   control::DetourOptions detour;
   int max_detours = 3;
   // At the last keyframe of an incomplete route: false, the repeat ends there (an interrupted
@@ -213,6 +218,9 @@ class RepeatSession {
   // This frame of the detour under way, the watch's check of the frame.
   RepeatStep Detouring(RepeatStep step, const ObstacleCheck& obstacle);
   double RouteSpeed() const;
+  // How much ground ahead the robot may still drive over (RepeatOptions::route_end_margin_m):
+  // infinite for an incomplete route or one without odometry.
+  double RouteLeftM() const;
   std::vector<control::FeaturePair> Pairs() const;
   RepeatStep Stop(RepeatStep step, RepeatStatus status, const std::string& reason);
 
@@ -245,6 +253,7 @@ class RepeatSession {
   Timestamp last_t_ns_ = 0;
   bool have_last_t_ = false;
   double driven_since_switch_s_ = 0.0;  // time with a moving command since the last switch
+  double driven_since_switch_m_ = 0.0;  // commanded forward motion since the last switch
   bool waiting_ = false;
   Timestamp waiting_since_ns_ = 0;
   std::optional<Timestamp> short_since_ns_;  // the destination short of features since

@@ -2,14 +2,31 @@
 // keyframe recovery (the following keyframes, within reach) and carrying on along the taught
 // odometry. The rest of the session is in repeat.cc.
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <string>
 
 #include "mapless/navigation/repeat.h"
 
 namespace mapless::navigation {
 
+double RepeatSession::RouteLeftM() const {
+  const auto& kfs = route_->keyframes;
+  const int n = static_cast<int>(kfs.size());
+  if (!route_->complete || n == 0) return std::numeric_limits<double>::infinity();
+  double left = 0.0;
+  for (int k = std::max(0, destination_ - 1); k + 1 < n; ++k) {
+    const auto& a = kfs[static_cast<std::size_t>(k)].odometry;
+    const auto& b = kfs[static_cast<std::size_t>(k) + 1].odometry;
+    if (!a || !b) return std::numeric_limits<double>::infinity();
+    left += std::hypot(b->x_m - a->x_m, b->y_m - a->y_m);
+  }
+  return std::max(0.0, left - driven_since_switch_m_) + options_.route_end_margin_m;
+}
+
 void RepeatSession::MarkSwitch() {
   driven_since_switch_s_ = 0.0;
+  driven_since_switch_m_ = 0.0;
   switch_odometry_ = odometry_;
   carrying_.reset();
   carry_active_ = false;

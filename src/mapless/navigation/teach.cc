@@ -1,5 +1,7 @@
 #include "mapless/navigation/teach.h"
 
+#include <algorithm>
+#include <numeric>
 #include <opencv2/imgproc.hpp>
 
 #include "mapless/control/funnel_lane.h"
@@ -17,6 +19,8 @@ void TeachOptions::Validate() const {
                 "TeachOptions.max_spread_growth = " << max_spread_growth << "; must be 0 or > 1");
   MAPLESS_CHECK(min_keyframe_features >= 0, "TeachOptions.min_keyframe_features = "
                                                 << min_keyframe_features << "; must be >= 0");
+  MAPLESS_CHECK(max_tracked_features >= 0,
+                "TeachOptions.max_tracked_features = " << max_tracked_features << "; must be >= 0");
   MAPLESS_CHECK(thumbnail_width_px >= 16,
                 "TeachOptions.thumbnail_width_px = " << thumbnail_width_px << "; must be >= 16");
 }
@@ -49,9 +53,21 @@ std::optional<route::Keyframe> TeachSession::MakeKeyframe(const cv::Mat& grey, T
   kf.descriptors = f.descriptors;
   kf.segment_start_px = start_;
   kf.segment_end_px = current_;
-  // The next segment tracks this keyframe's features.
+  // The next segment tracks this keyframe's features (the strongest, up to the limit).
+  std::vector<std::size_t> order(kf.keypoints.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  const std::size_t limit = options_.max_tracked_features > 0
+                                ? static_cast<std::size_t>(options_.max_tracked_features)
+                                : order.size();
+  if (order.size() > limit) {
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return kf.keypoints[a].response > kf.keypoints[b].response;
+    });
+    order.resize(limit);
+    std::sort(order.begin(), order.end());  // in the keyframe's order
+  }
   start_.clear();
-  for (const auto& k : kf.keypoints) start_.push_back(k.pt);
+  for (const std::size_t i : order) start_.push_back(kf.keypoints[i].pt);
   current_ = start_;
   initial_count_ = start_.size();
   return kf;
@@ -63,13 +79,15 @@ std::optional<route::Keyframe> TeachSession::Update(const cv::Mat& image, Timest
   cv::Mat grey = image;
   if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
   std::optional<route::Keyframe> out;
+  features::KltPyramid pyramid = features::BuildKltPyramid(grey, options_.klt);
   if (next_index_ == 0) {
     out = MakeKeyframe(grey, t_ns, odometry);  // the first keyframe: the first frame with features
   } else {
     MAPLESS_CHECK(grey.size() == previous_.size(), "TeachSession: frame size changed from "
                                                        << previous_.cols << "x" << previous_.rows
                                                        << " to " << grey.cols << "x" << grey.rows);
-    const features::KltResult tracked = features::TrackKlt(previous_, grey, current_, options_.klt);
+    const features::KltResult tracked =
+        features::TrackKlt(previous_pyramid_, pyramid, current_, options_.klt);
     std::vector<cv::Point2f> kept_start;
     std::vector<cv::Point2f> kept_current;
     for (std::size_t i = 0; i < current_.size(); ++i) {
@@ -95,6 +113,7 @@ std::optional<route::Keyframe> TeachSession::Update(const cv::Mat& image, Timest
   }
   previous_is_keyframe_ = out.has_value();
   previous_ = grey.clone();
+  previous_pyramid_ = std::move(pyramid);
   previous_t_ns_ = t_ns;
   previous_odometry_ = odometry;
   return out;

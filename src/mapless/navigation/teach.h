@@ -31,6 +31,10 @@ struct TeachOptions {
   // A frame with fewer features than this never becomes a keyframe (the repeat could not match
   // it); the keyframe is deferred to the next frame that has enough, and the deferral counted.
   int min_keyframe_features = 30;
+  // Track at most this many of a keyframe's features through its segment, the strongest (Harris
+  // response) first; all are stored for matching. The tracking is most of a teach step's time,
+  // and the keyframe rule needs a fraction, not every feature. 0 tracks them all.
+  int max_tracked_features = 300;
   int thumbnail_width_px = 160;  // width of the stored downscaled image
   void Validate() const;
 };
@@ -62,6 +66,7 @@ class TeachSession {
   features::FeatureExtractor extractor_;
   int next_index_ = 0;
   cv::Mat previous_;
+  features::KltPyramid previous_pyramid_;
   Timestamp previous_t_ns_ = 0;
   std::optional<Pose2> previous_odometry_;
   bool previous_is_keyframe_ = false;
