@@ -61,7 +61,9 @@ void PrintLinkRows(const nlohmann::json& j) {
 }  // namespace
 
 void PrintStageTable(const nlohmann::json& j) {
-  std::printf("%-34s %10s\n", "stage", "median ms");
+  // Every stage runs on one thread (cv::setNumThreads(1)); fps: the frame rate the stage alone
+  // allows on this host (1000 / median).
+  std::printf("%-34s %10s %9s\n", "stage (one thread)", "median ms", "fps");
   for (const char* key : {"sim_render_320x240_ms",
                           "opencv_dis_fast_320x240_ms",
                           "teach_step_ms",
@@ -89,7 +91,8 @@ void PrintStageTable(const nlohmann::json& j) {
                           "ipca_add_1000_ms",
                           "markov_update_10000_ms",
                           "subwindow_control_ms"}) {
-    std::printf("%-34s %10.3f\n", key, j[key].get<double>());
+    const double ms = j[key].get<double>();
+    std::printf("%-34s %10.3f %9.0f\n", key, ms, ms > 0.0 ? 1000.0 / ms : 0.0);
   }
   std::printf("%-34s %10.2f  (issue 2: <= 2.0)\n", "sim_render / dis_fast",
               j["sim_render_over_dis_fast"].get<double>());

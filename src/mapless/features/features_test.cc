@@ -176,6 +176,7 @@ TEST(TrackKlt, FullResolutionIsOpenCvsTrackerBitForBit) {
   cv::goodFeaturesToTrack(a, corners, 200, 0.01, 8);
   KltOptions o;
   o.finest_level = 0;
+  o.epsilon = 0.01;
   const KltResult r = TrackKlt(BuildKltPyramid(a, o), BuildKltPyramid(b, o), corners, o);
   std::vector<cv::Point2f> forward;
   std::vector<uchar> status;

@@ -25,7 +25,9 @@ struct KltOptions {
   double max_forward_backward_px = 1.0;  // reject if tracking back misses the start by more (px
                                          // of the full image)
   int max_iterations = 30;
-  double epsilon = 0.01;  // (px of the finest level tracked)
+  // Iterations stop when the step is below this (px of the finest level tracked: 0.06 px of the
+  // full image at level 1; 0.01 at level 1 cost 10% more time and kept the same points).
+  double epsilon = 0.03;
   // The window side at the finest level tracked (odd).
   int LevelWindowPx() const;
   void Validate() const;

@@ -116,8 +116,8 @@ void ParseTopics(const io::YamlMap& t, RobotFile* r) {
 
 // The section `obstacles`: the obstacle watch (navigation/obstacle_watch.h).
 void ParseObstacles(const io::YamlMap& o, RobotFile* r) {
-  o.CheckKnownKeys({"on_obstacle", "region_top", "region_width", "region_half_width_m", "horizon",
-                    "baseline_m", "min_blocked_fraction"});
+  o.CheckKnownKeys({"on_obstacle", "region_top", "region_far_m", "region_width",
+                    "region_half_width_m", "horizon", "baseline_m", "min_blocked_fraction"});
   const std::string on = o.GetString("on_obstacle", "stop");
   if (on != "stop" && on != "avoid" && on != "off")
     o.Fail("on_obstacle", "'" + on + "' is not stop, avoid or off");
@@ -132,6 +132,7 @@ void ParseObstacles(const io::YamlMap& o, RobotFile* r) {
   };
   r->obstacle.region_top = fraction("region_top", r->obstacle.region_top, 0.0, 0.95);
   r->obstacle.fit_top = std::min(r->obstacle.fit_top, r->obstacle.region_top);
+  r->obstacle.region_far_m = fraction("region_far_m", r->obstacle.region_far_m, 0.2, 50.0);
   r->obstacle.region_width = fraction("region_width", r->obstacle.region_width, 0.05, 1.0);
   r->obstacle.region_half_width_m =
       fraction("region_half_width_m", r->obstacle.region_half_width_m, 0.05, 2.0);

@@ -87,6 +87,9 @@ TEST(RobotFile, ObstacleWatchSettings) {
   EXPECT_TRUE(a.obstacle.avoid);
   EXPECT_DOUBLE_EQ(a.obstacle.region_half_width_m, 0.35);
   ExpectError("obstacles: {region_half_width_m: 0}\n", "region_half_width_m");
+  EXPECT_DOUBLE_EQ(
+      ParseRobotFile("obstacles: {region_far_m: 3.5}\n", "robot.yaml").obstacle.region_far_m, 3.5);
+  ExpectError("obstacles: {region_far_m: -1}\n", "region_far_m");
 }
 
 }  // namespace
