@@ -1,7 +1,9 @@
 // Issue 42: objects that were in the taught views near the route's end are not obstacles. A route
 // that ends 0.5 m in front of a chair (there at teach time and still there) completes without a
-// stop, because near the end the obstacle watch looks no farther than the route goes; with that
-// limit off (an effectively infinite margin) the same run stops in front of the chair for good.
+// stop: near the end the obstacle watch looks no farther than the route goes, and the repeat
+// tells it how far that is. (That the watch would stop for the same thing without the limit:
+// ObstacleWatch.WhatStandsPastTheRoutesEndIsNotInTheWay. In this scenario, before the limit, 3 runs
+// of 3 stopped for good 0.26 m before the end.)
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -26,12 +28,6 @@ TEST(RouteEnd, AChairPastTheEndOfTheRouteDoesNotStopTheRepeat) {
   EXPECT_TRUE(run.success) << run.status;
   EXPECT_FALSE(EverBlocked(run));
   EXPECT_LE(run.final_error_m, 0.2);
-
-  // The same run without the limit: the watch sees the chair over the route's last metres.
-  o.repeat.route_end_margin_m = 100.0;
-  const RepeatRun unlimited = RepeatOnSimulator(scenario, taught, o);
-  EXPECT_TRUE(EverBlocked(unlimited));
-  EXPECT_FALSE(unlimited.success);
 }
 
 }  // namespace

@@ -3,12 +3,12 @@
 // The funnel-lane paper tracks with KLT and a 31x31 window.
 //
 // Where the time goes: the Lucas-Kanade iterations over the window, per point, level and direction
-// (the pyramids are ~3% of it). By default the finest level tracked is the half-resolution image,
-// with the window halved: the same 31 pixels of the full image around each point, a quarter of the
-// samples. Against tracking on the full image (finest_level 0), the positions differ by 0.13 px
-// (median; 0.38 px at the 90th percentile) and fewer than 1% of the points change their
-// forward-backward verdict, on the teach drives of table1_almost_straight and
-// narrow_room_sharp_turn; the step costs ~3x less (docs/results.md, Speed).
+// (the pyramids are ~3% of it). finest_level 1 tracks on the half-resolution image with the window
+// halved: the same 31 pixels of the full image around each point, a quarter of the samples, ~3x
+// less time; the positions differ by 0.15 px (median) from full-resolution tracking. It is not the
+// default: the teach's keyframes move, and a carry-on repeat through three missing keyframes
+// (KeyframeRecovery.ARepeatCarriesOnByOdometryThroughThreeKeyframesGone) then ended 3 m early
+// (docs/results.md, Teach speed).
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -19,15 +19,13 @@ namespace mapless::features {
 struct KltOptions {
   int window_px = 31;      // square window, in pixels of the full image (the paper's [31 31])
   int pyramid_levels = 3;  // levels above the full image; the coarsest is 1/8 of its size
-  // The finest level tracked: 0 = the full image; 1 = the half-resolution image, the window halved
-  // (15 px there for the default 31), positions rescaled to the full image.
-  int finest_level = 1;
+  // The finest level tracked: 0 (the default) = the full image; 1 = the half-resolution image, the
+  // window halved (15 px there for 31), positions rescaled to the full image.
+  int finest_level = 0;
   double max_forward_backward_px = 1.0;  // reject if tracking back misses the start by more (px
                                          // of the full image)
   int max_iterations = 30;
-  // Iterations stop when the step is below this (px of the finest level tracked: 0.06 px of the
-  // full image at level 1; 0.01 at level 1 cost 10% more time and kept the same points).
-  double epsilon = 0.03;
+  double epsilon = 0.01;  // iterations stop when the step is below this (px of the finest level)
   // The window side at the finest level tracked (odd).
   int LevelWindowPx() const;
   void Validate() const;

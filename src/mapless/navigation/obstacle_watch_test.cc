@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
@@ -23,9 +24,11 @@ struct WatchRun {
 // (`box_x`, `box_y`) when box_x > 0, taken away at `box_leaves_s`), the watch deciding every
 // frame; stops for good when it blocks (the command is zero while blocked). `zigzag_radps`:
 // turning left and right at that rate on alternate frames, as the standard funnel lane does.
+// `route_end_x` > 0: the route ends there, and the watch is told how much of it is left (the
+// commanded forward motion since the start taken off, plus the repeat's 0.3 m margin).
 WatchRun DriveAt(double box_x, double box_leaves_s, double drive_s, std::uint64_t seed,
                  const ObstacleWatchOptions& options = {}, double box_y = 0.0,
-                 double zigzag_radps = 0.0) {
+                 double zigzag_radps = 0.0, double route_end_x = -1.0) {
   sim::Scenario s = sim::LoadScenario("table1_almost_straight");
   sim::World world = s.world;
   if (box_x > 0.0) {
@@ -53,6 +56,7 @@ WatchRun DriveAt(double box_x, double box_leaves_s, double drive_s, std::uint64_
   WatchRun out;
   const double period = 0.1;
   Twist2 command{0.2, 0.0};
+  double driven_m = 0.0;
   for (int i = 0; i * period < drive_s; ++i) {
     cv::Mat image = simulation.Render(r);
     cv::Mat grey;
@@ -62,8 +66,11 @@ WatchRun DriveAt(double box_x, double box_leaves_s, double drive_s, std::uint64_
       grey = image;
     }
     const double dt = i > 0 ? period : 0.0;
-    const ObstacleCheck c =
-        watch.Update(grey, FromSeconds(i * period), command.v_mps * dt, command.omega_radps * dt);
+    driven_m += command.v_mps * dt;
+    const double route_left = route_end_x > 0.0 ? std::max(0.0, route_end_x - driven_m) + 0.3
+                                                : std::numeric_limits<double>::infinity();
+    const ObstacleCheck c = watch.Update(grey, FromSeconds(i * period), command.v_mps * dt,
+                                         command.omega_radps * dt, {}, route_left);
     if (c.observed) ++out.observed;
     if (c.observed && out.first_blocked < 0)
       out.max_fraction = std::max(out.max_fraction, c.blocked_fraction);
@@ -108,6 +115,20 @@ TEST(ObstacleWatch, StopsBeforeABoxAndGoesOnWhenItIsGone) {
     ASSERT_GE(run.first_blocked, 0) << "seed " << seed;
     EXPECT_GE(run.clearance_at_block, 0.3) << "seed " << seed;
     EXPECT_GT(run.cleared_frame, 200) << "seed " << seed;  // after the box left (20 s)
+  }
+}
+
+// Issue 42: a route that ends 0.5 m before a box (its face at 2.75 m, the end at 2.25 m). Told
+// how much route is left, the watch does not stop the robot for what stands past the end; not
+// told, it stops for the same box on the same drive.
+TEST(ObstacleWatch, WhatStandsPastTheRoutesEndIsNotInTheWay) {
+  for (std::uint64_t seed : Seeds()) {
+    const double drive_s = 2.25 / 0.2;  // to the route's end
+    const WatchRun limited = DriveAt(3.0, 1000.0, drive_s, seed, {}, 0.0, 0.0, 2.25);
+    EXPECT_EQ(limited.first_blocked, -1) << "seed " << seed;
+    EXPECT_GT(limited.observed, 50) << "seed " << seed;  // it looked on the way
+    const WatchRun unlimited = DriveAt(3.0, 1000.0, drive_s, seed);
+    EXPECT_GE(unlimited.first_blocked, 0) << "seed " << seed;
   }
 }
 
