@@ -20,6 +20,10 @@ double RepeatSession::RouteLeftM() const {
     const auto& b = kfs[static_cast<std::size_t>(k) + 1].odometry;
     if (!a || !b) return std::numeric_limits<double>::infinity();
     left += std::hypot(b->x_m - a->x_m, b->y_m - a->y_m);
+    // Beyond what the watch can see the answer makes no difference: mid-route this stops after a
+    // few keyframes instead of summing the rest of a long route every frame.
+    if (left - driven_since_switch_m_ > options_.obstacle.region_far_m)
+      return std::numeric_limits<double>::infinity();
   }
   return std::max(0.0, left - driven_since_switch_m_) + options_.route_end_margin_m;
 }
