@@ -34,6 +34,7 @@ PACKAGES=(
   libbenchmark-dev       # micro benchmarks
   libzmq3-dev cppzmq-dev # fleet messaging (leader/follower)
   libzstd-dev liblz4-dev zlib1g-dev   # MCAP recordings: zstd and lz4 chunks, CRC-32
+  libwebsocketpp-dev libasio-dev   # the live view (--live): the Foxglove WebSocket protocol
 )
 if [ "$WITH_ROS" = "1" ]; then
   PACKAGES+=(

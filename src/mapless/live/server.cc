@@ -1,0 +1,369 @@
+#include "mapless/live/server.h"
+
+#include <websocketpp/config/asio_no_tls.hpp>
+#include <websocketpp/server.hpp>
+// (websocketpp before the rest: it defines what asio needs standalone)
+
+#include <chrono>
+#include <future>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <thread>
+
+#include "mapless/core/check.h"
+
+namespace mapless::live {
+namespace {
+
+using WsServer = websocketpp::server<websocketpp::config::asio>;
+using Hdl = websocketpp::connection_hdl;
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+struct Client {
+  std::string name;  // "127.0.0.1:50412 (foxglove.sdk.v1)"
+  Subscriptions subscriptions;
+  std::optional<Clock::time_point> full_since;  // its queue over the limit since
+  Clock::time_point window_start = Clock::now();
+  int requests_in_window = 0;
+  std::set<std::string> told;  // the kinds of bad input already logged for it
+  bool cut_off = false;        // its socket is closed; what it sent before is ignored
+};
+
+}  // namespace
+
+Address ParseAddress(const std::string& text) {
+  Address a;
+  std::string port = text;
+  if (!text.empty() && text.front() == '[') {
+    const auto close = text.find("]:");
+    MAPLESS_CHECK(close != std::string::npos, "--live " << text << ": expected [ADDRESS]:PORT");
+    a.host = text.substr(1, close - 1);
+    port = text.substr(close + 2);
+  } else if (const auto colon = text.rfind(':'); colon != std::string::npos) {
+    a.host = text.substr(0, colon);
+    port = text.substr(colon + 1);
+  }
+  if (a.host == "localhost") a.host = "127.0.0.1";
+  MAPLESS_CHECK(!a.host.empty(), "--live " << text << ": an empty address");
+  std::error_code ec;
+  (void)asio::ip::make_address(a.host, ec);
+  MAPLESS_CHECK(!ec, "--live " << text << ": " << a.host << " is not an IP address");
+  MAPLESS_CHECK(!port.empty() && port.size() <= 5 &&
+                    port.find_first_not_of("0123456789") == std::string::npos,
+                "--live " << text << ": the port must be a number from 0 to 65535");
+  a.port = std::stoi(port);
+  MAPLESS_CHECK(a.port <= 65535, "--live " << text << ": the port must be from 0 to 65535");
+  return a;
+}
+
+struct Server::Impl {
+  ServerOptions options;
+  std::vector<Channel> channels;
+  std::vector<std::uint32_t> channel_ids;
+  std::unique_ptr<Feed> feed;  // the server's thread only
+  std::string page;
+  WsServer ws;
+  std::map<Hdl, Client, std::owner_less<Hdl>> clients;  // the server's thread only
+  std::atomic<std::size_t> client_count{0};
+  int port = 0;
+  std::unique_ptr<asio::steady_timer> timer;
+  std::thread thread;
+  Timestamp last_t_ns = 0;
+  int ticks = 0;
+
+  mutable std::mutex mu;  // guards the fields below
+  std::optional<FrameView> pending;
+  bool flush_posted = false;
+  ServerStats stats;
+
+  void Log(const std::string& line) const {
+    if (options.log) options.log("live view: " + line);
+  }
+  // Logs a kind of bad input once per client (a flood gets one line).
+  void Tell(Client& c, const std::string& kind, const std::string& line) const {
+    if (c.told.insert(kind).second) Log(c.name + ": " + line);
+  }
+  void SendText(Hdl h, const std::string& text) {
+    std::error_code ec;
+    ws.send(h, text, websocketpp::frame::opcode::text, ec);
+  }
+  void CutOff(Hdl h, Client& c, const std::string& why) {
+    if (c.cut_off) return;
+    c.cut_off = true;
+    Log(c.name + ": cut off (" + why + ")");
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      ++stats.clients_cut_off;
+    }
+    std::error_code ec;
+    WsServer::connection_ptr con = ws.get_con_from_hdl(h, ec);
+    if (ec) return;
+    con->get_raw_socket().shutdown(asio::ip::tcp::socket::shutdown_both, ec);
+    con->get_raw_socket().close(ec);
+  }
+
+  bool Validate(Hdl h);
+  void Http(Hdl h);
+  void Open(Hdl h);
+  void Closed(Hdl h);
+  void Message(Hdl h, WsServer::message_ptr msg);
+  void Flush();
+  void Tick();
+  void Start();
+};
+
+bool Server::Impl::Validate(Hdl h) {
+  WsServer::connection_ptr con = ws.get_con_from_hdl(h);
+  const std::string who = con->get_remote_endpoint();
+  if (client_count.load() >= options.max_clients) {
+    Log(who + ": refused (" + std::to_string(options.max_clients) + " clients already)");
+    return false;
+  }
+  const std::string chosen = ChooseSubprotocol(con->get_requested_subprotocols());
+  if (chosen.empty()) {
+    Log(who + ": refused (offers neither " + kSubprotocolSdk + " nor " + kSubprotocolV1 + ")");
+    return false;
+  }
+  con->select_subprotocol(chosen);
+  return true;
+}
+
+void Server::Impl::Http(Hdl h) {
+  WsServer::connection_ptr con = ws.get_con_from_hdl(h);
+  const std::string resource = con->get_resource();
+  if (resource == "/" || resource == "/index.html") {
+    con->set_status(websocketpp::http::status_code::ok);
+    con->append_header("Content-Type", "text/html; charset=utf-8");
+    con->append_header("Cache-Control", "no-store");
+    // Self-contained: nothing from elsewhere, and no way to send anything but to this server.
+    con->append_header("Content-Security-Policy",
+                       "default-src 'none'; script-src 'unsafe-inline'; style-src "
+                       "'unsafe-inline'; img-src blob: data:; connect-src ws: wss:");
+    con->set_body(page);
+  } else {
+    con->set_status(websocketpp::http::status_code::not_found);
+    con->append_header("Content-Type", "text/plain");
+    con->set_body("not found: the live view is at /\n");
+  }
+}
+
+void Server::Impl::Open(Hdl h) {
+  WsServer::connection_ptr con = ws.get_con_from_hdl(h);
+  Client c;
+  c.name = con->get_remote_endpoint() + " (" + con->get_subprotocol() + ")";
+  Log(c.name + ": connected");
+  clients.emplace(h, std::move(c));
+  client_count = clients.size();
+  SendText(h, ServerInfoJson(options.name, std::to_string(port)));
+  SendText(h, AdvertiseJson(channels));
+}
+
+void Server::Impl::Closed(Hdl h) {
+  const auto it = clients.find(h);
+  if (it == clients.end()) return;
+  Log(it->second.name + ": disconnected");
+  clients.erase(it);
+  client_count = clients.size();
+}
+
+void Server::Impl::Message(Hdl h, WsServer::message_ptr msg) {
+  const auto it = clients.find(h);
+  if (it == clients.end()) return;
+  Client& c = it->second;
+  if (c.cut_off) return;
+  if (SecondsSince(c.window_start) >= 1.0) {
+    c.window_start = Clock::now();
+    c.requests_in_window = 0;
+  }
+  if (++c.requests_in_window > options.max_requests_per_s) {
+    CutOff(h, c, "more than " + std::to_string(options.max_requests_per_s) + " messages a second");
+    return;
+  }
+  if (msg->get_opcode() != websocketpp::frame::opcode::text) {
+    Tell(c, "binary", "sent a binary message (ignored: the live view takes no data)");
+    SendText(h, StatusJson(2, "binary messages are not accepted: the live view is read-only"));
+    return;
+  }
+  const ClientRequest request = ParseClientMessage(msg->get_payload());
+  if (request.kind == ClientRequest::Kind::kInvalid ||
+      request.kind == ClientRequest::Kind::kUnsupported) {
+    Tell(c, request.error, "sent a message that is ignored: " + request.error);
+    SendText(h, StatusJson(request.kind == ClientRequest::Kind::kInvalid ? 2 : 1, request.error));
+    return;
+  }
+  for (const std::string& refused : c.subscriptions.Apply(request, channel_ids)) {
+    Tell(c, refused.substr(0, refused.find(':')), refused);
+    SendText(h, StatusJson(1, refused));
+  }
+  // Before the first frame, the first frame's messages bring the route.
+  if (request.kind != ClientRequest::Kind::kSubscribe || last_t_ns == 0) return;
+  for (const Outgoing& o : feed->Latched(last_t_ns)) {
+    for (const auto& [sub, channel] : request.subscriptions) {
+      if (channel != o.channel_id) continue;
+      for (const std::uint32_t mine : c.subscriptions.For(channel))
+        if (mine == sub) {
+          std::error_code ec;
+          ws.send(h, MessageDataFrame(sub, static_cast<std::uint64_t>(last_t_ns), o.payload),
+                  websocketpp::frame::opcode::binary, ec);
+        }
+    }
+  }
+}
+
+void Server::Impl::Flush() {
+  std::optional<FrameView> frame;
+  {
+    std::lock_guard<std::mutex> lock(mu);
+    frame.swap(pending);
+    flush_posted = false;
+  }
+  if (!frame) return;
+  std::vector<Outgoing> messages = feed->Messages(*frame);
+  last_t_ns = std::max<Timestamp>(frame->observation.t_ns, 0);
+  std::uint64_t sent = 0, dropped = 0;
+  const std::string time = TimeFrame(static_cast<std::uint64_t>(last_t_ns));
+  for (auto& [h, c] : clients) {
+    std::error_code ec;
+    WsServer::connection_ptr con = ws.get_con_from_hdl(h, ec);
+    if (ec) continue;
+    ws.send(h, time, websocketpp::frame::opcode::binary, ec);
+    for (const Outgoing& o : messages) {
+      for (const std::uint32_t sub : c.subscriptions.For(o.channel_id)) {
+        const std::size_t buffered = con->get_buffered_amount();
+        if ((IsImageChannel(o.channel_id) && buffered > options.max_buffered_bytes) ||
+            buffered > 2 * options.max_buffered_bytes) {
+          ++dropped;
+          continue;
+        }
+        ws.send(h, MessageDataFrame(sub, static_cast<std::uint64_t>(last_t_ns), o.payload),
+                websocketpp::frame::opcode::binary, ec);
+        if (!ec) ++sent;
+      }
+    }
+  }
+  std::lock_guard<std::mutex> lock(mu);
+  ++stats.frames_sent;
+  stats.messages_sent += sent;
+  stats.images_dropped += dropped;
+}
+
+// Twice a second: clients whose queue stays over the limit are cut off; pings (a client that does
+// not answer within the handshake timeout is closed: half-open connections).
+void Server::Impl::Tick() {
+  std::vector<Hdl> stalled;
+  for (auto& [h, c] : clients) {
+    std::error_code ec;
+    WsServer::connection_ptr con = ws.get_con_from_hdl(h, ec);
+    if (ec) continue;
+    if (con->get_buffered_amount() > options.max_buffered_bytes) {
+      if (!c.full_since) c.full_since = Clock::now();
+      if (SecondsSince(*c.full_since) > options.stall_timeout_s) stalled.push_back(h);
+    } else {
+      c.full_since.reset();
+    }
+    if (ticks % 10 == 0) con->ping("", ec);
+  }
+  ++ticks;
+  for (Hdl h : stalled) {
+    const auto it = clients.find(h);
+    if (it != clients.end())
+      CutOff(h, it->second,
+             "it read nothing for " + std::to_string(options.stall_timeout_s) + " s");
+  }
+  timer->expires_after(std::chrono::milliseconds(500));
+  timer->async_wait([this](const std::error_code& ec) {
+    if (!ec) Tick();
+  });
+}
+
+void Server::Impl::Start() {
+  ws.clear_access_channels(websocketpp::log::alevel::all);
+  ws.clear_error_channels(websocketpp::log::elevel::all);
+  ws.init_asio();
+  ws.set_reuse_addr(true);
+  ws.set_max_message_size(options.max_message_bytes);
+  ws.set_max_http_body_size(options.max_message_bytes);
+  const long handshake_ms = static_cast<long>(options.handshake_timeout_s * 1000);
+  ws.set_open_handshake_timeout(handshake_ms);
+  ws.set_close_handshake_timeout(1000);
+  ws.set_pong_timeout(handshake_ms);
+  ws.set_validate_handler([this](Hdl h) { return Validate(h); });
+  ws.set_http_handler([this](Hdl h) { Http(h); });
+  ws.set_open_handler([this](Hdl h) { Open(h); });
+  ws.set_close_handler([this](Hdl h) { Closed(h); });
+  ws.set_fail_handler([this](Hdl h) { Closed(h); });
+  ws.set_message_handler([this](Hdl h, WsServer::message_ptr m) { Message(h, std::move(m)); });
+  ws.set_pong_timeout_handler([this](Hdl h, const std::string&) {
+    const auto it = clients.find(h);
+    if (it != clients.end()) CutOff(h, it->second, "no answer to a ping");
+  });
+  std::error_code ec;
+  const asio::ip::tcp::endpoint endpoint(asio::ip::make_address(options.address.host),
+                                         static_cast<unsigned short>(options.address.port));
+  ws.listen(endpoint, ec);
+  MAPLESS_CHECK(!ec, "--live " << options.address.host << ":" << options.address.port << ": "
+                               << ec.message());
+  ws.start_accept(ec);
+  MAPLESS_CHECK(!ec, "--live: cannot accept connections: " << ec.message());
+  port = ws.get_local_endpoint(ec).port();
+  timer = std::make_unique<asio::steady_timer>(ws.get_io_service());
+  Tick();
+  thread = std::thread([this] { ws.run(); });
+}
+
+Server::Server(std::vector<Channel> channels, std::unique_ptr<Feed> feed, std::string page,
+               ServerOptions options)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->options = std::move(options);
+  impl_->channels = std::move(channels);
+  for (const Channel& c : impl_->channels) impl_->channel_ids.push_back(c.id);
+  impl_->feed = std::move(feed);
+  impl_->page = std::move(page);
+  impl_->Start();
+}
+
+Server::~Server() {
+  Impl* impl = impl_.get();
+  auto done = std::make_shared<std::promise<void>>();
+  asio::post(impl->ws.get_io_service(), [impl, done] {
+    std::error_code ec;
+    impl->ws.stop_listening(ec);
+    impl->timer->cancel();
+    for (auto& [h, c] : impl->clients)
+      impl->ws.close(h, websocketpp::close::status::going_away, "the run ended", ec);
+    done->set_value();
+  });
+  done->get_future().wait_for(std::chrono::seconds(2));
+  // A moment for the close frames to leave; then the thread stops whatever is left.
+  if (impl->client_count.load() > 0) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  impl->ws.stop();
+  if (impl->thread.joinable()) impl->thread.join();
+}
+
+int Server::port() const { return impl_->port; }
+std::size_t Server::clients() const { return impl_->client_count.load(); }
+
+void Server::Offer(FrameView frame) {
+  {
+    std::lock_guard<std::mutex> lock(impl_->mu);
+    ++impl_->stats.frames_offered;
+    impl_->pending = std::move(frame);
+    if (impl_->flush_posted) return;
+    impl_->flush_posted = true;
+  }
+  Impl* impl = impl_.get();
+  asio::post(impl->ws.get_io_service(), [impl] { impl->Flush(); });
+}
+
+ServerStats Server::stats() const {
+  std::lock_guard<std::mutex> lock(impl_->mu);
+  return impl_->stats;
+}
+
+}  // namespace mapless::live

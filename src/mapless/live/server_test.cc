@@ -1,0 +1,374 @@
+// The live view's server on loopback, against websocketpp's client and raw sockets: both
+// subprotocols, every channel, bad input, a stalled client, a half-open connection, the page.
+#include "mapless/live/server.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <thread>
+#include <websocketpp/client.hpp>
+#include <websocketpp/config/asio_no_tls_client.hpp>
+
+#include "mapless/core/check.h"
+#include "mapless/live/live_view.h"
+#include "mapless/rosmsg/messages.h"
+
+namespace mapless::live {
+namespace {
+
+using WsClient = websocketpp::client<websocketpp::config::asio_client>;
+using namespace std::chrono_literals;
+
+// A client on its own thread; what it receives, in order.
+class TestClient {
+ public:
+  TestClient(int port, const std::string& subprotocol) {
+    ws_.clear_access_channels(websocketpp::log::alevel::all);
+    ws_.clear_error_channels(websocketpp::log::elevel::all);
+    ws_.init_asio();
+    ws_.set_open_handler([this](websocketpp::connection_hdl) { Set(&open_); });
+    ws_.set_fail_handler([this](websocketpp::connection_hdl) { Set(&closed_); });
+    ws_.set_close_handler([this](websocketpp::connection_hdl) { Set(&closed_); });
+    ws_.set_message_handler([this](websocketpp::connection_hdl, WsClient::message_ptr m) {
+      std::lock_guard<std::recursive_mutex> lock(mu_);
+      (m->get_opcode() == websocketpp::frame::opcode::text ? texts_ : binaries_)
+          .push_back(m->get_payload());
+      cv_.notify_all();
+    });
+    std::error_code ec;
+    con_ = ws_.get_connection("ws://127.0.0.1:" + std::to_string(port) + "/", ec);
+    if (!subprotocol.empty()) con_->add_subprotocol(subprotocol, ec);
+    ws_.connect(con_);
+    thread_ = std::thread([this] { ws_.run(); });
+  }
+  ~TestClient() {
+    std::error_code ec;
+    if (Opened() && !Closed()) ws_.close(con_, websocketpp::close::status::normal, "", ec);
+    Wait([this] { return closed_; }, 2s);
+    ws_.stop();
+    thread_.join();
+  }
+  bool Wait(const std::function<bool()>& done, std::chrono::milliseconds timeout = 5000ms) {
+    std::unique_lock<std::recursive_mutex> lock(mu_);
+    return cv_.wait_for(lock, timeout, done);
+  }
+  bool Opened() {
+    return Wait([this] { return open_ || closed_; }) && open_;
+  }
+  bool Closed() {
+    std::lock_guard<std::recursive_mutex> lock(mu_);
+    return closed_;
+  }
+  void Send(const std::string& text,
+            websocketpp::frame::opcode::value op = websocketpp::frame::opcode::text) {
+    std::error_code ec;
+    ws_.send(con_, text, op, ec);
+  }
+  std::string subprotocol() { return con_->get_response_header("Sec-WebSocket-Protocol"); }
+  std::vector<std::string> texts() {
+    std::lock_guard<std::recursive_mutex> lock(mu_);
+    return texts_;
+  }
+  std::vector<std::string> binaries() {
+    std::lock_guard<std::recursive_mutex> lock(mu_);
+    return binaries_;
+  }
+  // The text messages with op `op`.
+  std::vector<nlohmann::json> Ops(const std::string& op) {
+    std::vector<nlohmann::json> out;
+    for (const std::string& t : texts()) {
+      auto j = nlohmann::json::parse(t);
+      if (j["op"] == op) out.push_back(j);
+    }
+    return out;
+  }
+  void SubscribeAll() {
+    ASSERT_TRUE(Wait([this] { return texts_.size() >= 2; }));
+    nlohmann::json sub = {{"op", "subscribe"}, {"subscriptions", nlohmann::json::array()}};
+    const std::vector<nlohmann::json> advertised = Ops("advertise");
+    for (const auto& c : advertised.at(0)["channels"])
+      sub["subscriptions"].push_back({{"id", c["id"].get<int>() + 100}, {"channelId", c["id"]}});
+    Send(sub.dump());
+  }
+
+ private:
+  void Set(bool* flag) {
+    std::lock_guard<std::recursive_mutex> lock(mu_);
+    *flag = true;
+    cv_.notify_all();
+  }
+  WsClient ws_;
+  WsClient::connection_ptr con_;
+  std::thread thread_;
+  std::recursive_mutex mu_;  // Wait's predicates read under it
+  std::condition_variable_any cv_;
+  bool open_ = false, closed_ = false;
+  std::vector<std::string> texts_, binaries_;
+};
+
+FrameView AFrame(int i, int width = 320, int height = 240) {
+  FrameView f;
+  f.method = "repeat";
+  f.frame = i;
+  f.observation.image = cv::Mat(height, width, CV_8UC1);
+  cv::randu(f.observation.image, 0, 255);
+  f.observation.t_ns = 2'000'000'000LL + i;
+  f.observation.odometry = Pose2{0.1 * i, 0.0, 0.0};
+  f.decision.state = robot::MethodState::kDriving;
+  f.decision.status = "driving";
+  f.command = {0.2, 0.0};
+  return f;
+}
+
+std::unique_ptr<Server> AServer(ServerOptions options, std::vector<std::string>* log = nullptr,
+                                std::mutex* log_mu = nullptr) {
+  options.address = ParseAddress("127.0.0.1:0");
+  if (log != nullptr)
+    options.log = [log, log_mu](const std::string& line) {
+      std::lock_guard<std::mutex> lock(*log_mu);
+      log->push_back(line);
+    };
+  return std::make_unique<Server>(RunChannels("repeat", true),
+                                  std::make_unique<Feed>(std::vector<Pose2>{{0, 0, 0}, {2, 0, 0}}),
+                                  LivePage(), options);
+}
+
+// Offers frames until `done` or 5 s.
+bool OfferUntil(Server& server, const std::function<bool()>& done, int width = 320,
+                int height = 240) {
+  for (int i = 0; i < 500; ++i) {
+    if (done()) return true;
+    server.Offer(AFrame(i, width, height));
+    std::this_thread::sleep_for(10ms);
+  }
+  return done();
+}
+
+TEST(LiveServer, SpeaksBothSubprotocolsEchoesTheOneOfferedAndAdvertisesEveryChannel) {
+  ServerOptions defaults;
+  auto server = AServer(defaults);
+  for (const char* sub : {kSubprotocolSdk, kSubprotocolV1}) {
+    SCOPED_TRACE(sub);
+    TestClient c(server->port(), sub);
+    ASSERT_TRUE(c.Opened());
+    EXPECT_EQ(c.subprotocol(), sub);
+    ASSERT_TRUE(c.Wait([&] { return c.texts().size() >= 2; }));
+    const auto info = nlohmann::json::parse(c.texts()[0]);
+    EXPECT_EQ(info["op"], "serverInfo");
+    EXPECT_EQ(info["capabilities"], nlohmann::json::array({"time"}));
+    EXPECT_EQ(c.Ops("advertise").at(0)["channels"].size(), RunChannels("repeat", true).size());
+  }
+  TestClient none(server->port(), "");
+  EXPECT_FALSE(none.Opened());
+  TestClient other(server->port(), "chat");
+  EXPECT_FALSE(other.Opened());
+}
+
+TEST(LiveServer, ASubscriberGetsEveryChannelWithTheRunsTimestamps) {
+  ServerOptions defaults;
+  auto server = AServer(defaults);
+  TestClient c(server->port(), kSubprotocolV1);
+  ASSERT_TRUE(c.Opened());
+  c.SubscribeAll();
+  std::set<std::uint32_t> seen;
+  auto all = [&] {
+    seen.clear();
+    for (const std::string& b : c.binaries()) {
+      if (b[0] != 1) continue;
+      std::uint32_t sub = 0;
+      std::memcpy(&sub, b.data() + 1, 4);
+      seen.insert(sub - 100);
+    }
+    return seen.size() == RunChannels("repeat", true).size();
+  };
+  ASSERT_TRUE(OfferUntil(*server, all))
+      << ::testing::PrintToString(seen) << " seen; " << ::testing::PrintToString(c.texts());
+  for (const std::string& b : c.binaries()) {
+    ASSERT_GE(b.size(), 9u);
+    std::uint64_t t = 0;
+    std::memcpy(&t, b.data() + (b[0] == 1 ? 5 : 1), 8);
+    EXPECT_GE(t, 2'000'000'000u);
+    std::uint32_t sub = 0;
+    std::memcpy(&sub, b.data() + 1, 4);
+    if (b[0] == 1 && sub - 100 == kCameraChannel) {
+      const auto img =
+          rosmsg::DecodeCompressedImage(std::string_view(b).substr(13), rosmsg::Wire::kCdr);
+      EXPECT_EQ(img.format, "jpeg");
+      EXPECT_EQ(static_cast<std::uint64_t>(img.header.stamp_ns), t);
+    }
+  }
+  EXPECT_GT(server->stats().messages_sent, 0u);
+}
+
+TEST(LiveServer, BadInputIsAnsweredLoggedOnceAndChangesNothing) {
+  std::vector<std::string> log;
+  std::mutex log_mu;
+  ServerOptions defaults;
+  auto server = AServer(defaults, &log, &log_mu);
+  TestClient bad(server->port(), kSubprotocolSdk);
+  TestClient good(server->port(), kSubprotocolSdk);
+  ASSERT_TRUE(bad.Opened());
+  ASSERT_TRUE(good.Opened());
+  good.SubscribeAll();
+  for (int i = 0; i < 3; ++i) {
+    bad.Send("{not json");
+    bad.Send(R"({"op":"explode"})");
+    bad.Send(R"({"op":"advertise","channels":[]})");
+    bad.Send(R"({"op":"subscribe","subscriptions":[{"id":1,"channelId":999}]})");
+    bad.Send(std::string("\x01\x02\x03", 3), websocketpp::frame::opcode::binary);
+  }
+  ASSERT_TRUE(bad.Wait([&] { return bad.Ops("status").size() >= 15; }));
+  EXPECT_FALSE(bad.Closed());
+  {
+    std::lock_guard<std::mutex> lock(log_mu);
+    int about_bad = 0;
+    for (const std::string& l : log)
+      about_bad +=
+          l.find("ignored") != std::string::npos || l.find("no channel") != std::string::npos;
+    EXPECT_EQ(about_bad, 5) << "each kind of bad input once";
+  }
+  // An oversized frame closes that client (1009), and only it.
+  bad.Send(std::string(200 * 1024, 'x'));
+  EXPECT_TRUE(bad.Wait([&] { return bad.Closed(); }));
+  const std::size_t before = good.binaries().size();
+  EXPECT_TRUE(OfferUntil(*server, [&] { return good.binaries().size() > before + 10; }));
+  EXPECT_FALSE(good.Closed());
+}
+
+TEST(LiveServer, AFloodOfSubscribeMessagesCutsThatClientOff) {
+  ServerOptions options;
+  options.max_requests_per_s = 50;
+  auto server = AServer(options);
+  TestClient flood(server->port(), kSubprotocolV1);
+  ASSERT_TRUE(flood.Opened());
+  for (int i = 0; i < 500; ++i)
+    flood.Send(R"({"op":"subscribe","subscriptions":[{"id":)" + std::to_string(i) +
+               R"(,"channelId":3}]})");
+  EXPECT_TRUE(flood.Wait([&] { return flood.Closed(); }));
+  EXPECT_EQ(server->stats().clients_cut_off, 1u);
+  TestClient after(server->port(), kSubprotocolV1);
+  EXPECT_TRUE(after.Opened());
+}
+
+// A raw TCP client: `request` written, then nothing read.
+struct RawClient {
+  asio::io_context io;
+  asio::ip::tcp::socket socket{io};
+  explicit RawClient(int port) {
+    socket.connect({asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port)});
+  }
+  void Write(const std::string& bytes) { asio::write(socket, asio::buffer(bytes)); }
+  // Reads until the peer closes or `timeout`; what was read.
+  std::string ReadAll(std::chrono::seconds timeout, bool* closed) {
+    std::string out;
+    socket.non_blocking(true);
+    const auto end = std::chrono::steady_clock::now() + timeout;
+    char buf[65536];
+    *closed = false;
+    while (std::chrono::steady_clock::now() < end) {
+      std::error_code ec;
+      const std::size_t n = socket.read_some(asio::buffer(buf), ec);
+      if (ec == asio::error::would_block) {
+        std::this_thread::sleep_for(20ms);
+        continue;
+      }
+      if (ec) {
+        *closed = true;
+        break;
+      }
+      out.append(buf, n);
+    }
+    return out;
+  }
+};
+
+std::string Upgrade(const char* subprotocol) {
+  return std::string("GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\n") +
+         "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n" +
+         "Sec-WebSocket-Version: 13\r\nSec-WebSocket-Protocol: " + subprotocol + "\r\n\r\n";
+}
+
+// A client's text frame (clients mask: RFC 6455), for payloads under 126 bytes.
+std::string MaskedText(const std::string& payload) {
+  std::string f = {'\x81', static_cast<char>(0x80 | payload.size()), 1, 2, 3, 4};
+  for (std::size_t i = 0; i < payload.size(); ++i)
+    f.push_back(payload[i] ^ "\x01\x02\x03\x04"[i % 4]);
+  return f;
+}
+
+TEST(LiveServer, AStalledClientLosesImagesThenIsCutOffAndTheOthersGoOn) {
+  ServerOptions options;
+  options.max_buffered_bytes = 256 * 1024;
+  options.stall_timeout_s = 1.0;
+  auto server = AServer(options);
+  RawClient stalled(server->port());
+  stalled.Write(Upgrade(kSubprotocolV1));
+  std::this_thread::sleep_for(200ms);
+  stalled.Write(MaskedText(R"({"op":"subscribe","subscriptions":[{"id":1,"channelId":1}]})"));
+  stalled.Write(MaskedText(R"({"op":"subscribe","subscriptions":[{"id":2,"channelId":2}]})"));
+  stalled.socket.set_option(asio::socket_base::receive_buffer_size(4096));
+  TestClient reader(server->port(), kSubprotocolV1);
+  ASSERT_TRUE(reader.Opened());
+  reader.SubscribeAll();
+  // Large, incompressible frames, until the stalled client is cut off.
+  EXPECT_TRUE(OfferUntil(
+      *server, [&] { return server->stats().clients_cut_off == 1; }, 640, 480));
+  EXPECT_GT(server->stats().images_dropped, 0u);
+  EXPECT_EQ(server->clients(), 1u);
+  const std::size_t before = reader.binaries().size();
+  EXPECT_TRUE(OfferUntil(*server, [&] { return reader.binaries().size() > before + 10; }));
+  EXPECT_FALSE(reader.Closed());
+}
+
+TEST(LiveServer, AHalfOpenConnectionIsClosed) {
+  ServerOptions options;
+  options.handshake_timeout_s = 0.5;
+  auto server = AServer(options);
+  RawClient silent(server->port());
+  silent.Write("GET / HTTP/1.1\r\nHost: 127.0.0.1\r\n");  // and never the end of the request
+  bool closed = false;
+  silent.ReadAll(5s, &closed);
+  EXPECT_TRUE(closed);
+}
+
+TEST(LiveServer, ServesThePageAndNothingElse) {
+  ServerOptions defaults;
+  auto server = AServer(defaults);
+  {
+    RawClient http(server->port());
+    http.Write("GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n");
+    bool closed = false;
+    const std::string response = http.ReadAll(5s, &closed);
+    EXPECT_NE(response.find("HTTP/1.1 200"), std::string::npos);
+    EXPECT_NE(response.find("<title>mapless live</title>"), std::string::npos);
+    EXPECT_NE(response.find("Content-Security-Policy: default-src 'none'"), std::string::npos);
+    // Self-contained: no address of anywhere else.
+    EXPECT_EQ(LivePage().find("http://"), std::string::npos);
+    EXPECT_EQ(LivePage().find("https://"), std::string::npos);
+  }
+  RawClient http(server->port());
+  http.Write("GET /etc/passwd HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n");
+  bool closed = false;
+  EXPECT_NE(http.ReadAll(5s, &closed).find("HTTP/1.1 404"), std::string::npos);
+}
+
+TEST(LiveServer, RefusesAnAddressInUseWithAClearError) {
+  ServerOptions defaults;
+  auto first = AServer(defaults);
+  ServerOptions options;
+  options.address.port = first->port();
+  try {
+    Server second(RunChannels("repeat", false), std::make_unique<Feed>(std::vector<Pose2>{}), "",
+                  options);
+    FAIL() << "bound a port in use";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(std::to_string(first->port())), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace mapless::live
