@@ -110,6 +110,7 @@ void AddFollowCommand(CLI::App* app) {
       f.motion_noise = a->motion_noise;
       f.on_obstacle = a->on_obstacle;
       f.carry_on_m = a->carry_on_m;
+      f.live = a->record.live;
       RefuseOutputOverInputs(f.log, "--log", {run::SourceInput(f.source), f.robot});
       FollowConnected(f);
       return;
@@ -130,6 +131,8 @@ void AddFollowCommand(CLI::App* app) {
       args.log = a->log;
       args.playback = a->playback;
       args.record = &a->record;
+      args.live = a->record.live;
+      args.route = live::RoutePoses(*route);
       args.size_needed_by = "the route " + a->route + " was taught at";
       args.robot = !a->robot.empty();
       RunOnSource(method, args.robot ? a->robot : a->source, args);
@@ -144,7 +147,8 @@ void AddFollowCommand(CLI::App* app) {
     run::SimRun sim(scenario, run::FollowEpisode(scenario, fleet::RouteKind::kEigenspace, a->seed,
                                                  a->motion_noise, /*live_leader=*/false));
     const auto recorder = OpenRecorder(a->record, recording::CameraInfoOf(scenario.camera.model));
-    const run::RunOutcome outcome = RunOnSim(method, sim, a->log, recorder.get());
+    const auto live = OpenLive(a->record.live, "follow", true, live::RoutePoses(*route));
+    const run::RunOutcome outcome = RunOnSim(method, sim, a->log, recorder.get(), {}, live.get());
     spdlog::info("follow: {} ({} frames); {:.2f} m from the route's end", outcome.loop.reason,
                  outcome.loop.frames, sim.error_at_end_m());
     if (!sim.succeeded(outcome.loop.finished))

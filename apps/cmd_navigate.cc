@@ -146,11 +146,12 @@ void NavigateOnSim(const NavigateArgs& a, bool by_index) {
 
   RefuseOutputOverInputs(a.record.path, "--record", {a.calibration, a.scenario});
   const auto recorder = OpenRecorder(a.record, recording::CameraInfoOf(scenario.camera.model));
+  const auto live = OpenLive(a.record.live, "navigate", true);
   std::unique_ptr<JsonLines> log;
   if (!a.log.empty()) log = std::make_unique<JsonLines>(a.log);
   o.wrap_link = run::LogDecisions(
       "navigate", log ? run::JsonSink([&log](const nlohmann::json& j) { log->Write(j); }) : nullptr,
-      RecordingWrapper(recorder.get(), "navigate"));
+      RecordingWrapper(recorder.get(), "navigate", live.get()));
   StopCleanlyOnInterrupt();
   const eval::PotentialRun run = eval::RunPotential(
       scenario, calibration, o,

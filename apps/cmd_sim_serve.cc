@@ -21,10 +21,6 @@ namespace mapless::app {
 
 namespace {
 
-nlohmann::json PoseJson(const Pose2& p) {
-  return {{"x_m", p.x_m}, {"y_m", p.y_m}, {"theta_deg", RadToDeg(p.theta_rad)}};
-}
-
 struct ServeArgs {
   std::string scenario;
   std::string robot;
@@ -36,6 +32,7 @@ struct ServeArgs {
   std::string summary;
   std::string encoding = "mono8";
   std::string size;
+  live::LiveArgs live;
 };
 
 void Serve(const ServeArgs& a) {
@@ -56,30 +53,19 @@ void Serve(const ServeArgs& a) {
   options.log = [](const std::string& m) { spdlog::info("{}", m); };
   options.encoding = a.encoding;
   options.size = size;
+  const auto live = OpenLive(a.live, "serve", false);
+  options.on_step = live::ServedStep(live.get());
   const robot::ServeSummary s = BuiltinMiddlewares().For(file).serve(sim, r, file, options);
   spdlog::info("sim serve: {} after {} frames, {} commands{}, {:.1f} s simulated{}", s.end,
                s.frames, s.commands,
                s.resent > 0 ? ", " + std::to_string(s.resent) + " frames sent again" : "",
                s.sim_time_s, s.collided ? "; " + s.collision : "");
   if (!a.summary.empty()) {
-    nlohmann::json j;
-    j["scenario"] = scenario.name;
-    j["like"] = a.like;
-    j["seed"] = a.seed;
-    j["middleware"] = file.middleware;
-    j["end"] = s.end;
-    j["frames"] = s.frames;
-    j["commands"] = s.commands;
-    j["resent"] = s.resent;
-    j["sim_time_s"] = s.sim_time_s;
-    j["collided"] = s.collided;
-    if (s.collided) j["collision"] = s.collision;
-    j["final"] = PoseJson(s.final_pose);
-    if (s.have_decided_pose) {
-      j["decided"] = PoseJson(s.decided_pose);
-      j["decided_x_m"] = s.decided_pose.x_m;  // flat, for scripts
-      j["decided_y_m"] = s.decided_pose.y_m;
-    }
+    nlohmann::json j = robot::ServeSummaryJson(s);
+    j.update({{"scenario", scenario.name},
+              {"like", a.like},
+              {"seed", a.seed},
+              {"middleware", file.middleware}});
     io::WriteFileAtomic(a.summary, j.dump(2) + "\n");
   }
   ThrowIfInterrupted();
@@ -113,6 +99,7 @@ void AddSimServeCommand(CLI::App* simcmd) {
   cmd->add_option("--image-noise", a->image_noise, "Grey levels (repeat)")
       ->capture_default_str()
       ->check(FiniteIn(0.0, 100.0));
+  AddLiveOption(cmd, &a->live);
   cmd->add_option("--timeout", a->timeout_s, "Simulated seconds, then the serve ends")
       ->capture_default_str()
       ->check(FiniteIn(1.0, 86400.0));

@@ -19,6 +19,7 @@
 #include "mapless/route/route_store.h"
 #include "mapless/run/decision_log.h"
 #include "mapless/run/link_kinds.h"
+#include "mapless/run/route_info.h"
 #include "mapless/run/sim_episode.h"
 #include "recording_args.h"
 #include "robot_run.h"
@@ -61,6 +62,7 @@ void RepeatOnSim(const RepeatArgs& r, const std::shared_ptr<route::Route>& route
                      std::to_string(route->image_height));
   }
   const auto recorder = OpenRecorder(r.record, recording::CameraInfoOf(scenario.camera.model));
+  const auto live = OpenLive(r.record.live, "repeat", true, live::RoutePoses(*route));
   JsonLines log(r.log);
   StopCleanlyOnInterrupt();
   const run::SimEpisode episode = run::FollowEpisode(scenario, fleet::RouteKind::kFunnel, r.seed,
@@ -76,7 +78,7 @@ void RepeatOnSim(const RepeatArgs& r, const std::shared_ptr<route::Route>& route
   run_options.image_noise_sigma = r.image_noise;
   run_options.wrap_link = run::LogDecisions(
       "repeat", [&log](const nlohmann::json& j) { log.Write(j); },
-      RecordingWrapper(recorder.get(), "repeat"));
+      RecordingWrapper(recorder.get(), "repeat", live.get()));
   const double speed = eval::RepeatSpeedFor(scenario, run_options.max_repeat_speed_mps);
   run_options.repeat.sloped.max_speed_mps = speed;
   run_options.repeat.standard.forward_speed_mps = speed;
@@ -122,6 +124,8 @@ void Repeat(const RepeatArgs& r) {
     args.playback = r.playback;
     args.playback.fps = r.fps;
     args.record = &r.record;
+    args.live = r.record.live;
+    args.route = live::RoutePoses(*route);
     args.size_needed_by = "the route " + r.route + " was taught at";
     args.robot = !r.robot.empty();
     RunOnSource(method, args.robot ? r.robot : r.source, args);
@@ -248,52 +252,8 @@ static void AddRouteCommand(CLI::App* app) {
   info->add_option("ROUTE", i->route, "Route directory")->required();
   info->add_flag("--json", i->json, "Print one JSON object");
   info->callback([i] {
-    if (std::filesystem::exists(std::filesystem::path(i->route) / "appearance.json") &&
-        !std::filesystem::exists(std::filesystem::path(i->route) / "manifest.json")) {
-      // An appearance route (teach --method eigenspace).
-      const route::StoredAppearanceRoute a = route::LoadAppearanceRoute(i->route);
-      nlohmann::json j;
-      j["kind"] = "appearance";
-      j["images"] = a.images.size();
-      j["complete"] = a.complete;
-      j["image_width"] = a.image_width;
-      j["image_height"] = a.image_height;
-      j["low_width"] = a.low_width;
-      j["low_height"] = a.low_height;
-      j["length_m"] = a.images.empty() ? 0.0 : a.images.back().distance_m;
-      if (i->json) {
-        std::cout << j.dump() << "\n";
-      } else {
-        std::printf("%s: appearance route of %zu images (%s), %dx%d camera, %dx%d stored, %.1f m\n",
-                    i->route.c_str(), a.images.size(),
-                    a.complete ? "complete" : "INTERRUPTED teach", a.image_width, a.image_height,
-                    a.low_width, a.low_height, j["length_m"].get<double>());
-      }
-      return;
-    }
-    const route::Route route = route::LoadRoute(i->route);
-    std::size_t keypoints = 0;
-    for (const auto& kf : route.keyframes) keypoints += kf.keypoints.size();
-    nlohmann::json j;
-    j["kind"] = "keyframes";
-    j["keyframes"] = route.keyframes.size();
-    j["complete"] = route.complete;
-    j["detector"] = route.detector;
-    j["image_width"] = route.image_width;
-    j["image_height"] = route.image_height;
-    j["keypoints"] = keypoints;
-    // From the first keyframe to the last: a robot's keyframes carry the ROS clock's time.
-    j["duration_s"] = route.keyframes.empty()
-                          ? 0.0
-                          : ToSeconds(route.keyframes.back().t_ns - route.keyframes.front().t_ns);
-    if (i->json) {
-      std::cout << j.dump() << "\n";
-    } else {
-      std::printf("%s: %zu keyframes (%s), %s features, %dx%d, %.1f s\n", i->route.c_str(),
-                  route.keyframes.size(), route.complete ? "complete" : "INTERRUPTED teach",
-                  route.detector.c_str(), route.image_width, route.image_height,
-                  j["duration_s"].get<double>());
-    }
+    const nlohmann::json j = run::RouteInfo(i->route);
+    std::cout << (i->json ? j.dump() : run::RouteInfoLine(i->route, j)) << "\n";
   });
 }
 

@@ -29,7 +29,9 @@ void AddTeleopCommand(CLI::App* app) {
     run::Keyboard keyboard;
     robot::TeleopMethod method(a->keys, [&keyboard] { return keyboard.Read(); });
     spdlog::info("teleop: {}", robot::TeleopKeysHelp());
-    RunOnSource(method, a->robot, SourceRunArgs{{}, {}, nullptr, {}, /*robot=*/true});
+    SourceRunArgs args;
+    args.robot = true;
+    RunOnSource(method, a->robot, args);
   });
 }
 

@@ -35,6 +35,7 @@ struct LeadArgs {
   std::string robot;
   std::string route;
   std::string bind;
+  live::LiveArgs live;
   std::string method = "funnel";
   std::string detector = "orb";
   std::string curve_key;
@@ -72,6 +73,8 @@ void Lead(const LeadArgs& a) {
   teacher_options.kind = kind;
   teacher_options.detector = a.detector;
   run::Teacher teacher(teacher_options, sink);
+  const auto live = OpenLive(a.live, "teach", false);
+  const run::FrameTap tap = run::LiveTeachTap(live.get(), teacher);
   bool robot_teach_ended = false;
   if (copy.complete()) {
     spdlog::info("lead: {} is a complete route of {} records; serving it", a.route,
@@ -84,14 +87,14 @@ void Lead(const LeadArgs& a) {
     run::TeachOutcome outcome;
     if (scenario) {
       run::Pacer pacer(a.rate);
-      outcome = run::TeachOnSimulator(*scenario, teacher, {}, skip,
+      outcome = run::TeachOnSimulator(*scenario, teacher, tap, skip,
                                       [&pacer](Timestamp t_ns) { pacer.At(t_ns); });
     } else {
       run::LinkRequest request;
       request.warn = [](const std::string& m) { spdlog::warn("{}", m); };
       std::unique_ptr<robot::RobotLink> link = Links().Named("robot").open(a.robot, request);
       spdlog::info("lead: recording; drive the robot, Ctrl-C ends the route");
-      outcome = run::TeachFromLink(*link, teacher);
+      outcome = run::TeachFromLink(*link, teacher, tap);
       // On a robot, Ctrl-C ends the route; a second one ends the leader.
       robot_teach_ended = outcome.interrupted;
     }
@@ -194,8 +197,10 @@ void FollowOnSim(robot::Method& method, const sim::Scenario& scenario,
   double lateral_sq = 0.0;
   int moving = 0;
   int waited = 0;  // frames stopped at the end of the route taught so far
+  const auto live = OpenLive(a.live, method.name(), false);
   const run::RunOutcome outcome = RunOnSim(
-      method, sim, a.log, nullptr, [&](const robot::Observation&, const robot::Decision& decision) {
+      method, sim, a.log, nullptr,
+      [&](const robot::Observation&, const robot::Decision& decision) {
         if (decision.reason.rfind("waiting for the leader", 0) == 0 ||
             decision.status == "waiting_for_leader")
           ++waited;
@@ -205,34 +210,23 @@ void FollowOnSim(robot::Method& method, const sim::Scenario& scenario,
           ++moving;
         }
         return true;
-      });
+      },
+      live.get());
   const robot::LoopResult& result = outcome.loop;
   const bool success = sim.succeeded(result.finished);
   const fleet::ClientStats stats = client.stats();
   spdlog::info("follow: {} ({} frames); {:.2f} m from the route's end; {} records applied",
                result.reason, result.frames, sim.error_at_end_m(), stats.applied);
   if (!a.summary.empty()) {
-    const std::vector<double>& latency = stats.latency_ms;
-    const auto pct = [&](double p) {  // -1: no live records (the route was finished)
-      return latency.empty() ? -1.0 : robot::Percentile(latency, p);
-    };
-    const nlohmann::json j = {{"completed", success},
-                              {"reason", result.reason},
-                              {"collided", sim.collided()},
-                              {"final_error_m", sim.error_at_end_m()},
-                              {"lateral_rms_m", moving > 0 ? std::sqrt(lateral_sq / moving) : 0.0},
-                              {"frames", result.frames},
-                              {"frames_waiting_for_leader", waited},
-                              {"records_received", stats.received},
-                              {"records_applied", stats.applied},
-                              {"duplicates_dropped", stats.duplicates_dropped},
-                              {"ahead_dropped", stats.ahead_dropped},
-                              {"rejected", stats.rejected},
-                              {"subscriptions", stats.subscriptions},
-                              {"copy_records", copy.next_sequence()},
-                              {"latency_samples", latency.size()},
-                              {"latency_median_ms", pct(0.5)},
-                              {"latency_p99_ms", pct(0.99)}};
+    nlohmann::json j = fleet::ClientStatsJson(stats);
+    j.update({{"completed", success},
+              {"reason", result.reason},
+              {"collided", sim.collided()},
+              {"final_error_m", sim.error_at_end_m()},
+              {"lateral_rms_m", moving > 0 ? std::sqrt(lateral_sq / moving) : 0.0},
+              {"frames", result.frames},
+              {"frames_waiting_for_leader", waited},
+              {"copy_records", copy.next_sequence()}});
     io::WriteFileAtomic(a.summary, j.dump(1) + "\n");
   }
   if (!success) throw RunFailed("follow did not succeed: " + result.reason);
@@ -272,6 +266,7 @@ void FollowConnected(const FollowConnectArgs& a) {
   SourceRunArgs args;
   args.log = a.log;
   args.robot = true;
+  args.live = a.live;
   RunOnSource(*method, a.robot, args);
 }
 
@@ -285,6 +280,7 @@ void AddLeadCommand(CLI::App* app) {
   cmd->add_option("--robot", a->robot, "Teach on a robot (a person drives): its robot file");
   cmd->add_option("--route", a->route, "Route directory (new, or an interrupted leader's)")
       ->required();
+  AddLiveOption(cmd, &a->live);
   cmd->add_option("--bind", a->bind,
                   "Endpoint to serve on: tcp://ADDRESS:PORT (tcp://*:5600 for all interfaces), "
                   "ipc://PATH")

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "mapless/live/live_view.h"
+
 namespace mapless::app {
 
 struct FollowConnectArgs {
@@ -23,6 +25,7 @@ struct FollowConnectArgs {
   double motion_noise = 0.1;
   std::string on_obstacle;  // the obstacle watch: stop, off, or empty (the robot file's, else stop)
   double carry_on_m = 6.0;  // carrying on where the route no longer matches (0: off)
+  live::LiveArgs live;      // --live
 };
 void FollowConnected(const FollowConnectArgs& a);
 

@@ -25,6 +25,19 @@ void AddRecordOptions(CLI::App* cmd, RecordArgs* args) {
                   "With --record: the camera's intrinsics (ROS camera_info YAML, as "
                   "camera_calibration writes it), recorded as sensor_msgs/CameraInfo with every "
                   "frame");
+  AddLiveOption(cmd, &args->live);
+}
+
+void AddLiveOption(CLI::App* cmd, live::LiveArgs* args) {
+  cmd->add_option("--live-rate", args->rate,
+                  "The simulator, while someone watches --live: simulated seconds per second "
+                  "(0: as fast as it runs)")
+      ->capture_default_str()
+      ->check(ZeroOrIn(0.01, 1000.0));
+  cmd->add_option("--live", args->address,
+                  "Watch the run live: [ADDRESS:]PORT (address 127.0.0.1 unless given) serves "
+                  "the Foxglove WebSocket protocol (Foxglove, Lichtblick) and a page at "
+                  "http://ADDRESS:PORT/ (docs/live_view.md)");
 }
 
 void AddPlaybackOptions(CLI::App* cmd, recording::PlaybackOptions* options, bool with_rate) {
@@ -67,11 +80,20 @@ std::unique_ptr<recording::RunRecorder> OpenRecorder(
   return recorder;
 }
 
-robot::LinkWrapper RecordingWrapper(recording::RunRecorder* recorder, const char* method) {
-  if (!recorder) return {};
-  return [recorder, method](robot::RobotLink& inner) -> std::unique_ptr<robot::RobotLink> {
-    return std::make_unique<recording::RecordingLink>(inner, *recorder, method);
-  };
+std::unique_ptr<live::LiveView> OpenLive(const live::LiveArgs& args, const char* method,
+                                         bool simulated, std::vector<Pose2> route) {
+  return live::OpenLiveView(args, method, std::move(route), simulated,
+                            [](const std::string& line) { spdlog::info("{}", line); });
+}
+
+robot::LinkWrapper RecordingWrapper(recording::RunRecorder* recorder, const char* method,
+                                    live::LiveView* live) {
+  robot::LinkWrapper record;
+  if (recorder)
+    record = [recorder, method](robot::RobotLink& inner) -> std::unique_ptr<robot::RobotLink> {
+      return std::make_unique<recording::RecordingLink>(inner, *recorder, method);
+    };
+  return live::LiveWrapper(live, record);
 }
 
 }  // namespace mapless::app

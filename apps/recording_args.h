@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "mapless/live/live_view.h"
 #include "mapless/recording/playback.h"
 #include "mapless/recording/run_recorder.h"
 #include "mapless/robot/link.h"
@@ -18,10 +19,11 @@ struct RecordArgs {
   std::string images = "raw";
   std::string compression = "zstd";
   std::string camera_info;  // ROS camera_info YAML: the intrinsics recorded with every frame
+  live::LiveArgs live;      // --live [ADDRESS:]PORT, --live-rate: the live view
 };
 
 // --record FILE, --record-images raw|png|jpeg, --record-compression zstd|lz4|none,
-// --camera-info FILE.yaml.
+// --camera-info FILE.yaml, --live [ADDRESS:]PORT.
 void AddRecordOptions(CLI::App* cmd, RecordArgs* args);
 
 // --topic, --odom-topic, --start, --loop, and --rate unless `with_rate` is false (a command whose
@@ -34,7 +36,18 @@ void AddPlaybackOptions(CLI::App* cmd, recording::PlaybackOptions* options, bool
 std::unique_ptr<recording::RunRecorder> OpenRecorder(
     const RecordArgs& args, std::optional<rosmsg::CameraInfoFields> camera_info = std::nullopt);
 
-// A link wrapper that records through `recorder` (empty when it is nullptr).
-robot::LinkWrapper RecordingWrapper(recording::RunRecorder* recorder, const char* method);
+// --live [ADDRESS:]PORT and --live-rate (AddRecordOptions has them too).
+void AddLiveOption(CLI::App* cmd, live::LiveArgs* args);
+
+// The live view --live ADDRESS asks for (nullptr without it), serving before the run starts;
+// `route`: the taught route's poses in its odometry frame, drawn under the robot.
+// `simulated`: a run on the simulator (paced while watched).
+std::unique_ptr<live::LiveView> OpenLive(const live::LiveArgs& args, const char* method,
+                                         bool simulated, std::vector<Pose2> route = {});
+
+// A link wrapper that records through `recorder` and shows the run in `live` (each when not
+// nullptr).
+robot::LinkWrapper RecordingWrapper(recording::RunRecorder* recorder, const char* method,
+                                    live::LiveView* live = nullptr);
 
 }  // namespace mapless::app

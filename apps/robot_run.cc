@@ -67,6 +67,7 @@ void RunOnRobot(robot::Method& method, const std::string& path, const SourceRunA
   std::unique_ptr<JsonLines> log;
   if (!args.log.empty()) log = std::make_unique<JsonLines>(args.log);
   const auto recorder = args.record ? OpenRecorder(*args.record) : nullptr;
+  const auto live = OpenLive(args.live, method.name(), false, args.route);
   StopCleanlyOnInterrupt();
   run::LinkRequest request;
   request.method = method.name();
@@ -84,6 +85,7 @@ void RunOnRobot(robot::Method& method, const std::string& path, const SourceRunA
   };
   options.say = [&status](const std::string& line) { status.Clear(), Say(line); };
   options.recorder = recorder.get();
+  options.live = live.get();
   const run::RunOutcome outcome = run::RunMethod(method, *link, options);
   link.reset();  // zero velocity published, then off the graph
   status.Clear();
@@ -106,11 +108,13 @@ void RunOnRecording(robot::Method& method, const std::string& source, const Sour
   request.size_needed_by = args.size_needed_by;
   request.playback = args.playback;
   std::unique_ptr<robot::RobotLink> link = Links().Open(source, request);
+  const auto live = OpenLive(args.live, method.name(), false, args.route);
   JsonLines log(args.log);
   StopCleanlyOnInterrupt();
   run::StatusLine status(!args.log.empty() && args.log != "-");  // not between JSON lines
   run::RunOptions options;
   options.log = [&log, &status](const nlohmann::json& j) { log.Write(j), status.Show(j); };
+  options.live = live.get();
   const run::RunOutcome outcome = run::RunMethod(method, *link, options);
   status.Clear();
   ThrowIfInterrupted();
@@ -138,7 +142,8 @@ void RunOnSource(robot::Method& method, const std::string& source, const SourceR
 }
 
 run::RunOutcome RunOnSim(robot::Method& method, run::SimRun& sim, const std::string& log_path,
-                         recording::RunRecorder* recorder, const robot::LoopObserver& observer) {
+                         recording::RunRecorder* recorder, const robot::LoopObserver& observer,
+                         live::LiveView* live) {
   std::unique_ptr<JsonLines> log;
   if (!log_path.empty()) log = std::make_unique<JsonLines>(log_path);
   StopCleanlyOnInterrupt();
@@ -147,6 +152,7 @@ run::RunOutcome RunOnSim(robot::Method& method, run::SimRun& sim, const std::str
   options.more_fields = [&sim](nlohmann::json* j) { sim.AddTruth(j); };
   options.observer = observer;
   options.recorder = recorder;
+  options.live = live;
   const run::RunOutcome outcome = run::RunMethod(method, sim.link(), options);
   ThrowIfInterrupted();
   return outcome;

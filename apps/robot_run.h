@@ -30,6 +30,8 @@ struct SourceRunArgs {
   std::string log;
   recording::PlaybackOptions playback;  // a recording, video, folder or camera
   const RecordArgs* record = nullptr;   // --record: a robot's run is recorded
+  live::LiveArgs live;                  // --live: the run shown live
+  std::vector<Pose2> route;             // the taught route in its odometry frame, for the live view
   std::string size_needed_by;  // "the route R was taught at": a recording's frames must match
   bool robot = false;          // the source is a robot file (--robot), whatever its name
 };
@@ -42,10 +44,10 @@ struct SourceRunArgs {
 void RunOnSource(robot::Method& method, const std::string& source, const SourceRunArgs& args);
 
 // Runs `method` on the simulator (run/sim_episode.h), decisions with the true pose to `log`
-// ("": none, "-": stdout), recorded with `record`; `observer` sees every decision.
+// ("": none, "-": stdout), recorded with `record`, shown in `live`; `observer` sees every decision.
 run::RunOutcome RunOnSim(robot::Method& method, run::SimRun& sim, const std::string& log,
-                         recording::RunRecorder* recorder,
-                         const robot::LoopObserver& observer = {});
+                         recording::RunRecorder* recorder, const robot::LoopObserver& observer = {},
+                         live::LiveView* live = nullptr);
 
 // The obstacle watch of `repeat` and `follow`: the method's `defaults` with the robot file's
 // section `obstacles` when a robot file is given (its baseline_m only when the file has one: the

@@ -82,12 +82,15 @@ void Teach(const TeachArgs& t) {
   teacher_options.never_odometry =
       !robot && !scenario && !live && !recording::IsRecording(t.source) && t.playback.poses.empty();
   run::Teacher teacher(teacher_options, store);
-  const run::FrameTap tap = [&](const robot::Observation& f, const std::optional<Pose2>& truth) {
-    if (!recorder) return;
-    if (!f.image.empty()) recorder->Image(f.t_ns, f.image);
-    if (f.odometry) recorder->Odometry(f.t_ns, *f.odometry);
-    if (truth) recorder->GroundTruth(f.t_ns, *truth);
-  };
+  const auto live_view = OpenLive(t.record.live, "teach", scenario.has_value());
+  const run::FrameTap tap =
+      run::LiveTeachTap(live_view.get(), teacher,
+                        [&](const robot::Observation& f, const std::optional<Pose2>& truth) {
+                          if (!recorder) return;
+                          if (!f.image.empty()) recorder->Image(f.t_ns, f.image);
+                          if (f.odometry) recorder->Odometry(f.t_ns, *f.odometry);
+                          if (truth) recorder->GroundTruth(f.t_ns, *truth);
+                        });
   run::TeachOutcome outcome;
   try {
     if (scenario) {

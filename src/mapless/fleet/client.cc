@@ -1,5 +1,6 @@
 #include "mapless/fleet/client.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -377,6 +378,24 @@ bool FollowerClient::Verified() const {
 std::string FollowerClient::Refusal() const {
   std::lock_guard<std::mutex> lock(impl_->stats_mutex);
   return impl_->refusal;
+}
+
+nlohmann::json ClientStatsJson(const ClientStats& stats) {
+  std::vector<double> latency = stats.latency_ms;
+  std::sort(latency.begin(), latency.end());
+  const auto pct = [&](double p) {
+    if (latency.empty()) return -1.0;
+    return latency[static_cast<std::size_t>(p * static_cast<double>(latency.size() - 1) + 0.5)];
+  };
+  return {{"records_received", stats.received},
+          {"records_applied", stats.applied},
+          {"duplicates_dropped", stats.duplicates_dropped},
+          {"ahead_dropped", stats.ahead_dropped},
+          {"rejected", stats.rejected},
+          {"subscriptions", stats.subscriptions},
+          {"latency_samples", latency.size()},
+          {"latency_median_ms", pct(0.5)},
+          {"latency_p99_ms", pct(0.99)}};
 }
 
 ClientStats FollowerClient::stats() const {

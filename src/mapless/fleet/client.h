@@ -15,6 +15,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,11 @@ struct ClientStats {
   std::string link_state;          // what the connection is doing ("no connection to ...")
   std::vector<double> latency_ms;  // live records: leader's write to this receive
 };
+
+// The counts of a follower's link for its summary (`follow --connect --summary`): records_received,
+// records_applied, duplicates_dropped, ahead_dropped, rejected, subscriptions, latency_samples,
+// latency_median_ms and latency_p99_ms (-1 without live records: the route was finished).
+nlohmann::json ClientStatsJson(const ClientStats& stats);
 
 class FollowerClient {
  public:

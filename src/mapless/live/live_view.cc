@@ -1,5 +1,7 @@
 #include "mapless/live/live_view.h"
 
+#include <thread>
+
 namespace mapless::live {
 namespace {
 
@@ -29,7 +31,8 @@ class LiveLink : public robot::RobotLink {
 
 }  // namespace
 
-LiveView::LiveView(std::string method, LiveViewOptions options) : method_(std::move(method)) {
+LiveView::LiveView(std::string method, LiveViewOptions options)
+    : method_(std::move(method)), pace_rate_(options.pace_rate) {
   options.server.address = options.address;
   host_ = options.address.host;
   const bool has_route = !options.route.empty();
@@ -52,6 +55,25 @@ void LiveView::Frame(const robot::Observation& observation, const robot::Decisio
   f.truth = truth;
   last_stop_.clear();
   server_->Offer(std::move(f));
+  Pace(observation.t_ns);
+}
+
+void LiveView::Pace(Timestamp t_ns) {
+  using Clock = std::chrono::steady_clock;
+  if (pace_rate_ <= 0.0 || server_->clients() == 0) {
+    pace_origin_.reset();
+    return;
+  }
+  const Clock::time_point now = Clock::now();
+  if (!pace_origin_) pace_origin_.emplace(t_ns, now);
+  const auto due = pace_origin_->second +
+                   std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+                       ToSeconds(t_ns - pace_origin_->first) / pace_rate_));
+  if (due > now + std::chrono::seconds(1) || now > due + std::chrono::seconds(1)) {
+    pace_origin_.emplace(t_ns, now);  // a jump in the clock or a slow stretch: start again here
+  } else if (due > now) {
+    std::this_thread::sleep_until(due);
+  }
 }
 
 void LiveView::Stopped(Timestamp t_ns, const std::string& reason) {
@@ -68,6 +90,49 @@ void LiveView::Stopped(Timestamp t_ns, const std::string& reason) {
 std::string LiveView::url() const {
   const bool v6 = host_.find(':') != std::string::npos;
   return "http://" + (v6 ? "[" + host_ + "]" : host_) + ":" + std::to_string(port()) + "/";
+}
+
+std::function<void(const robot::Observation&, const Twist2&, const Pose2&)> ServedStep(
+    LiveView* view) {
+  if (view == nullptr) return {};
+  return [view](const robot::Observation& f, const Twist2& command, const Pose2& truth) {
+    robot::Decision d;
+    const bool moving = command.v_mps != 0.0 || command.omega_radps != 0.0;
+    d.state = moving ? robot::MethodState::kDriving : robot::MethodState::kStopped;
+    d.status = "served";
+    d.command = command;
+    view->Frame(f, d, command, truth);
+  };
+}
+
+std::unique_ptr<LiveView> OpenLiveView(const LiveArgs& args, const char* method,
+                                       std::vector<Pose2> route, bool simulated,
+                                       const std::function<void(const std::string&)>& say) {
+  if (args.address.empty()) return nullptr;
+  LiveViewOptions options;
+  options.address = ParseAddress(args.address);
+  options.pace_rate = simulated ? args.rate : 0.0;
+  options.route = std::move(route);
+  options.server.log = say;
+  auto view = std::make_unique<LiveView>(method, std::move(options));
+  say("live view: " + view->url() +
+      " in a browser; in Foxglove or Lichtblick open a Foxglove "
+      "WebSocket connection to ws://" +
+      view->url().substr(7));
+  return view;
+}
+
+std::vector<Pose2> RoutePoses(const route::Route& route) {
+  std::vector<Pose2> poses;
+  for (const route::Keyframe& k : route.keyframes)
+    if (k.odometry) poses.push_back(*k.odometry);
+  return poses;
+}
+
+std::vector<Pose2> RoutePoses(const route::AppearanceRoute& route) {
+  std::vector<Pose2> poses;
+  for (const auto& image : route.images) poses.push_back(image->odometry);
+  return poses;
 }
 
 robot::LinkWrapper LiveWrapper(LiveView* view, robot::LinkWrapper then) {

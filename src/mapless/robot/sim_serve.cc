@@ -97,6 +97,29 @@ Timestamp SimTransport::DecidedAt() {
   return decided_ns_;
 }
 
+namespace {
+nlohmann::json PoseJson(const Pose2& p) {
+  return {{"x_m", p.x_m}, {"y_m", p.y_m}, {"theta_deg", RadToDeg(p.theta_rad)}};
+}
+}  // namespace
+
+nlohmann::json ServeSummaryJson(const ServeSummary& s) {
+  nlohmann::json j = {{"end", s.end},
+                      {"frames", s.frames},
+                      {"commands", s.commands},
+                      {"resent", s.resent},
+                      {"sim_time_s", s.sim_time_s},
+                      {"collided", s.collided},
+                      {"final", PoseJson(s.final_pose)}};
+  if (s.collided) j["collision"] = s.collision;
+  if (s.have_decided_pose) {
+    j["decided"] = PoseJson(s.decided_pose);
+    j["decided_x_m"] = s.decided_pose.x_m;
+    j["decided_y_m"] = s.decided_pose.y_m;
+  }
+  return j;
+}
+
 ServeSummary ServeSimulation(sim::Simulation& sim, int robot, const RobotFile& file,
                              const ServeOptions& options, SimTransport& transport) {
   const auto log = [&](const std::string& m) {
@@ -140,7 +163,8 @@ ServeSummary ServeSimulation(sim::Simulation& sim, int robot, const RobotFile& f
       // Stamped with the simulated time: it is the ROS clock there, via /clock.
       const Timestamp stamp = sim.now_ns();
       const Pose2 odometry = sim.robot(robot).odometry();
-      const CameraMessage image = EncodeCamera(sim.Render(robot), options.encoding, options.size);
+      const cv::Mat grey = sim.Render(robot);
+      const CameraMessage image = EncodeCamera(grey, options.encoding, options.size);
       transport.Publish(stamp, true, odometry, image);
       ++summary.frames;
       Twist2 command;
@@ -154,6 +178,7 @@ ServeSummary ServeSimulation(sim::Simulation& sim, int robot, const RobotFile& f
         ++summary.resent;
       }
       ++summary.commands;
+      if (options.on_step) options.on_step({grey, stamp, odometry}, command, truth);
       step(command);
       if (ToSeconds(sim.now_ns()) > options.timeout_s) return finish("timeout");
     }
@@ -166,8 +191,9 @@ ServeSummary ServeSimulation(sim::Simulation& sim, int robot, const RobotFile& f
     const Pose2 truth = sim.robot(robot).pose();
     truth_at[sim.now_ns()] = truth;
     summary.path.push_back(truth);
-    transport.Publish(transport.now_ns(), false, sim.robot(robot).odometry(),
-                      EncodeCamera(sim.Render(robot), options.encoding, options.size));
+    const Observation served{sim.Render(robot), transport.now_ns(), sim.robot(robot).odometry()};
+    transport.Publish(served.t_ns, false, *served.odometry,
+                      EncodeCamera(served.image, options.encoding, options.size));
     ++summary.frames;
     next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(
         std::chrono::duration<double>(options.period_s));
@@ -175,7 +201,9 @@ ServeSummary ServeSimulation(sim::Simulation& sim, int robot, const RobotFile& f
     double age = 0.0;
     const Twist2 command = transport.Latest(&age);
     summary.commands = transport.commands();
-    step(age <= options.command_timeout_s ? command : Twist2{});
+    const Twist2 obeyed = age <= options.command_timeout_s ? command : Twist2{};
+    if (options.on_step) options.on_step(served, obeyed, truth);
+    step(obeyed);
     if (ToSeconds(sim.now_ns()) > options.timeout_s) return finish("timeout");
   }
 }

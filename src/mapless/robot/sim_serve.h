@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <functional>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -87,6 +88,8 @@ struct ServeOptions {
   cv::Size size;                   // publish at this size (0x0: the simulated camera's)
   std::function<bool()> interrupted;
   std::function<void(const std::string&)> log;
+  // Each frame served, with the command it was answered with and the true pose (the live view).
+  std::function<void(const Observation&, const Twist2&, const Pose2&)> on_step;
 };
 
 struct ServeSummary {
@@ -103,6 +106,11 @@ struct ServeSummary {
   Pose2 final_pose;
   std::vector<Pose2> path;  // ground truth per frame published
 };
+
+// The summary as `sim serve --summary` writes it: end, frames, commands, resent, sim_time_s,
+// collided (and collision), the final pose and the decided one ({x_m, y_m, theta_deg}; the
+// decided one also flat as decided_x_m, decided_y_m, for scripts).
+nlohmann::json ServeSummaryJson(const ServeSummary& s);
 
 ServeSummary ServeSimulation(sim::Simulation& sim, int robot, const RobotFile& file,
                              const ServeOptions& options, SimTransport& transport);

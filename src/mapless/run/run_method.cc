@@ -13,7 +13,10 @@ RunOutcome RunMethod(robot::Method& method, robot::RobotLink& link, const RunOpt
   std::unique_ptr<robot::RobotLink> recording;
   if (options.recorder)
     recording = std::make_unique<recording::RecordingLink>(link, *options.recorder, method.name());
-  robot::RobotLink& used = recording ? *recording : link;
+  robot::RobotLink& recorded = recording ? *recording : link;
+  const std::unique_ptr<robot::RobotLink> shown =
+      options.live ? live::LiveWrapper(options.live)(recorded) : nullptr;
+  robot::RobotLink& used = shown ? *shown : recorded;
   const std::function<bool()> interrupted =
       options.interrupted ? options.interrupted : [] { return InterruptRequested(); };
   RunOutcome outcome;

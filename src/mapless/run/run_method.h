@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "mapless/live/live_view.h"
 #include "mapless/recording/run_recorder.h"
 #include "mapless/robot/link.h"
 #include "mapless/robot/loop.h"
@@ -29,6 +30,8 @@ struct RunOptions {
   robot::LoopObserver observer;
   // The run is recorded into this recorder (recording/recording_link.h); null: not recorded.
   recording::RunRecorder* recorder = nullptr;
+  // The run is shown live (live/live_view.h: --live); null: not shown.
+  live::LiveView* live = nullptr;
   // Checked at every frame and while waiting; by default the process-wide interrupt
   // (core/interrupt.h: Ctrl-C, SIGTERM).
   std::function<bool()> interrupted;

@@ -1,9 +1,13 @@
 #include "mapless/run/teach.h"
 
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+
 #include "mapless/core/check.h"
 #include "mapless/core/interrupt.h"
 #include "mapless/features/features.h"
 #include "mapless/recording/playback.h"
+#include "mapless/robot/status.h"
 #include "mapless/route/route_store.h"
 
 namespace mapless::run {
@@ -120,6 +124,36 @@ void Teacher::Finish() {
 }
 
 // ---- the teach loop ----------------------------------------------------------------------------
+
+namespace {
+
+// What the live view shows of a teach frame: the route made so far.
+class TeachDetail : public robot::DecisionDetail {
+ public:
+  TeachDetail(int stored, const char* unit) : stored_(stored), unit_(unit) {}
+  void Fields(nlohmann::json* j) const override { (*j)["stored"] = stored_; }
+  void Draw(cv::Mat*, double, std::vector<std::string>* lines) const override {
+    lines->push_back(std::to_string(stored_) + " " + unit_ + " so far");
+  }
+
+ private:
+  int stored_;
+  const char* unit_;
+};
+
+}  // namespace
+
+FrameTap LiveTeachTap(live::LiveView* view, const Teacher& teacher, FrameTap then) {
+  if (view == nullptr) return then;
+  return [view, &teacher, then](const robot::Observation& f, const std::optional<Pose2>& truth) {
+    robot::Decision d;
+    d.state = robot::MethodState::kDriving;  // a person drives; the teach records
+    d.status = "teaching";
+    d.detail = std::make_shared<TeachDetail>(teacher.stored(), teacher.unit());
+    view->Frame(f, d, Twist2{}, truth);
+    if (then) then(f, truth);
+  };
+}
 
 TeachOutcome TeachFromLink(robot::RobotLink& link, Teacher& teacher, const FrameTap& tap,
                            const std::function<bool()>& interrupted) {

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "mapless/fleet/route_log.h"
+#include "mapless/live/live_view.h"
 #include "mapless/navigation/appearance.h"
 #include "mapless/navigation/teach.h"
 #include "mapless/robot/link.h"
@@ -111,6 +112,10 @@ class Teacher {
 // One frame as the teach loop hands it on (to be recorded, say) before the teacher has it.
 using FrameTap =
     std::function<void(const robot::Observation& frame, const std::optional<Pose2>& truth)>;
+
+// A tap that shows each frame of a teach in the live view (live/live_view.h: `--live`), with how
+// much route the teacher has made so far, then hands the frame to `then`. `view` null: `then`.
+FrameTap LiveTeachTap(live::LiveView* view, const Teacher& teacher, FrameTap then = {});
 
 struct TeachOutcome {
   int frames = 0;

@@ -1,0 +1,58 @@
+#include "mapless/run/route_info.h"
+
+#include <filesystem>
+
+#include "mapless/route/appearance_store.h"
+#include "mapless/route/route_store.h"
+#include "mapless/run/text.h"
+
+namespace mapless::run {
+
+nlohmann::json RouteInfo(const std::string& dir) {
+  const std::filesystem::path path(dir);
+  nlohmann::json j;
+  if (std::filesystem::exists(path / "appearance.json") &&
+      !std::filesystem::exists(path / "manifest.json")) {
+    const route::StoredAppearanceRoute a = route::LoadAppearanceRoute(dir);
+    j = {{"kind", "appearance"},
+         {"images", a.images.size()},
+         {"complete", a.complete},
+         {"image_width", a.image_width},
+         {"image_height", a.image_height},
+         {"low_width", a.low_width},
+         {"low_height", a.low_height},
+         {"length_m", a.images.empty() ? 0.0 : a.images.back().distance_m}};
+    return j;
+  }
+  const route::Route route = route::LoadRoute(dir);
+  std::size_t keypoints = 0;
+  for (const auto& kf : route.keyframes) keypoints += kf.keypoints.size();
+  j = {{"kind", "keyframes"},
+       {"keyframes", route.keyframes.size()},
+       {"complete", route.complete},
+       {"detector", route.detector},
+       {"image_width", route.image_width},
+       {"image_height", route.image_height},
+       {"keypoints", keypoints}};
+  // From the first keyframe to the last: a robot's keyframes carry the ROS clock's time.
+  j["duration_s"] = route.keyframes.empty()
+                        ? 0.0
+                        : ToSeconds(route.keyframes.back().t_ns - route.keyframes.front().t_ns);
+  return j;
+}
+
+std::string RouteInfoLine(const std::string& dir, const nlohmann::json& j) {
+  const char* state = j["complete"].get<bool>() ? "complete" : "INTERRUPTED teach";
+  if (j["kind"] == "appearance") {
+    return Format("%s: appearance route of %zu images (%s), %dx%d camera, %dx%d stored, %.1f m",
+                  dir.c_str(), j["images"].get<std::size_t>(), state, j["image_width"].get<int>(),
+                  j["image_height"].get<int>(), j["low_width"].get<int>(),
+                  j["low_height"].get<int>(), j["length_m"].get<double>());
+  }
+  return Format("%s: %zu keyframes (%s), %s features, %dx%d, %.1f s", dir.c_str(),
+                j["keyframes"].get<std::size_t>(), state, j["detector"].get<std::string>().c_str(),
+                j["image_width"].get<int>(), j["image_height"].get<int>(),
+                j["duration_s"].get<double>());
+}
+
+}  // namespace mapless::run
