@@ -14,6 +14,8 @@
 #include "mapless/io/frame_source.h"
 #include "mapless/io/image_file.h"
 #include "mapless/io/tum.h"
+#include "mapless/live/feed.h"
+#include "mapless/live/protocol.h"
 #include "mapless/navigation/potential.h"
 #include "mapless/recording/bag_check.h"
 #include "mapless/recording/camera_info_yaml.h"
@@ -380,6 +382,32 @@ void RosBag(const std::string& input) {
   AcceptInputError([&] { PlayFrames(recording::OpenBagSource(path.string(), "", "")); });
 }
 
+void LiveClientMessage(const std::string& input) {
+  static const std::vector<std::uint32_t> channels = [] {
+    std::vector<std::uint32_t> ids;
+    for (const live::Channel& c : live::RunChannels("follow", true)) ids.push_back(c.id);
+    return ids;
+  }();
+  live::Subscriptions subscriptions(16);
+  // The input as up to 8 messages of one client (split at "\xffNXT").
+  std::size_t start = 0;
+  for (int i = 0; i < 8 && start <= input.size(); ++i) {
+    const std::size_t end = std::min(input.find("\xffNXT", start), input.size());
+    const live::ClientRequest r = live::ParseClientMessage(std::string_view(input).substr(start, end - start));
+    if ((r.kind == live::ClientRequest::Kind::kInvalid ||
+         r.kind == live::ClientRequest::Kind::kUnsupported) &&
+        r.error.empty())
+      std::abort();  // every refusal says why
+    for (const std::string& refused : subscriptions.Apply(r, channels))
+      (void)live::StatusJson(1, refused);
+    (void)live::StatusJson(2, r.error);
+    if (subscriptions.size() > 16) std::abort();
+    for (const std::uint32_t id : channels)
+      if (subscriptions.For(id).size() > 1) std::abort();  // a channel is subscribed once
+    start = end + 4;
+  }
+}
+
 const std::vector<NamedHarness>& Harnesses() {
   static const std::vector<NamedHarness> harnesses = {{"route_manifest", RouteManifest},
                                                       {"route_keyframe", RouteKeyframe},
@@ -399,7 +427,8 @@ const std::vector<NamedHarness>& Harnesses() {
                                                       {"ros2_message", Ros2Message},
                                                       {"mcap", McapFile},
                                                       {"rosbag", RosBag},
-                                                      {"camera_info", CameraInfo}};
+                                                      {"camera_info", CameraInfo},
+                                                      {"live_client", LiveClientMessage}};
   return harnesses;
 }
 

@@ -70,6 +70,11 @@ void McapFile(const std::string& input);
 // a camera source (nothing when mapless was built without ROS 1 bags).
 void RosBag(const std::string& input);
 
+// A text message from a live view client (live/protocol.h: issue 43), parsed as the server parses
+// it, applied to a client's subscriptions of the run's channels, and answered (a status message
+// for what was refused): never an exception, the subscriptions within their bound.
+void LiveClientMessage(const std::string& input);
+
 const std::vector<NamedHarness>& Harnesses();
 
 }  // namespace mapless::fuzz

@@ -76,6 +76,9 @@ struct Server::Impl {
   std::thread thread;
   Timestamp last_t_ns = 0;
   int ticks = 0;
+  // Tells a client that reconnects whether this is the server it saw before.
+  std::string session_id = std::to_string(
+      std::chrono::system_clock::now().time_since_epoch() / std::chrono::milliseconds(1));
 
   mutable std::mutex mu;  // guards the fields below
   std::optional<FrameView> pending;
@@ -160,8 +163,17 @@ void Server::Impl::Open(Hdl h) {
   Log(c.name + ": connected");
   clients.emplace(h, std::move(c));
   client_count = clients.size();
-  SendText(h, ServerInfoJson(options.name, std::to_string(port)));
-  SendText(h, AdvertiseJson(channels));
+  // The greeting a moment after the handshake, not in the same packet: a client that reads the
+  // handshake's answer and the next messages in one go (Node's `ws`) emits them before a program
+  // that awaits the connection has registered its handlers (mcap-record of ws-protocol-examples
+  // then never sees the channels).
+  auto greet =
+      std::make_shared<asio::steady_timer>(ws.get_io_service(), std::chrono::milliseconds(50));
+  greet->async_wait([this, h, greet](const std::error_code& ec) {
+    if (ec || clients.find(h) == clients.end()) return;
+    SendText(h, ServerInfoJson(options.name, session_id));
+    SendText(h, AdvertiseJson(channels));
+  });
 }
 
 void Server::Impl::Closed(Hdl h) {
