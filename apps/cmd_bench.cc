@@ -20,6 +20,7 @@ void AddBenchCommand(CLI::App* app) {
     bool links_only = false;
     std::string size;
     bool fleet = false;
+    bool live = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* bench = app->add_subcommand(
@@ -44,11 +45,13 @@ void AddBenchCommand(CLI::App* app) {
   bench->add_flag("--fleet", args->fleet,
                   "Also the fleet link on loopback: record latency, leader's write to follower's "
                   "receive, and a late follower's catch-up on a 1000-record route");
+  bench->add_flag("--live", args->live,
+                  "Also the live view on loopback: the repeat loop with 0 and 3 clients, latency");
   bench->add_flag("--links-only", args->links_only,
-                  "Only the link rows (with --ros1, --ros2 and/or --fleet), not the method stages");
+                  "Only the link rows (--ros1, --ros2, --fleet, --live), not the method stages");
   bench->callback([args] {
-    if (args->links_only && !args->ros1 && !args->ros2 && !args->fleet)
-      throw InputError("--links-only: add --ros1, --ros2 and/or --fleet");
+    if (args->links_only && !args->ros1 && !args->ros2 && !args->fleet && !args->live)
+      throw InputError("--links-only: add --ros1, --ros2, --fleet and/or --live");
     nlohmann::json j;
     if (!args->links_only) {
       bench::StageOptions options;
@@ -60,6 +63,7 @@ void AddBenchCommand(CLI::App* app) {
     if (args->ros1) bench::BenchMiddleware(BuiltinMiddlewares(), "ros1", &j);
     if (args->ros2) bench::BenchMiddleware(BuiltinMiddlewares(), "ros2", &j);
     if (args->fleet) bench::BenchFleet(&j);
+    if (args->live) bench::BenchLive(&j);
     if (args->json) {
       std::cout << j.dump() << "\n";
     } else if (args->links_only) {

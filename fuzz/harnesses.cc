@@ -393,7 +393,8 @@ void LiveClientMessage(const std::string& input) {
   std::size_t start = 0;
   for (int i = 0; i < 8 && start <= input.size(); ++i) {
     const std::size_t end = std::min(input.find("\xffNXT", start), input.size());
-    const live::ClientRequest r = live::ParseClientMessage(std::string_view(input).substr(start, end - start));
+    const live::ClientRequest r =
+        live::ParseClientMessage(std::string_view(input).substr(start, end - start));
     if ((r.kind == live::ClientRequest::Kind::kInvalid ||
          r.kind == live::ClientRequest::Kind::kUnsupported) &&
         r.error.empty())

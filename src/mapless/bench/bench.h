@@ -34,6 +34,9 @@ void BenchMiddleware(const robot::MiddlewareRegistry& middlewares, const std::st
 // The fleet link on loopback: record latency, a late follower's catch-up, a follower's work per
 // live record.
 void BenchFleet(nlohmann::json* j);
+// The live view on loopback (issue 43): the repeat loop's per-frame time with 0 and 3 clients (one
+// stalled), and the latency from the loop to a client at 30 frames a second.
+void BenchLive(nlohmann::json* j);
 
 // The tables, to stdout.
 void PrintStageTable(const nlohmann::json& j);  // the stages and then the links

@@ -38,6 +38,15 @@ void PrintLinkRows(const nlohmann::json& j) {
                 j["fleet_follower_apply_first100_ms"].get<double>(),
                 j["fleet_follower_apply_last100_ms"].get<double>());
   }
+  if (j.contains("live_loop_3_over_0_clients")) {
+    std::printf("%-34s %10.3f  3 clients (1 stalled): %.3f ms, %.3fx (issue 43: <= 1.05x)\n",
+                "live view: repeat loop, 0 clients", j["live_loop_0_clients_ms"].get<double>(),
+                j["live_loop_3_clients_ms"].get<double>(),
+                j["live_loop_3_over_0_clients"].get<double>());
+    std::printf("%-34s %10.3f  p99 %.3f ms, %d frames at 30 fps (issue 43: p99 <= 20)\n",
+                "live view: frame to client", j["live_latency_median_ms"].get<double>(),
+                j["live_latency_p99_ms"].get<double>(), j["live_latency_samples"].get<int>());
+  }
   for (const char* mw : {"ros1", "ros2"}) {
     const std::string prefix = std::string(mw) + "_link";
     if (j.contains(prefix)) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>  // the IMREAD_ flags (the library itself is loaded lazily)
 #include <opencv2/imgproc.hpp>
 #include <vector>
 

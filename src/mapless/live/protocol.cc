@@ -163,7 +163,9 @@ std::vector<std::string> Subscriptions::Apply(const ClientRequest& request,
                                               const std::vector<std::uint32_t>& known_channel_ids) {
   std::vector<std::string> refused;
   if (request.kind == ClientRequest::Kind::kSubscribe) {
-    for (const auto& [id, channel] : request.subscriptions) {
+    for (const auto& entry : request.subscriptions) {
+      const std::uint32_t id = entry.first,
+                          channel = entry.second;  // (clang: lambdas capture these)
       const bool known = std::find(known_channel_ids.begin(), known_channel_ids.end(), channel) !=
                          known_channel_ids.end();
       const bool id_used = std::any_of(entries_.begin(), entries_.end(),

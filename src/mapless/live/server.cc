@@ -77,8 +77,8 @@ struct Server::Impl {
   Timestamp last_t_ns = 0;
   int ticks = 0;
   // Tells a client that reconnects whether this is the server it saw before.
-  std::string session_id = std::to_string(
-      std::chrono::system_clock::now().time_since_epoch() / std::chrono::milliseconds(1));
+  std::string session_id = std::to_string(std::chrono::system_clock::now().time_since_epoch() /
+                                          std::chrono::milliseconds(1));
 
   mutable std::mutex mu;  // guards the fields below
   std::optional<FrameView> pending;
