@@ -45,13 +45,14 @@ void AddBenchCommand(CLI::App* app) {
   bench->add_flag("--fleet", args->fleet,
                   "Also the fleet link on loopback: record latency, leader's write to follower's "
                   "receive, and a late follower's catch-up on a 1000-record route");
-  bench->add_flag("--live", args->live,
+  bench->add_flag("--live-view", args->live,
                   "Also the live view on loopback: the repeat loop with 0 and 3 clients, latency");
-  bench->add_flag("--links-only", args->links_only,
-                  "Only the link rows (--ros1, --ros2, --fleet, --live), not the method stages");
+  bench->add_flag(
+      "--links-only", args->links_only,
+      "Only the link rows (--ros1, --ros2, --fleet, --live-view), not the method stages");
   bench->callback([args] {
     if (args->links_only && !args->ros1 && !args->ros2 && !args->fleet && !args->live)
-      throw InputError("--links-only: add --ros1, --ros2, --fleet and/or --live");
+      throw InputError("--links-only: add --ros1, --ros2, --fleet and/or --live-view");
     nlohmann::json j;
     if (!args->links_only) {
       bench::StageOptions options;

@@ -1,5 +1,5 @@
-// `mapless bench --live` (issue 43): what the live view costs the robot's loop and how late its
-// clients see a frame, on loopback. The loop is the repeat's (robot::RepeatMethod, the default
+// `mapless bench --live-view` (issue 43): what the live view costs the robot's loop and how late
+// its clients see a frame, on loopback. The loop is the repeat's (robot::RepeatMethod, the default
 // options with the obstacle watch) on the table1_almost_straight teach drive's frames, each
 // decision offered to a LiveView. Its per-frame time with no client and with three (two that read,
 // one that connects, subscribes to everything and never reads) is measured in alternating passes,

@@ -352,8 +352,11 @@ Server::~Server() {
     done->set_value();
   });
   done->get_future().wait_for(std::chrono::seconds(2));
-  // A moment for the close frames to leave; then the thread stops whatever is left.
-  if (impl->client_count.load() > 0) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  // The clients' queues go out before the close frames (a reading client sees the run to its
+  // end); a client that reads nothing holds the exit at most 2 s, then the thread stops.
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+  while (impl->client_count.load() > 0 && std::chrono::steady_clock::now() < give_up)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
   impl->ws.stop();
   if (impl->thread.joinable()) impl->thread.join();
 }
