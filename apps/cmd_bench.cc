@@ -19,8 +19,7 @@ void AddBenchCommand(CLI::App* app) {
     bool ros2 = false;
     bool links_only = false;
     std::string size;
-    bool fleet = false;
-    bool live = false;
+    bool fleet = false, live = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* bench = app->add_subcommand(

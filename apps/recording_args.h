@@ -39,14 +39,12 @@ std::unique_ptr<recording::RunRecorder> OpenRecorder(
 // --live [ADDRESS:]PORT and --live-rate (AddRecordOptions has them too).
 void AddLiveOption(CLI::App* cmd, live::LiveArgs* args);
 
-// The live view --live ADDRESS asks for (nullptr without it), serving before the run starts;
-// `route`: the taught route's poses in its odometry frame, drawn under the robot.
-// `simulated`: a run on the simulator (paced while watched).
+// The live view --live asks for (nullptr without), serving before the run starts; `simulated`:
+// paced while watched; `route`: the taught route's poses in its odometry frame.
 std::unique_ptr<live::LiveView> OpenLive(const live::LiveArgs& args, const char* method,
                                          bool simulated, std::vector<Pose2> route = {});
 
-// A link wrapper that records through `recorder` and shows the run in `live` (each when not
-// nullptr).
+// A link wrapper that records through `recorder` and shows the run in `live` (each if not null).
 robot::LinkWrapper RecordingWrapper(recording::RunRecorder* recorder, const char* method,
                                     live::LiveView* live = nullptr);
 
