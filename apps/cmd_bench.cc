@@ -44,8 +44,7 @@ void AddBenchCommand(CLI::App* app) {
   bench->add_flag("--fleet", args->fleet,
                   "Also the fleet link on loopback: record latency, leader's write to follower's "
                   "receive, and a late follower's catch-up on a 1000-record route");
-  bench->add_flag("--live-view", args->live,
-                  "Also the live view on loopback: the repeat loop with 0 and 3 clients, latency");
+  bench->add_flag("--live-view", args->live, "Also the live view: loop with 0/3 clients, latency");
   bench->add_flag(
       "--links-only", args->links_only,
       "Only the link rows (--ros1, --ros2, --fleet, --live-view), not the method stages");

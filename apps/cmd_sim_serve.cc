@@ -99,7 +99,7 @@ void AddSimServeCommand(CLI::App* simcmd) {
   cmd->add_option("--image-noise", a->image_noise, "Grey levels (repeat)")
       ->capture_default_str()
       ->check(FiniteIn(0.0, 100.0));
-  AddLiveOption(cmd, &a->live);
+  AddLiveOption(cmd, &a->live, false);  // paced by the method or the clock
   cmd->add_option("--timeout", a->timeout_s, "Simulated seconds, then the serve ends")
       ->capture_default_str()
       ->check(FiniteIn(1.0, 86400.0));

@@ -280,7 +280,7 @@ void AddLeadCommand(CLI::App* app) {
   cmd->add_option("--robot", a->robot, "Teach on a robot (a person drives): its robot file");
   cmd->add_option("--route", a->route, "Route directory (new, or an interrupted leader's)")
       ->required();
-  AddLiveOption(cmd, &a->live);
+  AddLiveOption(cmd, &a->live, false);  // --real-time-factor paces it
   cmd->add_option("--bind", a->bind,
                   "Endpoint to serve on: tcp://ADDRESS:PORT (tcp://*:5600 for all interfaces), "
                   "ipc://PATH")

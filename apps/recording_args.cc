@@ -28,12 +28,13 @@ void AddRecordOptions(CLI::App* cmd, RecordArgs* args) {
   AddLiveOption(cmd, &args->live);
 }
 
-void AddLiveOption(CLI::App* cmd, live::LiveArgs* args) {
-  cmd->add_option("--live-rate", args->rate,
-                  "The simulator, while someone watches --live: simulated seconds per second "
-                  "(0: as fast as it runs)")
-      ->capture_default_str()
-      ->check(ZeroOrIn(0.01, 1000.0));
+void AddLiveOption(CLI::App* cmd, live::LiveArgs* args, bool with_rate) {
+  if (with_rate)
+    cmd->add_option("--live-rate", args->rate,
+                    "The simulator, while someone watches --live: simulated seconds per second "
+                    "(0: as fast as it runs)")
+        ->capture_default_str()
+        ->check(ZeroOrIn(0.01, 1000.0));
   cmd->add_option("--live", args->address,
                   "Watch the run live: [ADDRESS:]PORT (address 127.0.0.1 unless given) serves "
                   "the Foxglove WebSocket protocol (Foxglove, Lichtblick) and a page at "

@@ -36,8 +36,8 @@ void AddPlaybackOptions(CLI::App* cmd, recording::PlaybackOptions* options, bool
 std::unique_ptr<recording::RunRecorder> OpenRecorder(
     const RecordArgs& args, std::optional<rosmsg::CameraInfoFields> camera_info = std::nullopt);
 
-// --live [ADDRESS:]PORT and --live-rate (AddRecordOptions has them too).
-void AddLiveOption(CLI::App* cmd, live::LiveArgs* args);
+// --live [ADDRESS:]PORT, and --live-rate unless the command paces itself (AddRecordOptions: both).
+void AddLiveOption(CLI::App* cmd, live::LiveArgs* args, bool with_rate = true);
 
 // The live view --live asks for (nullptr without), serving before the run starts; `simulated`:
 // paced while watched; `route`: the taught route's poses in its odometry frame.

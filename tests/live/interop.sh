@@ -10,6 +10,9 @@
 # (http://ADDRESS:PORT/) in Debian's Chromium through playwright-core (page.mjs) while a repeat
 # goes on: no console error, no failed request, nothing asked of anywhere else, and a screenshot
 # that shows the camera with its overlay, a plot and the map.
+# Then follow (the belief channel decoded too), navigate and lead (the teach's frames) with --live;
+# teach --live says its address. (`sim serve --live` is the same link; its robot links are tested
+# in tests/ros1 and tests/ros2.)
 # Exit 77 (skipped) only when node or npm is absent.
 #   tests/live/interop.sh MAPLESS WORK_DIR
 set -uo pipefail
@@ -31,8 +34,10 @@ FAILS=0
 pids=()
 trap 'for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done' EXIT
 
-"$MAPLESS" teach --source $S --out "$R/route" >"$R/teach.log" 2>&1 ||
+"$MAPLESS" teach --source $S --out "$R/route" --live 127.0.0.1:0 >"$R/teach.log" 2>&1 ||
   { echo "FAIL teach:"; tail -5 "$R/teach.log"; exit 1; }
+grep -q "live view: http://127.0.0.1:[0-9]*/" "$R/teach.log" ||
+  { echo "FAIL teach --live said no address"; FAILS=$((FAILS + 1)); }
 # Port 0: a free port, read back from the line the command says. Paced at 5x while watched.
 "$MAPLESS" repeat --route "$R/route" --source $S --log "$R/repeat.jsonl" \
   --live 127.0.0.1:0 --live-rate 10 >"$R/repeat.log" 2>&1 &
@@ -69,6 +74,37 @@ if node "$WORK/js/read_mcap.mjs" "$R/live.mcap" /camera/image_raw/compressed \
   echo "ok   the live stream, recorded, reads back"
 else
   echo "FAIL the recording:"; tail -5 "$R/record.log"; FAILS=$((FAILS + 1))
+fi
+
+echo "-- the other commands: follow (with the belief), navigate, lead"
+"$MAPLESS" teach --source sim:office_aliasing --method eigenspace --out "$R/eroute" >"$R/eteach.log" 2>&1 ||
+  { echo "FAIL teach eigenspace:"; tail -5 "$R/eteach.log"; exit 1; }
+"$MAPLESS" follow --route "$R/eroute" --source sim:office_aliasing --live 127.0.0.1:0 --live-rate 20 \
+  >"$R/follow.log" 2>&1 & pids+=($!); follow=$!
+PORT=$(port_of "$R/follow.log") || exit 1
+node "$WORK/js/watch.mjs" "ws://127.0.0.1:$PORT" foxglove.sdk.v1 120 >"$R/follow.json" 2>"$R/follow.err"
+watched=$?
+if wait "$follow" && [ "$watched" = 0 ] && grep -q '"/mapless/belief":[1-9]' "$R/follow.json"; then
+  echo "ok   follow: $(cut -c1-300 "$R/follow.json")"
+else
+  echo "FAIL follow: $(cat "$R/follow.json") $(tail -3 "$R/follow.err" "$R/follow.log")"; FAILS=$((FAILS + 1))
+fi
+if "$MAPLESS" navigate --scenario obstacle_field --destination-index 1 --live 127.0.0.1:0 \
+  >"$R/navigate.log" 2>&1 && grep -q "live view: http://127.0.0.1:[0-9]*/" "$R/navigate.log"; then
+  echo "ok   navigate --live (served; the run succeeded)"
+else
+  echo "FAIL navigate --live:"; tail -3 "$R/navigate.log"; FAILS=$((FAILS + 1))
+fi
+# The leader teaches at 20x wall-clock time; its live view shows the teach.
+"$MAPLESS" lead --source $S --route "$R/lead" --bind "ipc://$R/lead.ipc" --real-time-factor 20 \
+  --live 127.0.0.1:0 >"$R/lead.log" 2>&1 & pids+=($!); lead=$!
+PORT=$(port_of "$R/lead.log") || exit 1
+node "$WORK/js/watch.mjs" "ws://127.0.0.1:$PORT" foxglove.websocket.v1 3 >"$R/lead.json" 2>"$R/lead.err"
+kill -INT "$lead" 2>/dev/null; wait "$lead"
+if grep -q '"/mapless/decision":[1-9]' "$R/lead.json" && grep -q '"/camera/image_raw/compressed":[1-9]' "$R/lead.json"; then
+  echo "ok   lead --live: the teach's frames and decisions seen"
+else
+  echo "FAIL lead --live: $(cat "$R/lead.json") $(tail -3 "$R/lead.log")"; FAILS=$((FAILS + 1))
 fi
 
 echo "-- the page in Chromium"
