@@ -59,7 +59,8 @@ void Lead(const LeadArgs& a) {
   fleet::ServerOptions server_options;
   server_options.bind = a.bind;
   server_options.security = fleet::LoadLeaderSecurity(a.curve_key, a.curve_allow);
-  fleet::RouteCopy copy(a.route);  // resumes an interrupted leader's route
+  const auto live = OpenLive(a.live, "teach", false);  // refused before anything is made
+  fleet::RouteCopy copy(a.route);                      // resumes an interrupted leader's route
   if (copy.header() && copy.header()->kind != kind)
     throw InputError(a.route + ": holds a " +
                      std::string(fleet::RouteKindName(copy.header()->kind)) +
@@ -73,7 +74,6 @@ void Lead(const LeadArgs& a) {
   teacher_options.kind = kind;
   teacher_options.detector = a.detector;
   run::Teacher teacher(teacher_options, sink);
-  const auto live = OpenLive(a.live, "teach", false);
   const run::FrameTap tap = run::LiveTeachTap(live.get(), teacher);
   bool robot_teach_ended = false;
   if (copy.complete()) {

@@ -71,6 +71,7 @@ void Teach(const TeachArgs& t) {
   const auto recorder = OpenRecorder(
       t.record,
       scenario ? std::optional(recording::CameraInfoOf(scenario->camera.model)) : std::nullopt);
+  const auto live_view = OpenLive(t.record.live, "teach", scenario.has_value());  // before output
   io::OutputDirectory out(t.out, t.overwrite, "route", marker);
   StopCleanlyOnInterrupt();
   run::StoreSink store(out.path());
@@ -82,7 +83,6 @@ void Teach(const TeachArgs& t) {
   teacher_options.never_odometry =
       !robot && !scenario && !live && !recording::IsRecording(t.source) && t.playback.poses.empty();
   run::Teacher teacher(teacher_options, store);
-  const auto live_view = OpenLive(t.record.live, "teach", scenario.has_value());
   const run::FrameTap tap =
       run::LiveTeachTap(live_view.get(), teacher,
                         [&](const robot::Observation& f, const std::optional<Pose2>& truth) {

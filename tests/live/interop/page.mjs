@@ -26,7 +26,13 @@ try {
   await page.waitForTimeout(1500);  // a few seconds of plot
   // What the pictures hold: coloured pixels in the debug picture (the overlay: the camera is grey)
   // and in the plot and the map (their lines).
-  shown = await page.evaluate(() => {
+  shown = await page.evaluate(async () => {
+    // An image being replaced by the next frame has no size for a moment: wait for a loaded one.
+    const loaded = async (img) => {
+      for (let i = 0; i < 100 && !(img.complete && img.naturalWidth > 0); i++)
+        await new Promise((r) => setTimeout(r, 20));
+      return img;
+    };
     const coloured = (source, w, h) => {
       const c = document.createElement("canvas");
       c.width = w; c.height = h;
@@ -40,7 +46,7 @@ try {
       }
       return n;
     };
-    const debug = document.getElementById("debug");
+    const debug = await loaded(document.getElementById("debug"));
     return {
       state: document.getElementById("state").textContent,
       debug_size: [debug.naturalWidth, debug.naturalHeight],
