@@ -12,15 +12,11 @@ MAPLESS=$1; WORK=$2
 HERE=$(cd "$(dirname "$0")" && pwd)
 command -v node >/dev/null 2>&1 && command -v npm >/dev/null 2>&1 ||
   { echo "interop.sh: SKIPPED: node and npm are needed for @mcap/core"; exit 77; }
-mkdir -p "$WORK/js"
 rm -rf "$WORK/run"
 mkdir -p "$WORK/run"
-cp "$HERE/interop/package.json" "$HERE/interop/package-lock.json" "$HERE/interop/"*.mjs "$WORK/js/"
-if ! cmp -s "$HERE/interop/package-lock.json" "$WORK/js/node_modules/.package-lock.json.installed" 2>/dev/null; then
-  (cd "$WORK/js" && npm ci --no-audit --no-fund --loglevel=error) >"$WORK/npm.log" 2>&1 ||
-    { echo "interop.sh: npm ci failed:"; tail -5 "$WORK/npm.log"; exit 1; }
-  cp "$HERE/interop/package-lock.json" "$WORK/js/node_modules/.package-lock.json.installed"
-fi
+# shellcheck source=../support/npm_folder.sh
+source "$HERE/../support/npm_folder.sh"
+npm_folder "$HERE/interop" "$WORK"
 R=$WORK/run
 S=sim:table1_almost_straight
 FAILS=0
