@@ -30,8 +30,29 @@ passed=0
 failed=0
 cases=0
 
+failures=()
 check() {  # check NAME CONDITION-EXIT-CODE
-  if [ "$2" -eq 0 ]; then passed=$((passed + 1)); echo "ok   $1"; else failed=$((failed + 1)); echo "FAIL $1"; fi
+  if [ "$2" -eq 0 ]; then
+    passed=$((passed + 1)); echo "ok   $1"
+  else
+    failed=$((failed + 1)); failures+=("$1"); echo "FAIL $1"
+  fi
+}
+
+# wait_until SECONDS PID COMMAND...: until COMMAND succeeds, the background run PID has ended or
+# SECONDS have passed. The runs it waits for (a leader, a teach) take a few seconds on an idle
+# machine and several times that on a loaded CI machine under the sanitizers: the bound is for a
+# run that never gets there, not a speed limit.
+wait_until() {
+  local seconds="$1" pid="$2"
+  shift 2
+  local end=$((SECONDS + seconds))
+  while [ "$SECONDS" -lt "$end" ]; do
+    "$@" && return 0
+    kill -0 "$pid" 2>/dev/null || { "$@"; return; }
+    sleep 0.05
+  done
+  "$@"
 }
 
 # Every regular file's checksum and every entry's name (FIFOs and links are named, not read).
@@ -335,7 +356,7 @@ probe "sim serve --size too small" 2 "--size '8x8'" -- "$MAPLESS" sim serve --sc
 echo "# two writers, and Ctrl-C"
 "$MAPLESS" teach --source sim:outdoor_70m --out "$NEW/locked" >"$TMP/first.out" 2>"$TMP/first.err" &
 first=$!
-for _ in $(seq 1 400); do [ -f "$NEW/locked/keyframes/000001.yml" ] && break; sleep 0.05; done
+wait_until 120 "$first" test -f "$NEW/locked/keyframes/000001.yml"
 probe "a second teach into a route being taught" 2 "locked: another mapless process is writing" -- "$MAPLESS" teach --source "$FX/frames" --out "$NEW/locked" --overwrite
 kill -INT "$first"
 wait "$first"
@@ -348,7 +369,7 @@ grep -q '"complete":false' "$TMP/out"; check "Ctrl-C: the route loads, marked in
 echo '{"old": "log"}' >"$NEW/old.jsonl"
 "$MAPLESS" repeat --route "$FX/route" --source sim:table1_almost_straight --log "$NEW/old.jsonl" >/dev/null 2>"$TMP/rep.err" &
 rep=$!
-for _ in $(seq 1 400); do [ -s "$NEW/old.jsonl.partial" ] && break; sleep 0.05; done
+wait_until 120 "$rep" test -s "$NEW/old.jsonl.partial"
 grep -q '"old"' "$NEW/old.jsonl"; check "a log being written leaves the old one whole until the run ends" $?
 kill -TERM "$rep"
 wait "$rep"
@@ -365,4 +386,6 @@ echo "probe: $cases bad-input cases"
 [ "$cases" -ge 60 ]; check "at least 60 bad-input cases ($cases)" $?
 [ "$ROUND3_CASES" -ge 80 ]; check "at least 80 cases of round 3 ($ROUND3_CASES)" $?
 echo "$passed passed, $failed failed"
+# The failures again, last: a log cut in the middle (CI keeps its head and tail) still names them.
+for f in "${failures[@]}"; do echo "FAILED: $f"; done
 [ "$failed" -eq 0 ]

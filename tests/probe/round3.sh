@@ -132,7 +132,7 @@ echo "# round 3: two writers"
 "$MAPLESS" lead --source sim:table1_almost_straight --method eigenspace --route "$NEW/r3lead" \
   --bind tcp://127.0.0.1:0 --real-time-factor 0 >"$TMP/r3lead.out" 2>"$TMP/r3lead.err" &
 r3lead=$!
-for _ in $(seq 1 200); do grep -q "route complete" "$TMP/r3lead.err" && break; sleep 0.05; done
+wait_until 120 "$r3lead" grep -q "route complete" "$TMP/r3lead.err"
 grep -q "route complete" "$TMP/r3lead.err"; check "round 3 fixture: a leader serving its route" $?
 probe "teach --overwrite onto a leader's route" 2 "r3lead: another mapless process is writing" -- "$MAPLESS" teach --source sim:table1_almost_straight --method eigenspace --out "$NEW/r3lead" --overwrite
 probe "a second leader on a leader's route" 2 "r3lead: another mapless process is writing" -- "$MAPLESS" lead --source sim:table1_almost_straight --method eigenspace --route "$NEW/r3lead" --bind tcp://127.0.0.1:1
@@ -140,12 +140,12 @@ probe "a follower copying into a leader's route" 2 "r3lead: another mapless proc
 kill -INT "$r3lead"; wait "$r3lead" 2>/dev/null
 "$MAPLESS" repeat --route "$FX/route" --source sim:table1_almost_straight --log "$NEW/r3two.jsonl" >/dev/null 2>&1 &
 r3rep=$!
-for _ in $(seq 1 400); do [ -s "$NEW/r3two.jsonl.partial" ] && break; sleep 0.05; done
+wait_until 120 "$r3rep" test -s "$NEW/r3two.jsonl.partial"
 probe "two runs writing one log" 2 "r3two.jsonl: another mapless process is writing this file" -- "$MAPLESS" repeat --route "$FX/route" --source "$FX/frames" --log "$NEW/r3two.jsonl"
 kill -INT "$r3rep"; wait "$r3rep" 2>/dev/null
 "$MAPLESS" teach --source sim:outdoor_70m --out "$NEW/r3teaching" >/dev/null 2>&1 &
 r3teach=$!
-for _ in $(seq 1 400); do [ -f "$NEW/r3teaching/keyframes/000001.yml" ] && break; sleep 0.05; done
+wait_until 120 "$r3teach" test -f "$NEW/r3teaching/keyframes/000001.yml"
 probe "a leader on a route a teach is writing" 2 "r3teaching: another mapless process is writing" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/r3teaching" --bind tcp://127.0.0.1:1
 probe "a follower copying into a route a teach is writing" 2 "r3teaching: another mapless process is writing" -- "$MAPLESS" follow --connect tcp://127.0.0.1:1 --source sim:table1_almost_straight --route "$NEW/r3teaching"
 kill -INT "$r3teach"; wait "$r3teach" 2>/dev/null
@@ -163,7 +163,8 @@ r3curve=$!
   --bind tcp://127.0.0.1:0 --real-time-factor 0 >"$TMP/r3plain.out" 2>"$TMP/r3plain.err" &
 r3plain=$!
 endpoint() { grep -o 'lead: serving .* on tcp://127.0.0.1:[0-9]*' "$1" | grep -o 'tcp://.*' | head -1; }
-for _ in $(seq 1 200); do [ -n "$(endpoint "$TMP/r3curve.err")" ] && [ -n "$(endpoint "$TMP/r3plain.err")" ] && break; sleep 0.05; done
+both_serving() { [ -n "$(endpoint "$TMP/r3curve.err")" ] && [ -n "$(endpoint "$TMP/r3plain.err")" ]; }
+wait_until 120 "$r3curve" both_serving
 curve_at=$(endpoint "$TMP/r3curve.err")
 plain_at=$(endpoint "$TMP/r3plain.err")
 [ -n "$curve_at" ] && [ -n "$plain_at" ]; check "round 3 fixture: two leaders ($curve_at, $plain_at)" $?
@@ -172,7 +173,10 @@ probe "follower with the wrong leader key" 1 "the handshake with $curve_at faile
 probe "follower whose key the leader does not admit" 1 "refused this follower's CURVE key" -- "$MAPLESS" follow --connect "$curve_at" --source sim:table1_almost_straight --route "$NEW/r3k3" --curve-key "$FX/fleet.key" --curve-leader "$FX/r3_leader.key.pub"
 probe "follower with a key, leader without" 1 "the handshake with $plain_at failed" -- "$MAPLESS" follow --connect "$plain_at" --source sim:table1_almost_straight --route "$NEW/r3k4" --curve-key "$FX/fleet.key" --curve-leader "$FX/r3_leader.key.pub"
 kill -INT "$r3curve" "$r3plain"; wait "$r3curve" "$r3plain" 2>/dev/null
-timeout -s INT 7 "$MAPLESS" follow --connect tcp://127.0.0.1:1 --source sim:table1_almost_straight --route "$NEW/r3k5" >/dev/null 2>"$TMP/r3wait.err"
+"$MAPLESS" follow --connect tcp://127.0.0.1:1 --source sim:table1_almost_straight --route "$NEW/r3k5" >/dev/null 2>"$TMP/r3wait.err" &
+r3wait=$!
+wait_until 60 "$r3wait" grep -q "still waiting" "$TMP/r3wait.err"
+kill -INT "$r3wait"; wait "$r3wait" 2>/dev/null
 grep -q "still waiting for the leader's route: no connection to tcp://127.0.0.1:1" "$TMP/r3wait.err"; check "a follower with no leader says what it waits for ($(head -c 200 "$TMP/r3wait.err"))" $?
 
 # ---------------------------------------------------------------------------------------------
