@@ -1,26 +1,12 @@
 // `mapless bench`: the options, then the benches of src/mapless/bench (bench.h) and their table.
-#include <iostream>
-#include <nlohmann/json.hpp>
-
 #include "builtin_middlewares.h"
 #include "cli_common.h"
 #include "mapless/bench/bench.h"
-#include "mapless/core/check.h"
-#include "mapless/io/image_file.h"
 
 namespace mapless::app {
 
 void AddBenchCommand(CLI::App* app) {
-  struct Args {
-    bool json = false;
-    int repeats = 100;
-    std::string scenario;  // empty: the default mix of indoor, outdoor and aliasing scenes
-    bool ros1 = false;
-    bool ros2 = false;
-    bool links_only = false;
-    std::string size;
-    bool fleet = false, live = false;
-  };
+  using Args = bench::BenchRequest;
   auto args = std::make_shared<Args>();
   CLI::App* bench = app->add_subcommand(
       "bench",
@@ -48,29 +34,7 @@ void AddBenchCommand(CLI::App* app) {
   bench->add_flag(
       "--links-only", args->links_only,
       "Only the link rows (--ros1, --ros2, --fleet, --live-view), not the method stages");
-  bench->callback([args] {
-    if (args->links_only && !args->ros1 && !args->ros2 && !args->fleet && !args->live)
-      throw InputError("--links-only: add --ros1, --ros2, --fleet and/or --live-view");
-    nlohmann::json j;
-    if (!args->links_only) {
-      bench::StageOptions options;
-      options.repeats = args->repeats;
-      if (!args->scenario.empty()) options.scenarios = {args->scenario};
-      if (!args->size.empty()) options.frame = io::ParseFrameSize(args->size, "--size", {64, 48});
-      j = bench::BenchStages(options);
-    }
-    if (args->ros1) bench::BenchMiddleware(BuiltinMiddlewares(), "ros1", &j);
-    if (args->ros2) bench::BenchMiddleware(BuiltinMiddlewares(), "ros2", &j);
-    if (args->fleet) bench::BenchFleet(&j);
-    if (args->live) bench::BenchLive(&j);
-    if (args->json) {
-      std::cout << j.dump() << "\n";
-    } else if (args->links_only) {
-      bench::PrintLinkTable(j);
-    } else {
-      bench::PrintStageTable(j);
-    }
-  });
+  bench->callback([args] { bench::RunBench(*args, BuiltinMiddlewares()); });
 }
 
 }  // namespace mapless::app

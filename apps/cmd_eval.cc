@@ -177,6 +177,20 @@ void AddEvalCommand(CLI::App* app) {
       "eigenspace", "Payá et al., Section 5: the appearance route follower on its two routes");
   AddSuiteOptions(e, eigenspace.get());
   e->callback([eigenspace] { RunSuite("eigenspace", *eigenspace, run::RunEigenspaceSuite); });
+  auto sessions = std::make_shared<std::pair<std::string, bool>>();
+  auto views = std::make_shared<eval::ExperiencesEvalOptions>();
+  CLI::App* x = eval->add_subcommand(
+      "experiences", "Experiences on real images of places visited in several sessions");
+  x->add_option("--sessions", sessions->first, "DIR/SSPP.png and DIR/offsets.txt")->required();
+  x->add_option("--max-views", views->experiences.max_views, "Views per place, the taught one too")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 64));
+  x->add_flag("--json", sessions->second, "Print one JSON object (the table goes to stderr)");
+  x->callback([sessions, views] {
+    const run::SuiteOutput out = run::RunExperiencesEval(sessions->first, *views);
+    std::fputs(out.table.c_str(), sessions->second ? stderr : stdout);
+    if (sessions->second) std::cout << out.json.dump() << "\n";
+  });
   auto fleet = std::make_shared<run::FleetEvalOptions>();
   auto fleet_json = std::make_shared<bool>(false);
   CLI::App* f = eval->add_subcommand(

@@ -42,4 +42,15 @@ void BenchLive(nlohmann::json* j);
 void PrintStageTable(const nlohmann::json& j);  // the stages and then the links
 void PrintLinkTable(const nlohmann::json& j);
 
+// What `mapless bench` was asked for; RunBench measures it and prints the table or the JSON.
+struct BenchRequest {
+  bool json = false;
+  int repeats = 100;
+  std::string scenario;  // empty: the default mix of indoor, outdoor and aliasing scenes
+  std::string size;      // WxH; empty: 320x240
+  bool ros1 = false, ros2 = false, fleet = false, live = false;
+  bool links_only = false;  // only the link rows: at least one of them must be asked for
+};
+void RunBench(const BenchRequest& request, const robot::MiddlewareRegistry& middlewares);
+
 }  // namespace mapless::bench

@@ -1,10 +1,13 @@
 // The table `mapless bench` prints (bench.h): each stage's median and the ratios with the targets
 // of the issues that set them.
 #include <cstdio>
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
 
 #include "mapless/bench/bench.h"
+#include "mapless/core/check.h"
+#include "mapless/io/image_file.h"
 
 namespace mapless::bench {
 
@@ -142,5 +145,30 @@ void PrintStageTable(const nlohmann::json& j) {
 }
 
 void PrintLinkTable(const nlohmann::json& j) { PrintLinkRows(j); }
+
+void RunBench(const BenchRequest& request, const robot::MiddlewareRegistry& middlewares) {
+  const BenchRequest& r = request;
+  if (r.links_only && !r.ros1 && !r.ros2 && !r.fleet && !r.live)
+    throw InputError("--links-only: add --ros1, --ros2, --fleet and/or --live-view");
+  nlohmann::json j;
+  if (!r.links_only) {
+    StageOptions options;
+    options.repeats = r.repeats;
+    if (!r.scenario.empty()) options.scenarios = {r.scenario};
+    if (!r.size.empty()) options.frame = io::ParseFrameSize(r.size, "--size", {64, 48});
+    j = BenchStages(options);
+  }
+  if (r.ros1) BenchMiddleware(middlewares, "ros1", &j);
+  if (r.ros2) BenchMiddleware(middlewares, "ros2", &j);
+  if (r.fleet) BenchFleet(&j);
+  if (r.live) BenchLive(&j);
+  if (r.json) {
+    std::cout << j.dump() << "\n";
+  } else if (r.links_only) {
+    PrintLinkTable(j);
+  } else {
+    PrintStageTable(j);
+  }
+}
 
 }  // namespace mapless::bench

@@ -273,4 +273,44 @@ SuiteOutput RunRepeatSuite(const std::string& suite, const SuiteOptions& options
   return {j, table};
 }
 
+SuiteOutput RunExperiencesEval(const std::string& sessions_dir,
+                               const eval::ExperiencesEvalOptions& options) {
+  const eval::ExperiencesFigures f =
+      eval::EvalExperiences(eval::LoadSessionsDataset(sessions_dir), options);
+  SuiteOutput out;
+  out.json = {{"suite", "experiences"},
+              {"sessions", sessions_dir},
+              {"tolerance_px", f.tolerance_px},
+              {"max_views", options.experiences.max_views},
+              {"single_fraction", f.single_fraction},
+              {"experiences_fraction", f.experiences_fraction},
+              {"learned", f.learned},
+              {"learned_within", f.learned_within},
+              {"places", nlohmann::json::array()}};
+  out.table = Format("%-6s %6s %8s %12s %8s %7s %6s\n", "place", "visits", "single", "experiences",
+                     "learned", "within", "views");
+  for (const auto& p : f.places) {
+    out.json["places"].push_back({{"place", p.place},
+                                  {"visits", p.visits},
+                                  {"single_fraction", p.single_fraction()},
+                                  {"experiences_fraction", p.experiences_fraction()},
+                                  {"learned", p.learned},
+                                  {"learned_within", p.learned_within},
+                                  {"views", p.views}});
+    out.table +=
+        Format("%-6d %6d %8.3f %12.3f %8d %7d %6d\n", p.place, p.visits, p.single_fraction(),
+               p.experiences_fraction(), p.learned, p.learned_within, p.views);
+  }
+  out.table += Format("%-6s %6s %8.3f %12.3f %8d %7d\n", "all", "", f.single_fraction,
+                      f.experiences_fraction, f.learned, f.learned_within);
+  out.table += Format(
+      "single, experiences: fraction of visits (every session after a place's first, in order)\n"
+      "whose shift against the taught view is within %.1f px of the truth, from the taught view\n"
+      "alone or from the view that matches best, chained by the offsets the route measured when "
+      "it\n"
+      "learned its views; learned: views learned; within: ... whose stored offset is within it\n",
+      f.tolerance_px);
+  return out;
+}
+
 }  // namespace mapless::run

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "mapless/eval/experiences.h"
 #include "mapless/eval/teach_repeat.h"
 
 namespace mapless::run {
@@ -37,5 +38,10 @@ SuiteOutput RunRepeatSuite(const std::string& suite, const SuiteOptions& options
 SuiteOutput RunPotentialSuite(const SuiteOptions& options);
 // Payá et al., Section 5.
 SuiteOutput RunEigenspaceSuite(const SuiteOptions& options);
+// Experiences on real multi-session images (eval/experiences.h): {"suite": "experiences",
+// "sessions", "single_fraction", "experiences_fraction", "learned", "learned_within",
+// "places": [...]}.
+SuiteOutput RunExperiencesEval(const std::string& sessions_dir,
+                               const eval::ExperiencesEvalOptions& options);
 
 }  // namespace mapless::run
