@@ -13,6 +13,18 @@
 
 namespace mapless::route {
 
+// A view of a keyframe's place learned on a later visit (issue 45; navigation/experiences.h): its
+// features, and the horizontal offset the repeat measured when it learned it (x in this view - x
+// in the taught view), which maps its features back into the taught view's coordinates.
+struct KeyframeView {
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+  double offset_px = 0.0;
+  int learned_at = 0;  // the route's visit that learned it (Route::visits then)
+  int last_used = 0;   // the last visit at which it was the view the repeat steered by
+  std::string file;    // where it is stored in the route directory; "" until it is
+};
+
 struct Keyframe {
   int index = 0;
   Timestamp t_ns = 0;
@@ -25,6 +37,7 @@ struct Keyframe {
   // The robot's odometry pose (REP-105 odom frame) when the keyframe was taught, when the teach
   // had odometry: lets the repeat carry on through keyframes whose landmarks are gone.
   std::optional<Pose2> odometry;
+  std::vector<KeyframeView> views;  // learned on later visits (empty: the taught view alone)
 };
 
 struct Route {
@@ -32,6 +45,7 @@ struct Route {
   int image_width = 0;           // size of the images the features were measured in
   int image_height = 0;
   bool complete = false;  // false: the teach was interrupted (the keyframes are intact)
+  int visits = 0;         // repeats that learned views (route_store.h: SaveViews)
   std::vector<Keyframe> keyframes;
 };
 

@@ -52,6 +52,42 @@ int ManifestInt(const nlohmann::json& j, const char* key, const std::string& nam
   return static_cast<int>(v.get<long long>());
 }
 
+// A keyframe entry's learned views (version 2): at most kMaxViewsPerKeyframe, files inside the
+// route, finite offsets within the image's reach, visits no later than the route's.
+std::vector<ManifestView> ParseViews(const nlohmann::json& entry, int index, int visits,
+                                     const std::string& name) {
+  std::vector<ManifestView> views;
+  if (!entry.contains("views")) return views;
+  const nlohmann::json& list = entry.at("views");
+  const std::string where = name + ": keyframe " + std::to_string(index) + ": ";
+  if (!list.is_array()) throw InputError(where + "corrupt manifest (views is not a list)");
+  if (list.size() > static_cast<std::size_t>(kMaxViewsPerKeyframe)) {
+    throw InputError(where + std::to_string(list.size()) + " views; the limit is " +
+                     std::to_string(kMaxViewsPerKeyframe));
+  }
+  for (const auto& v : list) {
+    ManifestView view;
+    view.data = v.at("data").get<std::string>();
+    const nlohmann::json& offset = v.at("offset_px");
+    view.learned_at = ManifestInt(v, "learned_at", name);
+    view.last_used = ManifestInt(v, "last_used", name);
+    if (!offset.is_number() || !std::isfinite(offset.get<double>()) ||
+        std::abs(offset.get<double>()) > io::kMaxImageSide) {
+      throw InputError(where + "a view's offset_px is not a number of pixels within the image");
+    }
+    view.offset_px = offset.get<double>();
+    if (!InsideRoute(view.data)) throw InputError(where + "a view names a file outside the route");
+    if (view.learned_at < 1 || view.learned_at > visits || view.last_used < view.learned_at ||
+        view.last_used > visits) {
+      throw InputError(where + "a view learned at visit " + std::to_string(view.learned_at) +
+                       " and last used at " + std::to_string(view.last_used) +
+                       " does not fit the route's " + std::to_string(visits) + " visits");
+    }
+    views.push_back(std::move(view));
+  }
+  return views;
+}
+
 // What a repeat relies on in one keyframe, checked where the file is known: descriptors as the
 // route's detector writes them, keypoints and tracks inside the image, the manifest's time.
 void CheckKeyframe(const Keyframe& kf, const ManifestEntry& entry, const Manifest& manifest,
@@ -90,6 +126,32 @@ void CheckKeyframe(const Keyframe& kf, const ManifestEntry& entry, const Manifes
   }
 }
 
+// A keyframe's learned views from their files, each checked as a keyframe file of that keyframe.
+std::vector<KeyframeView> LoadViews(const std::string& dir, const ManifestEntry& entry,
+                                    const Manifest& manifest,
+                                    const features::DescriptorLayout& layout) {
+  std::vector<KeyframeView> views;
+  for (const ManifestView& v : entry.views) {
+    const std::string path = (std::filesystem::path(dir) / v.data).string();
+    if (!std::filesystem::exists(path)) throw InputError(path + ": view file is missing");
+    Keyframe kf = ParseKeyframe(io::ReadFile(path, io::kMaxKeyframeFileBytes), path);
+    if (kf.index != entry.index) {
+      throw InputError(path + ": a view of keyframe " + std::to_string(kf.index) +
+                       ", listed under keyframe " + std::to_string(entry.index));
+    }
+    CheckKeyframe(kf, entry, manifest, layout, path);
+    KeyframeView view;
+    view.keypoints = std::move(kf.keypoints);
+    view.descriptors = kf.descriptors;
+    view.offset_px = v.offset_px;
+    view.learned_at = v.learned_at;
+    view.last_used = v.last_used;
+    view.file = v.data;
+    views.push_back(std::move(view));
+  }
+  return views;
+}
+
 }  // namespace
 
 RouteWriter::RouteWriter(std::string dir, std::string detector, int image_width, int image_height)
@@ -122,6 +184,10 @@ std::unique_ptr<RouteWriter> RouteWriter::Reopen(const std::string& dir) {
   const Manifest manifest = ParseManifest(io::ReadFile(path, io::kMaxManifestBytes), path);
   for (std::size_t i = 0; i < manifest.keyframes.size(); ++i) {
     const ManifestEntry& e = manifest.keyframes[i];
+    if (!e.views.empty())
+      throw InputError(path +
+                       ": the route has learned views; a teach or a copy cannot go on "
+                       "writing it");
     if (e.data != KeyframeStem(e.index) + ".yml" || e.thumbnail != KeyframeStem(e.index) + ".png")
       throw InputError(path + ": keyframe " + std::to_string(i) +
                        ": files are not where a mapless teach writes them");
@@ -195,12 +261,15 @@ Manifest ParseManifest(const std::string& text, const std::string& name) {
     if (j.at("format").get<std::string>() != "mapless-route") {
       throw InputError(name + ": not a mapless route manifest");
     }
-    const int version = ManifestInt(j, "version", name);
-    if (version != kRouteFormatVersion) {
-      throw InputError(name + ": route format version " + std::to_string(version) +
-                       " is not supported (this mapless reads version " +
-                       std::to_string(kRouteFormatVersion) + ")");
+    m.version = ManifestInt(j, "version", name);
+    if (m.version != kRouteFormatVersion && m.version != kRouteViewsFormatVersion) {
+      throw InputError(name + ": route format version " + std::to_string(m.version) +
+                       " is not supported (this mapless reads versions " +
+                       std::to_string(kRouteFormatVersion) + " and " +
+                       std::to_string(kRouteViewsFormatVersion) + ")");
     }
+    if (m.version == kRouteViewsFormatVersion) m.visits = ManifestInt(j, "visits", name);
+    if (m.visits < 0) throw InputError(name + ": corrupt manifest (visits is negative)");
     m.detector = j.at("detector").get<std::string>();
     m.image_width = ManifestInt(j, "image_width", name);
     m.image_height = ManifestInt(j, "image_height", name);
@@ -231,6 +300,8 @@ Manifest ParseManifest(const std::string& text, const std::string& name) {
         throw InputError(name + ": keyframe " + std::to_string(e.index) +
                          " names a file outside the route directory");
       }
+      if (m.version == kRouteViewsFormatVersion)
+        e.views = ParseViews(entry, e.index, m.visits, name);
       m.keyframes.push_back(std::move(e));
     }
   } catch (const nlohmann::json::exception& e) {
@@ -302,6 +373,7 @@ Route LoadRoute(const std::string& dir) {
   route.image_width = manifest.image_width;
   route.image_height = manifest.image_height;
   route.complete = manifest.complete;
+  route.visits = manifest.visits;
   for (const ManifestEntry& entry : manifest.keyframes) {
     const std::string data = (std::filesystem::path(dir) / entry.data).string();
     const std::string thumb = (std::filesystem::path(dir) / entry.thumbnail).string();
@@ -323,6 +395,7 @@ Route LoadRoute(const std::string& dir) {
       throw InputError(thumb + ": keyframe image of " + std::to_string(kf.thumbnail.cols) + "x" +
                        std::to_string(kf.thumbnail.rows) + " is larger than the route's images");
     }
+    kf.views = LoadViews(dir, entry, manifest, layout);
     route.keyframes.push_back(std::move(kf));
   }
   return route;

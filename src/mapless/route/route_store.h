@@ -23,6 +23,13 @@
 namespace mapless::route {
 
 inline constexpr int kRouteFormatVersion = 1;
+// A route with learned views (issue 45) is written as version 2: its keyframe entries list their
+// views, ROUTE/keyframes/NNNNNN-visit-VVVV.yml each (a keyframe file: the view's features, the
+// keyframe's index and time), with the offset and the visits that learned and last used it. A
+// mapless that reads version 1 only refuses it, saying which version it reads. A route without
+// views stays version 1.
+inline constexpr int kRouteViewsFormatVersion = 2;
+inline constexpr int kMaxViewsPerKeyframe = 64;
 
 struct Manifest;
 
@@ -33,7 +40,7 @@ class RouteWriter {
   // whole until the new one is done).
   RouteWriter(std::string dir, std::string detector, int image_width, int image_height);
   // Goes on writing a route an interrupted teach (or a follower's copy) left in DIR; throws
-  // InputError naming the manifest when it cannot be read.
+  // InputError naming the manifest when it cannot be read or the route has learned views.
   static std::unique_ptr<RouteWriter> Reopen(const std::string& dir);
   // Writes one keyframe, then the manifest that lists it.
   void Append(const Keyframe& keyframe);
@@ -76,15 +83,30 @@ std::string KeyframeFileStem(int index);
 // catches it.
 Route LoadRoute(const std::string& dir);
 
+// Writes the views of `route` (loaded from `dir`) that are not stored yet, then the manifest that
+// lists every view the route now has (version 2, with route->visits), atomically; view files no
+// longer listed (pruned) are removed after. The caller holds the directory's lock
+// (io::DirectoryLock) for the whole run that learned them.
+void SaveViews(const std::string& dir, Route* route);
+
 // The parsers behind LoadRoute, on bytes already read (`name` stands for the file in errors).
 // Fuzzed by fuzz/fuzz_route_manifest.cc and fuzz/fuzz_route_keyframe.cc.
+struct ManifestView {
+  std::string data;  // relative to the route directory, like the keyframe's
+  double offset_px = 0.0;
+  int learned_at = 0;
+  int last_used = 0;
+};
 struct ManifestEntry {
   int index = 0;
   double t_s = 0.0;       // the keyframe's time, as its file says
   std::string data;       // relative to the route directory; never absolute, never ".."
   std::string thumbnail;  // likewise
+  std::vector<ManifestView> views;
 };
 struct Manifest {
+  int version = kRouteFormatVersion;
+  int visits = 0;
   std::string detector;
   int image_width = 0;
   int image_height = 0;

@@ -200,6 +200,87 @@ TEST(RouteStore, NewerFormatVersionIsRefusedByName) {
             std::string::npos);
 }
 
+KeyframeView MakeView(int keyframe, int learned_at, double offset_px) {
+  const Keyframe source = MakeKeyframe(keyframe + 100 * learned_at);
+  KeyframeView v;
+  v.keypoints = source.keypoints;
+  v.descriptors = source.descriptors;
+  v.offset_px = offset_px;
+  v.learned_at = learned_at;
+  v.last_used = learned_at;
+  return v;
+}
+
+// Learned views (issue 45): written beside the keyframes, listed by a version-2 manifest, loaded
+// back with every field; a pruned view's file goes; a reader of version 1 only is refused by name.
+TEST(RouteStore, LearnedViewsRoundTripAndPrunedOnesLeaveNoFile) {
+  const std::string dir = FreshDir("views");
+  {
+    RouteWriter writer(dir, "orb", 320, 240);
+    for (int i = 0; i < 3; ++i) writer.Append(MakeKeyframe(i));
+    writer.Finish();
+  }
+  Route route = LoadRoute(dir);
+  EXPECT_EQ(route.visits, 0);
+  route.visits = 2;
+  route.keyframes[1].views = {MakeView(1, 1, 12.5), MakeView(1, 2, -3.25)};
+  route.keyframes[1].views[0].last_used = 2;
+  SaveViews(dir, &route);
+  const std::string first_file = route.keyframes[1].views[0].file;
+  EXPECT_EQ(first_file, "keyframes/000001-visit-0001.yml");
+  Route loaded = LoadRoute(dir);
+  EXPECT_EQ(loaded.visits, 2);
+  EXPECT_TRUE(loaded.keyframes[0].views.empty());
+  ASSERT_EQ(loaded.keyframes[1].views.size(), 2u);
+  const KeyframeView& v = loaded.keyframes[1].views[0];
+  EXPECT_EQ(v.offset_px, 12.5);
+  EXPECT_EQ(v.learned_at, 1);
+  EXPECT_EQ(v.last_used, 2);
+  EXPECT_EQ(cv::norm(v.descriptors, route.keyframes[1].views[0].descriptors, cv::NORM_INF), 0.0);
+  ASSERT_EQ(v.keypoints.size(), route.keyframes[1].views[0].keypoints.size());
+  EXPECT_EQ(v.keypoints[7].pt, route.keyframes[1].views[0].keypoints[7].pt);
+  // The first view pruned, a third learned: its file goes, the others stay.
+  loaded.visits = 3;
+  loaded.keyframes[1].views.erase(loaded.keyframes[1].views.begin());
+  loaded.keyframes[2].views = {MakeView(2, 3, 40.0)};
+  SaveViews(dir, &loaded);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/" + first_file));
+  const Route again = LoadRoute(dir);
+  EXPECT_EQ(again.keyframes[1].views.size(), 1u);
+  EXPECT_EQ(again.keyframes[1].views[0].offset_px, -3.25);
+  EXPECT_EQ(again.keyframes[2].views.size(), 1u);
+  // A route with views is not reopened by a teach or a copy.
+  EXPECT_NE(testing::InputErrorOf([&] { RouteWriter::Reopen(dir); }).find("learned views"),
+            std::string::npos);
+}
+
+TEST(RouteStore, AViewOutsideTheRouteOrItsVisitsIsRefused) {
+  const std::string dir = FreshDir("bad_views");
+  {
+    RouteWriter writer(dir, "orb", 320, 240);
+    for (int i = 0; i < 2; ++i) writer.Append(MakeKeyframe(i));
+    writer.Finish();
+  }
+  Route route = LoadRoute(dir);
+  route.visits = 1;
+  route.keyframes[1].views = {MakeView(1, 1, 5.0)};
+  SaveViews(dir, &route);
+  const std::string good = io::ReadFile(dir + "/manifest.json", 1 << 24);
+  const auto refused = [&](const std::string& from, const std::string& to) {
+    std::string m = good;
+    m.replace(m.find(from), from.size(), to);
+    return testing::InputErrorOf([&] { ParseManifest(m, "m.json"); });
+  };
+  EXPECT_NE(refused("\"keyframes/000001-visit-0001.yml\"", "\"../x.yml\"").find("outside"),
+            std::string::npos);
+  EXPECT_NE(refused("\"learned_at\": 1", "\"learned_at\": 7").find("visits"), std::string::npos);
+  EXPECT_NE(refused("\"offset_px\": 5.0", "\"offset_px\": 1e300").find("offset_px"),
+            std::string::npos);
+  std::filesystem::remove(dir + "/keyframes/000001-visit-0001.yml");
+  EXPECT_NE(testing::InputErrorOf([&] { LoadRoute(dir); }).find("view file is missing"),
+            std::string::npos);
+}
+
 // Everything a repeat relies on is checked on loading, naming the file.
 TEST(RouteStore, LoadingCatchesWhatARepeatWouldTripOn) {
   const auto route_with = [](const std::string& name, const std::string& detector,
