@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <opencv2/core.hpp>
 
 #include "mapless/eval/taught_once.h"
@@ -74,16 +75,27 @@ TEST(KeyframeRecovery, ARepeatCarriesOnByOdometryThroughThreeKeyframesGone) {
   EXPECT_TRUE(run.success) << run.status << ", final error " << run.final_error_m;
   int carrying = 0;
   int resumed_at = -1;
-  for (const auto& step : run.steps) {
+  Pose2 resumed_pose;
+  for (std::size_t i = 0; i < run.steps.size(); ++i) {
+    const auto& step = run.steps[i];
     if (step.carrying_on && step.destination == gone) {
       ++carrying;
       EXPECT_NE(step.command.v_mps, 0.0);
     } else if (carrying > 0 && resumed_at < 0) {
       resumed_at = step.destination;
+      resumed_pose = run.path[i];
     }
   }
   EXPECT_GT(carrying, 5);
   EXPECT_GE(resumed_at, gone + 3);  // the funnel lane takes over after the three gone ones
+  // ... and near where it should: heading for keyframe k puts the robot past k - 1, and a far
+  // keyframe of this straight route that matches from afar must not end carrying on metres early
+  // (RepeatOptions::carry_on_reach_factor; the route starts at the origin of the odometry).
+  ASSERT_GT(resumed_at, 0);
+  const Pose2 before = *taught.route->keyframes[static_cast<std::size_t>(resumed_at - 1)].odometry;
+  EXPECT_LT(std::hypot(before.x_m - resumed_pose.x_m, before.y_m - resumed_pose.y_m), 1.5)
+      << "resumed heading for keyframe " << resumed_at << " at x = " << resumed_pose.x_m
+      << " m; keyframe " << resumed_at - 1 << " was taught at x = " << before.x_m << " m";
 }
 
 // On an intact route the repeat passes the keyframes in order, one at a time: neither recovery

@@ -114,6 +114,10 @@ RepeatRun RepeatOnSimulator(const sim::Scenario& scenario, const TaughtRoute& ta
         run.steps.push_back(step);
         return true;
       });
+  if (navigation::RepeatSession* session = method.session()) {
+    run.learned = session->TakeLearned();
+    run.used_views = session->used_views();
+  }
   run.completed = result.finished;
   run.collided = sim.collided(r);
   run.status = result.reason;

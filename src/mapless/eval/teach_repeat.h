@@ -51,6 +51,10 @@ struct RepeatRun {
   std::string status;
   std::vector<Pose2> path;  // ground-truth poses of the repeat, one per frame
   std::vector<navigation::RepeatStep> steps;
+  // With repeat.learn: the views learned and the view each keyframe was steered by, for
+  // navigation::ApplyVisit.
+  std::vector<navigation::LearnedView> learned;
+  std::vector<int> used_views;
 };
 
 // Called once per frame with the robot's true pose and the decision (for logs and pictures).

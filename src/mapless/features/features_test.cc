@@ -167,14 +167,15 @@ TEST(TrackKlt, LosesPointsThatLeaveTheImageOrHitAnotherView) {
   EXPECT_LT(r.tracked, static_cast<int>(corners.size()) / 4);
 }
 
-// At finest_level 0 (the default), the pyramid API gives exactly what OpenCV's tracker gives on the
-// two images (the pyramid with its derivatives is what calcOpticalFlowPyrLK builds inside).
+// At finest_level 0, the pyramid API gives exactly what OpenCV's tracker gives on the two images
+// (the pyramid with its derivatives is what calcOpticalFlowPyrLK builds inside).
 TEST(TrackKlt, FullResolutionIsOpenCvsTrackerBitForBit) {
   const cv::Mat a = SimFrame("table1_almost_straight", Pose2{1.0, 0.0, 0.0});
   const cv::Mat b = SimFrame("table1_almost_straight", Pose2{1.05, 0.01, 0.02});
   std::vector<cv::Point2f> corners;
   cv::goodFeaturesToTrack(a, corners, 200, 0.01, 8);
   KltOptions o;
+  o.finest_level = 0;
   const KltResult r = TrackKlt(BuildKltPyramid(a, o), BuildKltPyramid(b, o), corners, o);
   std::vector<cv::Point2f> forward;
   std::vector<uchar> status;
@@ -190,16 +191,18 @@ TEST(TrackKlt, FullResolutionIsOpenCvsTrackerBitForBit) {
   }
 }
 
-// finest_level 1 tracks on the half-resolution image with the window halved: close to the full
-// resolution, on a real view change of the simulator (forward motion and a turn).
+// finest_level 1 (the default) tracks on the half-resolution image with the window halved: close
+// to the full resolution, on a real view change of the simulator (forward motion and a turn).
 TEST(TrackKlt, HalfResolutionStaysCloseToFullResolution) {
   const cv::Mat a = SimFrame("table1_almost_straight", Pose2{1.0, 0.0, 0.0});
   const cv::Mat b = SimFrame("table1_almost_straight", Pose2{1.05, 0.01, 0.02});
   std::vector<cv::Point2f> corners;
   cv::goodFeaturesToTrack(a, corners, 200, 0.01, 8);
-  const KltResult f = TrackKlt(a, b, corners, KltOptions{});
+  KltOptions full;
+  full.finest_level = 0;
+  const KltResult f = TrackKlt(a, b, corners, full);
   KltOptions half;
-  half.finest_level = 1;
+  EXPECT_EQ(half.finest_level, 1);
   const KltResult h = TrackKlt(a, b, corners, half);
   EXPECT_EQ(half.LevelWindowPx(), 15);
   std::vector<double> differences;

@@ -3,12 +3,10 @@
 // The funnel-lane paper tracks with KLT and a 31x31 window.
 //
 // Where the time goes: the Lucas-Kanade iterations over the window, per point, level and direction
-// (the pyramids are ~3% of it). finest_level 1 tracks on the half-resolution image with the window
-// halved: the same 31 pixels of the full image around each point, a quarter of the samples, ~3x
-// less time; the positions differ by 0.15 px (median) from full-resolution tracking. It is not the
-// default: the teach's keyframes move, and a carry-on repeat through three missing keyframes
-// (KeyframeRecovery.ARepeatCarriesOnByOdometryThroughThreeKeyframesGone) then ended 3 m early
-// (docs/results.md, Teach speed).
+// (the pyramids are ~3% of it). finest_level 1, the default, tracks on the half-resolution image
+// with the window halved: the same 31 pixels of the full image around each point, a quarter of the
+// samples, ~3x less time; the positions differ by 0.15 px (median) from full-resolution tracking.
+// finest_level 0 is the paper's tracker bit for bit (docs/results.md, Teach speed).
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -21,7 +19,7 @@ struct KltOptions {
   int pyramid_levels = 3;  // levels above the full image; the coarsest is 1/8 of its size
   // The finest level tracked: 0 (the default) = the full image; 1 = the half-resolution image, the
   // window halved (15 px there for 31), positions rescaled to the full image.
-  int finest_level = 0;
+  int finest_level = 1;
   double max_forward_backward_px = 1.0;  // reject if tracking back misses the start by more (px
                                          // of the full image)
   int max_iterations = 30;

@@ -47,26 +47,66 @@ void MarkUsed(std::vector<ExperienceView>* views, const ViewChoice& choice, int 
   used = std::max(used, visit);
 }
 
-void LearnView(std::vector<ExperienceView>* views, const ViewChoice& choice,
-               features::Features current, int visit, const ExperienceOptions& options) {
-  MAPLESS_CHECK(choice.view >= 0, "LearnView: the visit was not localized against any view");
-  MarkUsed(views, choice, visit);
-  if (static_cast<int>(views->size()) >= options.max_views) {
-    if (views->size() <= 1) return;  // max_views 1: the taught view only
-    // The learned view used least recently, then the oldest: it makes room.
-    const auto victim = std::min_element(views->begin() + 1, views->end(),
-                                         [](const ExperienceView& a, const ExperienceView& b) {
+namespace {
+
+// While `max_learned` or more learned views stand from `first_learned` on, the one used least
+// recently (then the oldest) makes room.
+template <typename View>
+void MakeRoom(std::vector<View>* views, std::size_t first_learned, int max_learned) {
+  while (views->size() > first_learned &&
+         static_cast<int>(views->size() - first_learned) >= max_learned) {
+    const auto victim = std::min_element(views->begin() + static_cast<long>(first_learned),
+                                         views->end(), [](const View& a, const View& b) {
                                            return std::make_pair(a.last_used, a.learned_at) <
                                                   std::make_pair(b.last_used, b.learned_at);
                                          });
     views->erase(victim);
   }
+}
+
+}  // namespace
+
+void LearnView(std::vector<ExperienceView>* views, const ViewChoice& choice,
+               features::Features current, int visit, const ExperienceOptions& options) {
+  MAPLESS_CHECK(choice.view >= 0, "LearnView: the visit was not localized against any view");
+  MarkUsed(views, choice, visit);
+  if (options.max_views <= 1) return;  // the taught view only
+  MakeRoom(views, 1, options.max_views - 1);
   ExperienceView view;
   view.features = std::move(current);
   view.offset_px = choice.taught_dx_px;
   view.learned_at = visit;
   view.last_used = visit;
   views->push_back(std::move(view));
+}
+
+int ApplyVisit(route::Route* route, const std::vector<int>& used_views,
+               std::vector<LearnedView> learned, const ExperienceOptions& options) {
+  options.Validate();
+  const int visit = ++route->visits;
+  auto& kfs = route->keyframes;
+  for (std::size_t k = 0; k < kfs.size() && k < used_views.size(); ++k) {
+    const int v = used_views[k] - 1;
+    if (v >= 0 && v < static_cast<int>(kfs[k].views.size()))
+      kfs[k].views[static_cast<std::size_t>(v)].last_used = visit;
+  }
+  int added = 0;
+  for (LearnedView& l : learned) {
+    MAPLESS_CHECK(l.keyframe >= 0 && l.keyframe < static_cast<int>(kfs.size()),
+                  "ApplyVisit: keyframe " << l.keyframe << " is not on the route");
+    if (options.max_views <= 1) continue;
+    auto& views = kfs[static_cast<std::size_t>(l.keyframe)].views;
+    MakeRoom(&views, 0, options.max_views - 1);
+    route::KeyframeView view;
+    view.keypoints = std::move(l.features.keypoints);
+    view.descriptors = l.features.descriptors;
+    view.offset_px = l.offset_px;
+    view.learned_at = visit;
+    view.last_used = visit;
+    views.push_back(std::move(view));
+    ++added;
+  }
+  return added;
 }
 
 }  // namespace mapless::navigation

@@ -17,6 +17,7 @@
 
 #include "mapless/features/features.h"
 #include "mapless/features/shift.h"
+#include "mapless/route/route.h"
 
 namespace mapless::navigation {
 
@@ -61,5 +62,21 @@ void MarkUsed(std::vector<ExperienceView>* views, const ViewChoice& choice, int 
 // taught view (index 0) always stays.
 void LearnView(std::vector<ExperienceView>* views, const ViewChoice& choice,
                features::Features current, int visit, const ExperienceOptions& options);
+
+// A view a repeat learned (RepeatOptions::learn): the keyframe, the frame's features, the offset
+// the repeat measured (x in the frame - x in the taught view: the median over its matches).
+struct LearnedView {
+  int keyframe = 0;
+  features::Features features;
+  double offset_px = 0.0;
+  std::string why;
+};
+
+// One repeat's visit of a route: route->visits + 1; the view each keyframe was steered by
+// (`used_views`, RepeatSession::used_views(): 0 the taught one, i + 1 learned view i, -1 none)
+// marked used at it; the learned views added, the least recently useful learned view making room
+// when a keyframe has options.max_views. Returns the number of views added.
+int ApplyVisit(route::Route* route, const std::vector<int>& used_views,
+               std::vector<LearnedView> learned, const ExperienceOptions& options);
 
 }  // namespace mapless::navigation

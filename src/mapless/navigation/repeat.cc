@@ -58,6 +58,7 @@ const char* RepeatStatusName(RepeatStatus s) {
 }
 
 void RepeatOptions::Validate() const {
+  experiences.Validate();
   MAPLESS_CHECK(route_end_margin_m >= 0.0,
                 "RepeatOptions.route_end_margin_m = " << route_end_margin_m << "; must be >= 0");
   features.Validate();
@@ -92,6 +93,8 @@ void RepeatOptions::Validate() const {
   MAPLESS_CHECK(recovery_time_factor > 0.0,
                 "RepeatOptions.recovery_time_factor = " << recovery_time_factor << "; must be > 0");
   carry_on.Validate();
+  MAPLESS_CHECK(carry_on_reach_factor > 0.0, "RepeatOptions.carry_on_reach_factor = "
+                                                 << carry_on_reach_factor << "; must be > 0");
   MAPLESS_CHECK(carry_on_keyframes >= 0,
                 "RepeatOptions.carry_on_keyframes = " << carry_on_keyframes << "; must be >= 0");
   MAPLESS_CHECK(recovery_min_features >= 2, "RepeatOptions.recovery_min_features = "
@@ -121,14 +124,28 @@ RepeatSession::RepeatSession(std::shared_ptr<const route::Route> route, RepeatOp
                 "RepeatSession: the route was taught with '"
                     << route_->detector << "' features but the repeat uses '"
                     << features::DetectorTypeName(options_.features.type) << "'");
-  for (const auto& kf : route_->keyframes) {
-    features::Features f;
-    f.keypoints = kf.keypoints;
-    f.descriptors = kf.descriptors;
-    f.binary = options_.features.type != features::DetectorType::kSift;
-    keyframe_features_.push_back(std::move(f));
-  }
+  for (const auto& kf : route_->keyframes) AddKeyframeFeatures(kf);
   cx_ = 0.5 * (route_->image_width - 1);
+}
+
+void RepeatSession::AddKeyframeFeatures(const route::Keyframe& kf) {
+  const bool binary = options_.features.type != features::DetectorType::kSift;
+  features::Features f;
+  f.keypoints = kf.keypoints;
+  f.descriptors = kf.descriptors;
+  f.binary = binary;
+  keyframe_features_.push_back(std::move(f));
+  std::vector<View> views;
+  for (const route::KeyframeView& v : kf.views) {
+    View view;
+    view.features.keypoints = v.keypoints;
+    view.features.descriptors = v.descriptors;
+    view.features.binary = binary;
+    view.offset_px = v.offset_px;
+    views.push_back(std::move(view));
+  }
+  learned_views_.push_back(std::move(views));
+  chosen_view_.push_back(-1);
 }
 
 void RepeatSession::Extend(std::shared_ptr<const route::Route> route) {
@@ -137,13 +154,8 @@ void RepeatSession::Extend(std::shared_ptr<const route::Route> route) {
                     route->image_width == route_->image_width &&
                     route->image_height == route_->image_height,
                 "RepeatSession::Extend: not a continuation of the route");
-  for (std::size_t i = keyframe_features_.size(); i < route->keyframes.size(); ++i) {
-    features::Features f;
-    f.keypoints = route->keyframes[i].keypoints;
-    f.descriptors = route->keyframes[i].descriptors;
-    f.binary = options_.features.type != features::DetectorType::kSift;
-    keyframe_features_.push_back(std::move(f));
-  }
+  for (std::size_t i = keyframe_features_.size(); i < route->keyframes.size(); ++i)
+    AddKeyframeFeatures(route->keyframes[i]);
   route_ = std::move(route);
 }
 
@@ -158,11 +170,39 @@ std::vector<control::FeaturePair> RepeatSession::Pairs() const {
 
 void RepeatSession::MatchKeyframe(int k, std::vector<cv::Point2f>* current_px,
                                   std::vector<cv::Point2f>* keyframe_px,
-                                  std::vector<cv::Point2f>* descriptor_matched) const {
-  const auto& kf = keyframe_features_[static_cast<std::size_t>(k)];
+                                  std::vector<cv::Point2f>* descriptor_matched) {
+  const auto index = static_cast<std::size_t>(k);
+  const int views = 1 + static_cast<int>(learned_views_[index].size());
+  int& chosen = chosen_view_[index];
+  if (views == 1 ||
+      (chosen >= 0 && k == destination_ && last_matches_ >= options_.recovery_min_features)) {
+    MatchView(k, std::max(0, chosen), current_px, keyframe_px, descriptor_matched);
+    return;
+  }
+  // Every view; the one with the most matches (ties: the older) is steered by.
+  int best = -1;
+  std::vector<cv::Point2f> cur, kp, scene;
+  for (int v = 0; v < views; ++v) {
+    MatchView(k, v, &cur, &kp, &scene);
+    if (best >= 0 && cur.size() <= current_px->size()) continue;
+    best = v;
+    *current_px = cur;
+    *keyframe_px = kp;
+    if (descriptor_matched != nullptr) *descriptor_matched = scene;
+  }
+  chosen = best;
+}
+
+void RepeatSession::MatchView(int k, int v, std::vector<cv::Point2f>* current_px,
+                              std::vector<cv::Point2f>* keyframe_px,
+                              std::vector<cv::Point2f>* descriptor_matched) const {
+  const auto index = static_cast<std::size_t>(k);
+  const View* view = v > 0 ? &learned_views_[index][static_cast<std::size_t>(v - 1)] : nullptr;
+  const auto& kf = view != nullptr ? view->features : keyframe_features_[index];
+  const float offset = view != nullptr ? static_cast<float>(view->offset_px) : 0.0f;
   features::MatchOptions matching = options_.matching;
   if (options_.guided_window_px > 0.0 && have_expected_dx_ && k == destination_) {
-    matching.expected_dx_px = expected_dx_;
+    matching.expected_dx_px = expected_dx_ - offset;  // x_current - x in this view
     matching.max_ddx_px = options_.guided_window_px;
   }
   const std::vector<cv::DMatch> matches = features::MatchFeatures(current_, kf, matching);
@@ -170,7 +210,9 @@ void RepeatSession::MatchKeyframe(int k, std::vector<cv::Point2f>* current_px,
   keyframe_px->clear();
   for (const auto& m : matches) {
     current_px->push_back(current_.keypoints[static_cast<std::size_t>(m.queryIdx)].pt);
-    keyframe_px->push_back(kf.keypoints[static_cast<std::size_t>(m.trainIdx)].pt);
+    cv::Point2f p = kf.keypoints[static_cast<std::size_t>(m.trainIdx)].pt;
+    p.x -= offset;  // into the taught view's pixels
+    keyframe_px->push_back(p);
   }
   if (descriptor_matched != nullptr) *descriptor_matched = *current_px;
   // Outlier rejection: matches must agree with one epipolar geometry, or, for a rotation in place
@@ -206,6 +248,7 @@ void RepeatSession::DetectAndMatch(const cv::Mat& grey, RepeatStep* step) {
   current_ = extractor_.Extract(grey);
   MatchKeyframe(destination_, &current_px_, &destination_px_, &scene_px_);
   last_matches_ = static_cast<int>(current_px_.size());
+  step->view = std::max(0, chosen_view_[static_cast<std::size_t>(destination_)]);
   step->redetected = true;
   frames_since_detect_ = 0;
 }
@@ -425,6 +468,24 @@ bool RepeatSession::HoldOrCarryOn(Timestamp t_ns, bool short_long, RepeatStep* s
   return false;
 }
 
+void RepeatSession::MaybeLearn(RepeatStep* step) {
+  if (frames_since_detect_ != 0 || current_.keypoints.empty() || current_px_.empty()) return;
+  ViewChoice choice;
+  choice.view = std::max(0, chosen_view_[static_cast<std::size_t>(destination_)]);
+  choice.shift.ok = true;
+  choice.shift.inliers = last_matches_;
+  const auto why = WhyLearn(choice, options_.experiences);
+  if (!why) return;
+  LearnedView learned;
+  learned.keyframe = destination_;
+  learned.features = current_;
+  learned.offset_px = MedianDx(destination_px_, current_px_);
+  learned.why = "keyframe " + std::to_string(destination_) + ": " + *why;
+  step->learned = destination_;
+  step->learned_why = learned.why;
+  learned_.push_back(std::move(learned));
+}
+
 bool RepeatSession::SwitchSegment(const cv::Mat& grey, Timestamp t_ns,
                                   std::vector<control::FeaturePair>* pairs, RepeatStep* step) {
   // Line 9: switch to the next segment.
@@ -452,6 +513,7 @@ bool RepeatSession::SwitchSegment(const cv::Mat& grey, Timestamp t_ns,
   const bool switch_now =
       options_.switching != Switching::kMse || by_scale ? switch_votes_ >= confirm : mse_says;
   if (!switch_now) return false;
+  if (options_.learn) MaybeLearn(step);
   step->switched = true;
   MarkSwitch();
   ++destination_;

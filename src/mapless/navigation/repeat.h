@@ -25,6 +25,7 @@
 #include "mapless/features/features.h"
 #include "mapless/features/klt.h"
 #include "mapless/navigation/camera_check.h"
+#include "mapless/navigation/experiences.h"
 #include "mapless/navigation/obstacle_watch.h"
 #include "mapless/route/route.h"
 
@@ -94,9 +95,14 @@ struct RepeatOptions {
   // unmatched keyframe and up to carry_on_keyframes after it, matching each of them every
   // frame; the first that matches becomes the destination and the funnel lane takes over. It
   // gives up after carry_on.max_distance_m (then waits and aborts as before). The obstacle watch
-  // guards the way as always. max_distance_m = 0: off.
+  // guards the way as always. max_distance_m = 0: off. As with recovery, a keyframe k farther
+  // than the next one qualifies only as far as the robot has come: keyframe k - 1 taught at most
+  // carry_on_reach_factor times the robot's odometry displacement since the last switch from
+  // keyframe destination - 1 (straight lines both). Without it a far keyframe of a straight
+  // route, which looks like the near one from afar, could end carrying on metres too early.
   control::TaughtPathOptions carry_on;
   int carry_on_keyframes = 6;
+  double carry_on_reach_factor = 1.25;
   // Guided matching (not in the paper): matches must lie within this many pixels of the
   // horizontal displacement predicted from the previous frame (at a segment switch: the previous
   // displacement minus the teach-time shift between the two keyframes). A repeating texture then
@@ -124,6 +130,14 @@ struct RepeatOptions {
   // teach read from disk); true, the robot waits for the leader that is still teaching it (fleet:
   // see Extend()).
   bool wait_for_leader = false;
+  // Experiences (issue 45; experiences.h): a keyframe with learned views is matched with each at
+  // a new destination and the repeat steers by the one that matches best (its features mapped
+  // into the taught view by the view's offset). With learn, the frame at which the switching
+  // rule says the robot has reached a keyframe becomes a new view of it when its matches with
+  // the view in use are at least experiences.sure_inliers (the place is certain) and fewer than
+  // experiences.changed_inliers (it looks different today). TakeLearned() hands them over.
+  bool learn = false;
+  ExperienceOptions experiences{5, 20, 60};
   void Validate() const;
 };
 
@@ -148,7 +162,10 @@ struct RepeatStep {
   control::LocalScale local_scale;  // measured on the last segment only (end_by_local_scale)
   control::SlopedFunnelLaneResult sloped;
   control::StandardFunnelLaneResult standard;
-  Twist2 command;  // zero unless driving
+  int learned = -1;         // this frame was learned as a view of this keyframe (learn)
+  std::string learned_why;  // ... and why
+  int view = 0;             // the destination's view in use (0: the taught one)
+  Twist2 command;           // zero unless driving
   // The features in use after this frame (debug pictures): in the current image and their matches
   // in the destination keyframe, pixels.
   std::vector<cv::Point2f> current_px;
@@ -169,6 +186,10 @@ class RepeatSession {
   // stops (waiting for the leader) instead of completing, and goes on when the next keyframe
   // arrives; the switching rules are those of a complete route.
   void Extend(std::shared_ptr<const route::Route> route);
+  // The views learned so far (RepeatOptions::learn), handed over once; and the view each keyframe
+  // was last steered by (-1: never a destination), for ApplyVisit (experiences.h).
+  std::vector<LearnedView> TakeLearned() { return std::move(learned_); }
+  const std::vector<int>& used_views() const { return chosen_view_; }
   bool finished() const {
     return status_ == RepeatStatus::kCompleted || status_ == RepeatStatus::kAborted;
   }
@@ -192,16 +213,24 @@ class RepeatSession {
   // rejected: current pixels and keyframe pixels.
   // `descriptor_matched` (optional): every current feature whose descriptor matched keyframe k,
   // before the geometric outlier rejection (the taught scene, for the obstacle watch).
+  // Matches keyframe k: its chosen view, or every view when none is chosen yet or the chosen one
+  // matches too little (the best becomes the chosen one).
   void MatchKeyframe(int k, std::vector<cv::Point2f>* current_px,
                      std::vector<cv::Point2f>* keyframe_px,
-                     std::vector<cv::Point2f>* descriptor_matched = nullptr) const;
+                     std::vector<cv::Point2f>* descriptor_matched = nullptr);
   // Keyframe recovery (RepeatOptions::recovery_keyframes): the nearest following keyframe the
   // robot may have reached that the current frame matches, switched to; false when none does.
   bool Recover(RepeatStep* step);
   // Switches to the nearest keyframe in [first, last] that the current frame matches with at
-  // least recovery_min_features (and min_features); false when none does. `taught_reach_s`
-  // >= 0: only keyframes k whose k - 1 was taught at most that long after the destination.
-  bool SwitchToMatching(int first, int last, double taught_reach_s, RepeatStep* step);
+  // least recovery_min_features (and min_features); false when none does. Only keyframes k whose
+  // k - 1 the robot may have reached: `reach.taught_s` >= 0, taught at most that long after the
+  // keyframe before the destination; `reach.taught_m` >= 0, taught at most that far (odometry,
+  // straight line) from it.
+  struct Reach {
+    double taught_s = -1.0;
+    double taught_m = -1.0;
+  };
+  bool SwitchToMatching(int first, int last, Reach reach, RepeatStep* step);
   // Carrying on (RepeatOptions::carry_on): starts it if it can; the command of this frame, or
   // nullopt when it cannot start or has given up.
   std::optional<Twist2> CarryOn(Timestamp t_ns, RepeatStep* step);
@@ -231,6 +260,22 @@ class RepeatSession {
   ObstacleWatch watch_;
   Twist2 last_command_;
   std::vector<features::Features> keyframe_features_;
+  // Learned views of each keyframe (route::Keyframe::views), and the view chosen for it (0: the
+  // taught one, i + 1: learned view i; -1: not chosen yet).
+  struct View {
+    features::Features features;
+    double offset_px = 0.0;
+  };
+  std::vector<std::vector<View>> learned_views_;
+  std::vector<int> chosen_view_;
+  std::vector<LearnedView> learned_;
+  void AddKeyframeFeatures(const route::Keyframe& kf);
+  // Matches keyframe k's view v (0: the taught one), keyframe points in the taught view's pixels.
+  void MatchView(int k, int v, std::vector<cv::Point2f>* current_px,
+                 std::vector<cv::Point2f>* keyframe_px,
+                 std::vector<cv::Point2f>* descriptor_matched) const;
+  // At a switch: the current frame as a new view of the keyframe reached (RepeatOptions::learn).
+  void MaybeLearn(RepeatStep* step);
   control::MseSwitch mse_;
   double cx_ = 0.0;
   int destination_ = 1;

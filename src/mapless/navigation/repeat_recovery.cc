@@ -39,12 +39,19 @@ void RepeatSession::MarkSwitch() {
   detours_ = 0;
 }
 
-bool RepeatSession::SwitchToMatching(int first, int last, double taught_reach_s, RepeatStep* step) {
+bool RepeatSession::SwitchToMatching(int first, int last, Reach reach, RepeatStep* step) {
   const auto& kfs = route_->keyframes;
   const auto taught_at = [&](int k) { return ToSeconds(kfs[static_cast<std::size_t>(k)].t_ns); };
+  const auto& from = kfs[static_cast<std::size_t>(std::max(0, destination_ - 1))].odometry;
+  const auto taught_m = [&](int k) {
+    const auto& to = kfs[static_cast<std::size_t>(k)].odometry;
+    return from && to ? std::hypot(to->x_m - from->x_m, to->y_m - from->y_m)
+                      : std::numeric_limits<double>::infinity();
+  };
   last = std::min(last, static_cast<int>(kfs.size()) - 1);
   for (int k = first; k <= last; ++k) {
-    if (taught_reach_s >= 0.0 && taught_at(k - 1) - taught_at(destination_) > taught_reach_s) break;
+    if (reach.taught_s >= 0.0 && taught_at(k - 1) - taught_at(destination_) > reach.taught_s) break;
+    if (reach.taught_m >= 0.0 && k - 1 > destination_ && taught_m(k - 1) > reach.taught_m) break;
     std::vector<cv::Point2f> cur, dst, scene;
     MatchKeyframe(k, &cur, &dst, &scene);
     if (static_cast<int>(cur.size()) <
@@ -84,8 +91,10 @@ bool RepeatSession::Recover(RepeatStep* step) {
   // unmatched one always qualifies (the robot is somewhere before the unmatched keyframe, the
   // next one is the next place it can head for), those farther only as far as the robot may
   // have driven since the last switch.
-  return SwitchToMatching(destination_ + 1, destination_ + options_.recovery_keyframes,
-                          options_.recovery_time_factor * driven_since_switch_s_, step);
+  Reach reach;
+  reach.taught_s = options_.recovery_time_factor * driven_since_switch_s_;
+  return SwitchToMatching(destination_ + 1, destination_ + options_.recovery_keyframes, reach,
+                          step);
 }
 
 std::optional<Twist2> RepeatSession::CarryOn(Timestamp t_ns, RepeatStep* step) {
@@ -109,7 +118,11 @@ std::optional<Twist2> RepeatSession::CarryOn(Timestamp t_ns, RepeatStep* step) {
   }
   carry_active_ = true;
   // A following keyframe that matches ends it: the funnel lane takes over.
-  if (SwitchToMatching(destination_ + 1, last, -1.0, step)) return {};
+  Reach reach;
+  reach.taught_m =
+      options_.carry_on_reach_factor *
+      std::hypot(odometry_->x_m - switch_odometry_->x_m, odometry_->y_m - switch_odometry_->y_m);
+  if (SwitchToMatching(destination_ + 1, last, reach, step)) return {};
   const std::optional<Twist2> command = carrying_->Command(*odometry_, RouteSpeed());
   if (!command) {
     // Given up: the robot stops and the abort countdown starts afresh; no second try at this

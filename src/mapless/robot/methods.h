@@ -54,6 +54,8 @@ class RepeatMethod : public Method {
   bool needs_odometry() const override { return false; }
   cv::Size image_size() const override { return size_; }
   Decision Step(const Observation& observation) override;
+  // The session once the route has 2 keyframes (null before): what it learned (experiences).
+  navigation::RepeatSession* session() { return session_ ? &*session_ : nullptr; }
 
  private:
   RouteSource source_;
