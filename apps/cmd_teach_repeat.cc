@@ -12,12 +12,14 @@
 #include "mapless/core/check.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/io/frame_source.h"
+#include "mapless/io/output_dir.h"
 #include "mapless/recording/recording_link.h"
 #include "mapless/robot/methods.h"
 #include "mapless/robot/robot_file.h"
 #include "mapless/route/appearance_store.h"
 #include "mapless/route/route_store.h"
 #include "mapless/run/decision_log.h"
+#include "mapless/run/learn.h"
 #include "mapless/run/link_kinds.h"
 #include "mapless/run/route_info.h"
 #include "mapless/run/sim_episode.h"
@@ -45,6 +47,7 @@ struct RepeatArgs {
   double fps = 10.0;
   std::string robot;
   double speed = 0.2;
+  bool learn = false;
   RecordArgs record;
   recording::PlaybackOptions playback;
 };
@@ -89,6 +92,9 @@ void RepeatOnSim(const RepeatArgs& r, const std::shared_ptr<route::Route>& route
                scenario.name, r.controller, run.status, run.final_error_m, run.lateral_rms_m,
                run.duration_s);
   if (!run.success) throw RunFailed("repeat did not succeed: " + run.status);
+  if (r.learn)
+    spdlog::info("repeat: {}",
+                 run::SaveVisit(r.route, *route, run.used_views, run.learned, options.experiences));
 }
 
 // `mapless repeat`: the funnel-lane repeat on a robot, a recording or the simulator.
@@ -100,6 +106,8 @@ void Repeat(const RepeatArgs& r) {
   if (!r.record.path.empty() && !r.source.empty() && !run::IsSim(r.source))
     throw InputError("--record: records runs on the simulator or a robot; " + r.source +
                      " is played open loop (its decisions are in --log)");
+  // --learn writes into the route: no other process may write it meanwhile.
+  const auto lock = r.learn ? std::make_unique<io::DirectoryLock>(r.route) : nullptr;
   auto route = std::make_shared<route::Route>(route::LoadRoute(r.route));
   if (!route->complete)
     spdlog::warn("repeat: {} is an interrupted teach; repeating its {} keyframes", r.route,
@@ -113,6 +121,7 @@ void Repeat(const RepeatArgs& r) {
   options.carry_on.max_distance_m = r.carry_on_m;
   options.features.type = features::ParseDetectorType(route->detector);
   options.obstacle = ObstacleWatchFor(r.robot, r.on_obstacle, options.obstacle, true);
+  options.learn = r.learn;
   if (!r.robot.empty() || !run::IsSim(r.source)) {
     if (!r.robot.empty()) {
       options.sloped.max_speed_mps = r.speed;
@@ -129,6 +138,10 @@ void Repeat(const RepeatArgs& r) {
     args.size_needed_by = "the route " + r.route + " was taught at";
     args.robot = !r.robot.empty();
     RunOnSource(method, args.robot ? r.robot : r.source, args);
+    if (r.learn && method.session())
+      spdlog::info("repeat: {}",
+                   run::SaveVisit(r.route, *route, method.session()->used_views(),
+                                  method.session()->TakeLearned(), options.experiences));
     return;
   }
   RepeatOnSim(r, route, options);
@@ -187,6 +200,9 @@ static void AddRepeatCommand(CLI::App* app) {
       ->capture_default_str()
       ->check(FiniteIn(0.01, 5.0));
   repeat->add_option("--controller", r->controller, "sloped or standard")->capture_default_str();
+  repeat->add_flag("--learn", r->learn,
+                   "Learn how the route's places look today: views of keyframes whose appearance "
+                   "changed, written into the route when the repeat ends");
   repeat
       ->add_option("--switching", r->switching,
                    "stdratio (Kassir et al.), mse (Chen & Birchfield) or scale (local scale of "

@@ -26,14 +26,20 @@ nlohmann::json RouteInfo(const std::string& dir) {
   }
   const route::Route route = route::LoadRoute(dir);
   std::size_t keypoints = 0;
-  for (const auto& kf : route.keyframes) keypoints += kf.keypoints.size();
+  std::size_t views = 0;
+  for (const auto& kf : route.keyframes) {
+    keypoints += kf.keypoints.size();
+    views += kf.views.size();
+  }
   j = {{"kind", "keyframes"},
        {"keyframes", route.keyframes.size()},
        {"complete", route.complete},
        {"detector", route.detector},
        {"image_width", route.image_width},
        {"image_height", route.image_height},
-       {"keypoints", keypoints}};
+       {"keypoints", keypoints},
+       {"visits", route.visits},
+       {"learned_views", views}};
   // From the first keyframe to the last: a robot's keyframes carry the ROS clock's time.
   j["duration_s"] = route.keyframes.empty()
                         ? 0.0
@@ -49,10 +55,14 @@ std::string RouteInfoLine(const std::string& dir, const nlohmann::json& j) {
                   j["image_height"].get<int>(), j["low_width"].get<int>(),
                   j["low_height"].get<int>(), j["length_m"].get<double>());
   }
-  return Format("%s: %zu keyframes (%s), %s features, %dx%d, %.1f s", dir.c_str(),
+  const int visits = j["visits"].get<int>();
+  const std::string learned = visits == 0 ? ""
+                                          : Format(", %zu learned views over %d repeats",
+                                                   j["learned_views"].get<std::size_t>(), visits);
+  return Format("%s: %zu keyframes (%s), %s features, %dx%d, %.1f s%s", dir.c_str(),
                 j["keyframes"].get<std::size_t>(), state, j["detector"].get<std::string>().c_str(),
                 j["image_width"].get<int>(), j["image_height"].get<int>(),
-                j["duration_s"].get<double>());
+                j["duration_s"].get<double>(), learned.c_str());
 }
 
 }  // namespace mapless::run

@@ -8,7 +8,8 @@
 namespace mapless::run {
 
 // A keyframe route: kind "keyframes", keyframes, complete, detector, image_width, image_height,
-// keypoints, duration_s (first to last keyframe). An appearance route (teach --method eigenspace):
+// keypoints, visits and learned_views (repeat --learn), duration_s (first to last keyframe). An
+// appearance route (teach --method eigenspace):
 // kind "appearance", images, complete, image_width, image_height, low_width, low_height, length_m.
 // Throws InputError for a route that does not load.
 nlohmann::json RouteInfo(const std::string& dir);

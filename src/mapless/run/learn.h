@@ -1,0 +1,20 @@
+// `mapless repeat --learn` (issue 45): what one repeat learned, written into its route.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mapless/navigation/experiences.h"
+#include "mapless/route/route.h"
+
+namespace mapless::run {
+
+// Applies the visit (navigation::ApplyVisit) to a copy of `route` and writes it into `dir`
+// (route::SaveViews; the caller holds the directory's lock). Returns one line for the log: "route:
+// visit 3, 2 views learned (keyframes 4, 5), 7 views in all".
+std::string SaveVisit(const std::string& dir, const route::Route& route,
+                      const std::vector<int>& used_views,
+                      std::vector<navigation::LearnedView> learned,
+                      const navigation::ExperienceOptions& options);
+
+}  // namespace mapless::run
