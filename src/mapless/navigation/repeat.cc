@@ -128,26 +128,6 @@ RepeatSession::RepeatSession(std::shared_ptr<const route::Route> route, RepeatOp
   cx_ = 0.5 * (route_->image_width - 1);
 }
 
-void RepeatSession::AddKeyframeFeatures(const route::Keyframe& kf) {
-  const bool binary = options_.features.type != features::DetectorType::kSift;
-  features::Features f;
-  f.keypoints = kf.keypoints;
-  f.descriptors = kf.descriptors;
-  f.binary = binary;
-  keyframe_features_.push_back(std::move(f));
-  std::vector<View> views;
-  for (const route::KeyframeView& v : kf.views) {
-    View view;
-    view.features.keypoints = v.keypoints;
-    view.features.descriptors = v.descriptors;
-    view.features.binary = binary;
-    view.offset_px = v.offset_px;
-    views.push_back(std::move(view));
-  }
-  learned_views_.push_back(std::move(views));
-  chosen_view_.push_back(-1);
-}
-
 void RepeatSession::Extend(std::shared_ptr<const route::Route> route) {
   MAPLESS_CHECK(route != nullptr && route->keyframes.size() >= route_->keyframes.size() &&
                     route->detector == route_->detector &&
@@ -166,31 +146,6 @@ std::vector<control::FeaturePair> RepeatSession::Pairs() const {
     pairs.push_back({current_px_[i].x - cx_, destination_px_[i].x - cx_});
   }
   return pairs;
-}
-
-void RepeatSession::MatchKeyframe(int k, std::vector<cv::Point2f>* current_px,
-                                  std::vector<cv::Point2f>* keyframe_px,
-                                  std::vector<cv::Point2f>* descriptor_matched) {
-  const auto index = static_cast<std::size_t>(k);
-  const int views = 1 + static_cast<int>(learned_views_[index].size());
-  int& chosen = chosen_view_[index];
-  if (views == 1 ||
-      (chosen >= 0 && k == destination_ && last_matches_ >= options_.recovery_min_features)) {
-    MatchView(k, std::max(0, chosen), current_px, keyframe_px, descriptor_matched);
-    return;
-  }
-  // Every view; the one with the most matches (ties: the older) is steered by.
-  int best = -1;
-  std::vector<cv::Point2f> cur, kp, scene;
-  for (int v = 0; v < views; ++v) {
-    MatchView(k, v, &cur, &kp, &scene);
-    if (best >= 0 && cur.size() <= current_px->size()) continue;
-    best = v;
-    *current_px = cur;
-    *keyframe_px = kp;
-    if (descriptor_matched != nullptr) *descriptor_matched = scene;
-  }
-  chosen = best;
 }
 
 void RepeatSession::MatchView(int k, int v, std::vector<cv::Point2f>* current_px,
@@ -466,24 +421,6 @@ bool RepeatSession::HoldOrCarryOn(Timestamp t_ns, bool short_long, RepeatStep* s
   expected_dx_ = MedianDx(destination_px_, current_px_);
   have_expected_dx_ = true;
   return false;
-}
-
-void RepeatSession::MaybeLearn(RepeatStep* step) {
-  if (frames_since_detect_ != 0 || current_.keypoints.empty() || current_px_.empty()) return;
-  ViewChoice choice;
-  choice.view = std::max(0, chosen_view_[static_cast<std::size_t>(destination_)]);
-  choice.shift.ok = true;
-  choice.shift.inliers = last_matches_;
-  const auto why = WhyLearn(choice, options_.experiences);
-  if (!why) return;
-  LearnedView learned;
-  learned.keyframe = destination_;
-  learned.features = current_;
-  learned.offset_px = MedianDx(destination_px_, current_px_);
-  learned.why = "keyframe " + std::to_string(destination_) + ": " + *why;
-  step->learned = destination_;
-  step->learned_why = learned.why;
-  learned_.push_back(std::move(learned));
 }
 
 bool RepeatSession::SwitchSegment(const cv::Mat& grey, Timestamp t_ns,

@@ -23,6 +23,11 @@ void RepeatDetail::Fields(nlohmann::json* j) const {
   if (s.recovered_from >= 0) (*j)["recovered_from"] = s.recovered_from;
   if (s.carrying_on) (*j)["carrying_on"] = true;
   if (s.avoiding) (*j)["avoiding"] = true;
+  if (s.view > 0) (*j)["view"] = s.view;  // a learned view of the destination (experiences)
+  if (s.learned >= 0) {
+    (*j)["learned"] = s.learned;
+    (*j)["learned_why"] = s.learned_why;
+  }
   (*j)["std_ratio"] = s.switching.std_ratio;
   (*j)["ed_px"] = s.switching.ed_px;
   if (s.local_scale.ok) (*j)["local_scale"] = s.local_scale.ratio;
