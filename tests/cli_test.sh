@@ -175,6 +175,12 @@ section_localize_eval() {
   expect_exit "localize with a bad method exits 2" 2 "$MAPLESS" localize --database "$NL/summer" --query "$NL/winter" --localizer best
   grep -q "'best' is unknown" "$TMP/err"; check "localize names the bad method" $?
 
+  # eval experiences (issue 45) on the bundled Stromovka subset: two places, sessions 01, 06, 12.
+  expect_exit "eval experiences --json" 0 "$MAPLESS" eval experiences --sessions "$HERE/data/stromovka" --json
+  grep -Eq '"single_fraction":[0-9.]+' "$TMP/out" && grep -Eq '"experiences_fraction":[0-9.]+' "$TMP/out" && [ "$(grep -o '"place":' "$TMP/out" | wc -l)" -eq 2 ]; check "eval experiences: both fractions, one row per place" $?
+  expect_exit "eval experiences on a folder without offsets.txt exits 2" 2 "$MAPLESS" eval experiences --sessions "$NL/summer"
+  grep -q "$NL/summer/offsets.txt" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "eval experiences names the missing offsets.txt in one line" $?
+
   expect_exit "eval eigenspace with an unknown scenario exits 2" 2 "$MAPLESS" eval eigenspace --only nowhere --runs 1
   grep -q "'nowhere': not a scenario of suite eigenspace" "$TMP/err"; check "eval eigenspace names the unknown scenario" $?
   expect_exit "eval with an unknown switching rule exits 2" 2 "$MAPLESS" eval table1 --runs 1 --switching sideways
@@ -289,6 +295,7 @@ section_bench() {
   grep -q '"sim_render_320x240_ms":[0-9.]*' "$TMP/out" && grep -q '"opencv_dis_fast_320x240_ms"' "$TMP/out"; check "bench JSON has the render stage and DIS reference" $?
   grep -q '"dominant_plane_step_ms":[0-9.]*' "$TMP/out" && grep -q '"opencv_dis_fast_ground_320x240_ms"' "$TMP/out"; check "bench JSON has the potential step and its DIS reference" $?
   grep -q '"repeat_step_default_over_orb_interleaved":[0-9.]*' "$TMP/out" && grep -q '"orb_detector_over_opencv_same_settings":[0-9.]*' "$TMP/out"; check "bench JSON has the default step against ORB-500 timed after each step, and OrbDetector against OpenCV's ORB" $?
+  grep -Eq '"repeat_step_5_views_over_1":[0-9.]+' "$TMP/out"; check "bench JSON has the step with 5 views against 1 (issue 45)" $?
   [ "$(wc -l <"$TMP/out")" -eq 1 ]; check "bench JSON is one line" $?
 }
 

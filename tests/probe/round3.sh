@@ -148,6 +148,7 @@ r3teach=$!
 wait_until 120 "$r3teach" test -f "$NEW/r3teaching/keyframes/000001.yml"
 probe "a leader on a route a teach is writing" 2 "r3teaching: another mapless process is writing" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/r3teaching" --bind tcp://127.0.0.1:1
 probe "a follower copying into a route a teach is writing" 2 "r3teaching: another mapless process is writing" -- "$MAPLESS" follow --connect tcp://127.0.0.1:1 --source sim:table1_almost_straight --route "$NEW/r3teaching"
+probe "a learning repeat on a route a teach is writing" 2 "r3teaching: another mapless process is writing" -- "$MAPLESS" repeat --learn --route "$NEW/r3teaching" --source sim:table1_almost_straight
 kill -INT "$r3teach"; wait "$r3teach" 2>/dev/null
 [ -s "$NEW/r3two.jsonl" ]; check "the first run's log is whole after the second was refused" $?
 

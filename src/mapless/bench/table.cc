@@ -122,6 +122,11 @@ void PrintStageTable(const nlohmann::json& j) {
   std::printf("%-34s %10.2f  (issue 44: <= 1.5; ORB-500 timed after each step)\n",
               "repeat_step_with_watch / orb500 int.",
               j["repeat_step_default_with_watch_over_orb_interleaved"].get<double>());
+  if (j.contains("repeat_step_5_views_over_1")) {
+    std::printf("%-34s %10.2f  (issue 45: <= 1.3; mean %.2f)\n", "repeat_step 5 views / 1 view",
+                j["repeat_step_5_views_over_1"].get<double>(),
+                j["repeat_step_5_views_over_1_mean"].get<double>());
+  }
   std::printf("%-34s %10.2f  (same keypoints and descriptors)\n",
               "orb_detector / opencv same settings",
               j["orb_detector_over_opencv_same_settings"].get<double>());

@@ -100,6 +100,58 @@ TEST(RepeatSession, ReplayingTheTaughtFramesPassesEveryKeyframe) {
   EXPECT_GE(last_destination, static_cast<int>(route->keyframes.size()) - 2);
 }
 
+// Experiences (issue 45): a keyframe whose taught view no longer matches but a learned view does
+// is steered by the learned one (its keypoints mapped back by its offset); with learn, frames at
+// the switches become views with small offsets on the taught drive itself.
+TEST(RepeatSession, ALearnedViewStandsInForATaughtViewThatNoLongerMatches) {
+  const auto taught = Teach(TeachOptions{});
+  auto route = std::make_shared<route::Route>(*taught);
+  ASSERT_GE(route->keyframes.size(), 4u);
+  route::Keyframe& kf = route->keyframes[2];
+  route::KeyframeView view;
+  view.keypoints = kf.keypoints;
+  for (auto& k : view.keypoints) k.pt.x += 8.0f;
+  view.descriptors = kf.descriptors.clone();
+  view.offset_px = 8.0;
+  view.learned_at = view.last_used = 1;
+  kf.views.push_back(view);
+  route->visits = 1;
+  kf.descriptors = kf.descriptors.clone();
+  cv::RNG(7).fill(kf.descriptors, cv::RNG::UNIFORM, 0, 256);  // the taught view is gone
+  RepeatOptions options;
+  options.learn = true;
+  options.experiences.changed_inliers = 100000;  // every sure switch learns
+  RepeatSession session(route, options);
+  const Drive& d = TaughtFrames();
+  int last_destination = 1;
+  bool steered_by_view = false;
+  for (std::size_t i = 0; i < d.frames.size() && !session.finished(); ++i) {
+    const RepeatStep step = session.Update(d.frames[i], d.t_ns[i]);
+    if (step.destination == 2 && step.redetected) {
+      EXPECT_EQ(step.view, 1);
+      steered_by_view |= step.view == 1 && step.matches >= options.min_features;
+    }
+    last_destination = step.destination;
+  }
+  EXPECT_TRUE(steered_by_view);
+  EXPECT_GE(last_destination, static_cast<int>(route->keyframes.size()) - 2);
+  EXPECT_EQ(session.used_views()[2], 1);
+  std::vector<LearnedView> learned = session.TakeLearned();
+  ASSERT_GE(learned.size(), 2u);
+  for (const auto& l : learned) {
+    EXPECT_LT(std::abs(l.offset_px), 10.0) << "keyframe " << l.keyframe;
+    EXPECT_NE(l.why.find("keyframe " + std::to_string(l.keyframe)), std::string::npos);
+  }
+  // The visit written into the route: views added, the view used at keyframe 2 marked.
+  const std::size_t before = route->keyframes[2].views.size();
+  ApplyVisit(route.get(), session.used_views(), learned, options.experiences);
+  EXPECT_EQ(route->visits, 2);
+  EXPECT_EQ(route->keyframes[2].views[0].last_used, 2);
+  std::size_t views = 0;
+  for (const auto& k : route->keyframes) views += k.views.size();
+  EXPECT_EQ(views, before + learned.size());
+}
+
 TEST(RepeatSession, TheLocalScaleDecidesTheEndOrEveryKeyframe) {
   const auto route = Teach(TeachOptions{});
   const int last = static_cast<int>(route->keyframes.size()) - 1;
