@@ -7,12 +7,12 @@
 #include "mapless/core/check.h"
 
 namespace mapless::navigation {
-namespace {
 
 // Upper median of b.x - a.x over pairs (0 when empty). Not control::Median, which averages the two
 // middle values of an even count: the loop scenario's measured 5/10 was made with this one and
 // is on the edge (2/10 with the averaged median).
-double MedianDx(const std::vector<cv::Point2f>& a, const std::vector<cv::Point2f>& b) {
+double RepeatSession::MedianDx(const std::vector<cv::Point2f>& a,
+                               const std::vector<cv::Point2f>& b) {
   std::vector<double> d;
   d.reserve(a.size());
   for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) d.push_back(b[i].x - a[i].x);
@@ -21,8 +21,6 @@ double MedianDx(const std::vector<cv::Point2f>& a, const std::vector<cv::Point2f
   std::nth_element(d.begin(), mid, d.end());
   return *mid;
 }
-
-}  // namespace
 
 Controller ParseController(const std::string& name) {
   if (name == "sloped") return Controller::kSloped;

@@ -276,6 +276,9 @@ class RepeatSession {
                  std::vector<cv::Point2f>* descriptor_matched) const;
   // At a switch: the current frame as a new view of the keyframe reached (RepeatOptions::learn).
   void MaybeLearn(RepeatStep* step);
+  // Upper median of b.x - a.x over the pairs (0 when empty); repeat.cc says why not the average
+  // of the two middle values.
+  static double MedianDx(const std::vector<cv::Point2f>& a, const std::vector<cv::Point2f>& b);
   control::MseSwitch mse_;
   double cx_ = 0.0;
   int destination_ = 1;

@@ -9,21 +9,6 @@
 
 namespace mapless::navigation {
 
-namespace {
-
-// The median of b.x - a.x over the pairs (0 for none): a learned view's offset.
-double MedianXOffset(const std::vector<cv::Point2f>& a, const std::vector<cv::Point2f>& b) {
-  std::vector<double> d;
-  d.reserve(a.size());
-  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) d.push_back(b[i].x - a[i].x);
-  if (d.empty()) return 0.0;
-  const auto mid = d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2);
-  std::nth_element(d.begin(), mid, d.end());
-  return *mid;
-}
-
-}  // namespace
-
 void RepeatSession::AddKeyframeFeatures(const route::Keyframe& kf) {
   const bool binary = options_.features.type != features::DetectorType::kSift;
   features::Features f;
@@ -80,7 +65,7 @@ void RepeatSession::MaybeLearn(RepeatStep* step) {
   LearnedView learned;
   learned.keyframe = destination_;
   learned.features = current_;
-  learned.offset_px = MedianXOffset(destination_px_, current_px_);
+  learned.offset_px = MedianDx(destination_px_, current_px_);
   learned.why = "keyframe " + std::to_string(destination_) + ": " + *why;
   step->learned = destination_;
   step->learned_why = learned.why;
