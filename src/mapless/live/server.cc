@@ -75,6 +75,8 @@ struct Server::Impl {
   std::unique_ptr<asio::steady_timer> timer;
   std::thread thread;
   Timestamp last_t_ns = 0;
+  // A frame has gone out (its time can be 0: the simulator's first frame is at t = 0).
+  bool had_frame = false;
   int ticks = 0;
   // Tells a client that reconnects whether this is the server it saw before.
   std::string session_id = std::to_string(std::chrono::system_clock::now().time_since_epoch() /
@@ -214,7 +216,7 @@ void Server::Impl::Message(Hdl h, WsServer::message_ptr msg) {
     SendText(h, StatusJson(1, refused));
   }
   // Before the first frame, the first frame's messages bring the route.
-  if (request.kind != ClientRequest::Kind::kSubscribe || last_t_ns == 0) return;
+  if (request.kind != ClientRequest::Kind::kSubscribe || !had_frame) return;
   for (const Outgoing& o : feed->Latched(last_t_ns)) {
     for (const auto& [sub, channel] : request.subscriptions) {
       if (channel != o.channel_id) continue;
@@ -238,6 +240,7 @@ void Server::Impl::Flush() {
   if (!frame) return;
   std::vector<Outgoing> messages = feed->Messages(*frame);
   last_t_ns = std::max<Timestamp>(frame->observation.t_ns, 0);
+  had_frame = true;
   std::uint64_t sent = 0, dropped = 0;
   const std::string time = TimeFrame(static_cast<std::uint64_t>(last_t_ns));
   for (auto& [h, c] : clients) {

@@ -210,6 +210,29 @@ TEST(LiveServer, ASubscriberGetsEveryChannelWithTheRunsTimestamps) {
   EXPECT_GT(server->stats().messages_sent, 0u);
 }
 
+// The simulator's first frame is at time 0: a client that subscribes after it still gets the route
+// and the path so far (CI once recorded a run without its route: 0 was taken for "no frame yet").
+TEST(LiveServer, AClientThatSubscribesAfterAFrameAtTimeZeroGetsTheRoute) {
+  ServerOptions defaults;
+  auto server = AServer(defaults);
+  FrameView first = AFrame(0);
+  first.observation.t_ns = 0;
+  server->Offer(first);
+  std::this_thread::sleep_for(200ms);  // the frame goes out to nobody
+  TestClient c(server->port(), kSubprotocolSdk);
+  ASSERT_TRUE(c.Opened());
+  c.SubscribeAll();
+  auto got_route = [&] {
+    for (const std::string& b : c.binaries()) {
+      std::uint32_t sub = 0;
+      if (b.size() >= 5 && b[0] == 1) std::memcpy(&sub, b.data() + 1, 4);
+      if (sub == 100 + kRouteChannel) return true;
+    }
+    return false;
+  };
+  EXPECT_TRUE(c.Wait(got_route)) << c.binaries().size() << " messages, none on the route";
+}
+
 TEST(LiveServer, BadInputIsAnsweredLoggedOnceAndChangesNothing) {
   std::vector<std::string> log;
   std::mutex log_mu;
