@@ -36,8 +36,6 @@ Pose2 ParsePoseDeg(const std::string& text, const std::string& option);
 // naming the value.
 bool ParseEndByLocalScale(const std::string& end);
 
-// A journal of JSON lines: each line is flushed as it is written, so an interrupted run keeps every
-// complete line.
 // Decision logs, one JSON object per line. To a file, each line is a journal record
 // (io/journal.h): a run killed at any moment leaves every line it finished, whole.
 class JsonLines {
@@ -55,10 +53,9 @@ class JsonLines {
 // Options of a simulated run, read from --config FILE (see config/default.yaml).
 sim::DriveOptions LoadDriveOptions(const std::string& config_path);
 
-// Drives the scenario's taught path and writes into DIR (new or empty: see io::OutputDirectory)
-// DIR/frames/NNNNNN.png, DIR/frames.csv,
-// DIR/groundtruth.tum, DIR/odometry.tum, DIR/topdown.png and DIR/summary.json (each file written
-// atomically; frames as they are rendered, so an interrupted run keeps every complete frame).
+// Drives the scenario's taught path and writes into DIR (new or empty: io::OutputDirectory)
+// frames/NNNNNN.png, frames.csv, groundtruth.tum, odometry.tum, topdown.png and summary.json (each
+// file atomically; frames as they are rendered: an interrupted run keeps every complete frame).
 sim::DriveSummary DriveToDirectory(const sim::Scenario& scenario, const sim::DriveOptions& options,
                                    const std::string& out_dir);
 

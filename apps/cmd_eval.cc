@@ -27,7 +27,7 @@ struct SuiteArgs {
 };
 
 // The options every simulator suite has.
-void AddSuiteOptions(CLI::App* cmd, SuiteArgs* a) {
+void AddSuiteOptions(CLI::App* cmd, SuiteArgs* a, bool report = true) {
   cmd->add_option("--runs", a->suite.runs, "Repeats per scenario and controller")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
@@ -39,15 +39,20 @@ void AddSuiteOptions(CLI::App* cmd, SuiteArgs* a) {
       ->capture_default_str()
       ->check(CLI::Range(1, 64));
   cmd->add_option("--only", a->suite.only, "Evaluate only this scenario of the suite");
-  cmd->add_option("--report", a->suite.report_dir,
-                  "Write an HTML report (index.html: the results, each scenario from above with "
-                  "every run, the error along the path; the first run's commands over time, its "
-                  "method's plots and chosen frames) and PNG plots into this directory");
+  if (report)
+    cmd->add_option("--report", a->suite.report_dir,
+                    "Write an HTML report (index.html and PNG plots) into this directory");
+}
+
+// The table on stdout, or with --json the JSON there and the table on stderr.
+template <typename Output>
+void Print(const Output& out, bool json) {
+  std::fputs(out.table.c_str(), json ? stderr : stdout);
+  if (json) std::cout << out.json.dump() << "\n";
 }
 
 // Checks the report directory before any work, shows progress on a terminal, runs, prints.
-void RunSuite(const std::string& /*name*/, SuiteArgs a,
-              const std::function<run::SuiteOutput(const run::SuiteOptions&)>& suite) {
+void RunSuite(SuiteArgs a, const std::function<run::SuiteOutput(const run::SuiteOptions&)>& suite) {
   if (!a.suite.report_dir.empty()) {
     RefuseOutputOverInputs(a.suite.report_dir, "--report", {});
     run::CheckReportDir(a.suite.report_dir, "--report");
@@ -63,8 +68,7 @@ void RunSuite(const std::string& /*name*/, SuiteArgs a,
   };
   const run::SuiteOutput out = suite(a.suite);
   progress.reset();
-  std::fputs(out.table.c_str(), a.json ? stderr : stdout);
-  if (a.json) std::cout << out.json.dump() << "\n";
+  Print(out, a.json);
   if (!a.suite.report_dir.empty())
     spdlog::info("eval: report in {}/index.html", a.suite.report_dir);
 }
@@ -118,7 +122,7 @@ void AddRepeatSuite(CLI::App* eval, const std::string& name, const std::string& 
                                      {"recover_keyframes", a->recover_keyframes},
                                      {"on_obstacle", a->on_obstacle},
                                      {"end", a->end}};
-    RunSuite(name, *a, [&](const run::SuiteOptions& o) {
+    RunSuite(*a, [&](const run::SuiteOptions& o) {
       return run::RunRepeatSuite(name, o, base, settings);
     });
   });
@@ -171,12 +175,12 @@ void AddEvalCommand(CLI::App* app) {
   CLI::App* p = eval->add_subcommand(
       "potential", "Ohnishi & Imiya, Section 5: corridors, obstacles, destinations and homing");
   AddSuiteOptions(p, potential.get());
-  p->callback([potential] { RunSuite("potential", *potential, run::RunPotentialSuite); });
+  p->callback([potential] { RunSuite(*potential, run::RunPotentialSuite); });
   auto eigenspace = std::make_shared<SuiteArgs>();
   CLI::App* e = eval->add_subcommand(
       "eigenspace", "Payá et al., Section 5: the appearance route follower on its two routes");
   AddSuiteOptions(e, eigenspace.get());
-  e->callback([eigenspace] { RunSuite("eigenspace", *eigenspace, run::RunEigenspaceSuite); });
+  e->callback([eigenspace] { RunSuite(*eigenspace, run::RunEigenspaceSuite); });
   auto sessions = std::make_shared<std::pair<std::string, bool>>();
   auto views = std::make_shared<eval::ExperiencesEvalOptions>();
   CLI::App* x = eval->add_subcommand(
@@ -187,10 +191,16 @@ void AddEvalCommand(CLI::App* app) {
       ->check(CLI::Range(1, 64));
   x->add_flag("--json", sessions->second, "Print one JSON object (the table goes to stderr)");
   x->callback([sessions, views] {
-    const run::SuiteOutput out = run::RunExperiencesEval(sessions->first, *views);
-    std::fputs(out.table.c_str(), sessions->second ? stderr : stdout);
-    if (sessions->second) std::cout << out.json.dump() << "\n";
+    Print(run::RunExperiencesEval(sessions->first, *views), sessions->second);
   });
+  auto lifelong = std::make_shared<SuiteArgs>();
+  CLI::App* l = eval->add_subcommand(
+      "lifelong", "Routes taught once and repeated on sessions 1..N of a world that changes");
+  AddSuiteOptions(l, lifelong.get(), /*report=*/false);
+  l->add_option("--session-count", lifelong->suite.sessions, "Sessions repeated after the teach's")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100));
+  l->callback([lifelong] { RunSuite(*lifelong, run::RunLifelongSuite); });
   auto fleet = std::make_shared<run::FleetEvalOptions>();
   auto fleet_json = std::make_shared<bool>(false);
   CLI::App* f = eval->add_subcommand(
@@ -206,8 +216,7 @@ void AddEvalCommand(CLI::App* app) {
     o.each_tick = ThrowIfInterrupted;
     o.say = [](const std::string& line) { spdlog::info("{}", line); };
     const run::FleetEvalOutput out = run::RunFleetEval(o);
-    std::fputs(out.table.c_str(), *fleet_json ? stderr : stdout);
-    if (*fleet_json) std::cout << out.json.dump() << "\n";
+    Print(out, *fleet_json);
     if (!out.ok)
       throw RunFailed(
           "eval fleet: a follower failed or its copy differs (logs: rerun with --keep DIR)");

@@ -44,6 +44,8 @@ cmake --build --preset release -j "$jobs"
 # shellcheck disable=SC2086
 check_names tests/release_only_tests.txt $release_only
 scripts=$(ctest --preset release -N -LE unit | sed -n 's/^ *Test *#[0-9]*: //p')
+# The robot links' own GoogleTest cases (label `unit-middleware`): only this build has the links.
+middleware=$(ctest --preset release -N -L '^unit-middleware$' | sed -n 's/^ *Test *#[0-9]*: //p')
 
 asan_build=""
 if [ "${MAPLESS_SKIP_SANITIZERS:-0}" != "1" ]; then
@@ -61,7 +63,7 @@ release_rc=0
 if [ "${MAPLESS_SKIP_SANITIZERS:-0}" = "1" ]; then
   ctest --preset release -j "$jobs" "$@" || release_rc=$?
 else
-  ctest --preset release -j "$jobs" -R "$(as_regex "$scripts"$'\n'"$release_only")" "$@" ||
+  ctest --preset release -j "$jobs" -R "$(as_regex "$scripts"$'\n'"$release_only"$'\n'"$middleware")" "$@" ||
     release_rc=$?
 fi
 

@@ -3,9 +3,11 @@
 // the learned views where they match best.
 #include <gtest/gtest.h>
 
+#include "mapless/eval/lifelong.h"
 #include "mapless/eval/taught_once.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/navigation/experiences.h"
+#include "mapless/sim/sessions.h"
 
 namespace mapless::eval {
 namespace {
@@ -51,6 +53,34 @@ TEST(Experiences, ARepeatWhereThePlaceChangedLearnsViewsAndTheNextRepeatSteersBy
   EXPECT_TRUE(steered_by_learned) << "keyframe " << k;
   ASSERT_GT(second.used_views.size(), static_cast<std::size_t>(k));
   EXPECT_EQ(second.used_views[static_cast<std::size_t>(k)], 1);
+}
+
+// The changing world's sessions in order (eval lifelong, shortened): with the drift of ten
+// sessions a step, each repeat completes and the route grows by the views it learned.
+TEST(Lifelong, ARouteRepeatedOnSessionsOfAChangingWorldLearnsViewsAndCompletesEach) {
+  sim::Scenario scenario = sim::LoadScenario("lifelong_indoor");
+  sim::WorldChange& change = *scenario.sessions;
+  change.brightness *= 10;
+  change.contrast *= 10;
+  change.light_turn_deg *= 10;
+  change.texture *= 10;
+  const TaughtRoute taught =
+      TeachOnSimulator(sim::SessionScenario(scenario, 0), navigation::TeachOptions{});
+  LifelongOptions options;
+  options.sessions = 2;
+  const LifelongRun run = RunLifelong(scenario, taught, options);
+  ASSERT_EQ(run.sessions.size(), 2u);
+  const int taught_views = static_cast<int>(taught.route->keyframes.size());
+  int last_views = taught_views;
+  for (const LifelongSession& s : run.sessions) {
+    std::printf("%s: %s, %d learned, %d views\n", sim::DescribeSession(scenario, s.session).c_str(),
+                s.status.c_str(), s.learned, s.route_views);
+    EXPECT_TRUE(s.success) << s.status;
+    EXPECT_EQ(s.route_views, last_views + s.learned) << "session " << s.session;
+    last_views = s.route_views;
+  }
+  EXPECT_GT(run.route_views, taught_views);
+  EXPECT_TRUE(run.all_succeeded());
 }
 
 }  // namespace

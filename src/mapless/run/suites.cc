@@ -9,11 +9,13 @@
 
 #include "mapless/core/check.h"
 #include "mapless/eval/eigenspace.h"
+#include "mapless/eval/lifelong.h"
 #include "mapless/eval/potential.h"
 #include "mapless/eval/suite.h"
 #include "mapless/run/report.h"
 #include "mapless/run/text.h"
 #include "mapless/run/traces.h"
+#include "mapless/sim/sessions.h"
 
 namespace mapless::run {
 
@@ -310,6 +312,115 @@ SuiteOutput RunExperiencesEval(const std::string& sessions_dir,
       "it\n"
       "learned its views; learned: views learned; within: ... whose stored offset is within it\n",
       f.tolerance_px);
+  return out;
+}
+
+namespace {
+
+// One scenario and mode of `eval lifelong`: its runs' sessions summed up.
+nlohmann::json LifelongRowJson(const std::string& scenario, bool learn,
+                               const std::vector<eval::LifelongRun>& runs, int sessions,
+                               std::string* table) {
+  int successes = 0;
+  double views = 0.0;
+  double features = 0.0;
+  for (const auto& r : runs) {
+    successes += r.all_succeeded() ? 1 : 0;
+    views += r.route_views;
+    features += r.route_features;
+  }
+  const double n = static_cast<double>(runs.size());
+  nlohmann::json row = {{"scenario", scenario},
+                        {"learn", learn},
+                        {"runs", runs.size()},
+                        {"successes", successes},
+                        {"route_views", views / n},
+                        {"route_features", features / n},
+                        {"per_session", nlohmann::json::array()}};
+  std::string line = Format("%-18s %-11s %4d/%-3zu", scenario.c_str(),
+                            learn ? "experiences" : "single", successes, runs.size());
+  double first_rms = 0.0;
+  double ratio_max = 0.0;
+  for (int s = 1; s <= sessions; ++s) {
+    int ok = 0;
+    int learned = 0;
+    double sum_sq = 0.0;
+    for (const auto& r : runs) {
+      const eval::LifelongSession& x = r.sessions[static_cast<std::size_t>(s - 1)];
+      ok += x.success ? 1 : 0;
+      learned += x.learned;
+      sum_sq += x.lateral_rms_m * x.lateral_rms_m;
+    }
+    const double rms = std::sqrt(sum_sq / n);
+    if (s == 1) first_rms = rms;
+    if (first_rms > 0.0) ratio_max = std::max(ratio_max, rms / first_rms);
+    row["per_session"].push_back(
+        {{"session", s}, {"successes", ok}, {"lateral_rms_m", rms}, {"learned", learned}});
+    line += Format(" %2d", ok);
+  }
+  row["lateral_rms_m_session1"] = first_rms;
+  row["lateral_rms_ratio_max"] = ratio_max;
+  *table += line + Format("  %5.2f %6.1f %8.0f\n", ratio_max, views / n, features / n);
+  return row;
+}
+
+}  // namespace
+
+SuiteOutput RunLifelongSuite(const SuiteOptions& options) {
+  const int sessions = options.sessions;
+  std::vector<std::string> names;
+  for (const auto& name : eval::LifelongScenarioNames())
+    if (options.only.empty() || options.only == name) names.push_back(name);
+  if (names.empty() && !options.only.empty()) names.push_back(options.only);  // a file or another
+  std::vector<sim::Scenario> scenarios;
+  for (const auto& name : names) {
+    scenarios.push_back(sim::LoadScenario(name));
+    (void)sim::SessionScenario(scenarios.back(), 0);  // refuses a scenario without sessions
+  }
+  // Each scenario taught on session 0 (clean, once), then every run in both modes.
+  std::vector<eval::TaughtRoute> taught(scenarios.size());
+  SuiteOptions quiet = options;
+  quiet.on_start = nullptr;
+  quiet.on_entry_done = nullptr;
+  RunInBatches(scenarios.size(), quiet, [&](std::size_t k) {
+    taught[k] =
+        eval::TeachOnSimulator(sim::SessionScenario(scenarios[k], 0), navigation::TeachOptions{});
+    return std::string();
+  });
+  const std::size_t per_mode = static_cast<std::size_t>(options.runs);
+  const std::size_t per_scenario = 2 * per_mode;
+  std::vector<eval::LifelongRun> results(scenarios.size() * per_scenario);
+  RunInBatches(results.size(), options, [&](std::size_t k) {
+    const std::size_t sc = k / per_scenario;
+    const bool learn = (k % per_scenario) < per_mode;
+    eval::LifelongOptions o;
+    o.sessions = sessions;
+    o.learn = learn;
+    o.seed = options.seed + k % per_mode;
+    results[k] = eval::RunLifelong(scenarios[sc], taught[sc], o);
+    int ok = 0;
+    for (const auto& s : results[k].sessions) ok += s.success ? 1 : 0;
+    return Format("%s %s run %zu: %d/%d sessions", names[sc].c_str(),
+                  learn ? "experiences" : "single", k % per_mode + 1, ok, sessions);
+  });
+  SuiteOutput out;
+  out.json = SuiteJson("lifelong", options.runs, options.seed);
+  out.json["sessions"] = sessions;
+  out.table = Format("%-18s %-11s %8s  successes per session 1..%d, ratio, views, features\n",
+                     "scenario", "mode", "all", sessions);
+  for (std::size_t sc = 0; sc < scenarios.size(); ++sc) {
+    for (const bool learn : {true, false}) {
+      const auto first =
+          results.begin() + static_cast<std::ptrdiff_t>(sc * per_scenario + (learn ? 0 : per_mode));
+      const std::vector<eval::LifelongRun> runs(first,
+                                                first + static_cast<std::ptrdiff_t>(per_mode));
+      out.json["results"].push_back(LifelongRowJson(names[sc], learn, runs, sessions, &out.table));
+    }
+  }
+  out.table += Format(
+      "all: runs that completed every session; then successes on each session; ratio: the\n"
+      "largest lateral RMS of a session over session 1's; views, features: the route after the\n"
+      "last session (taught views included), mean over runs\n");
   return out;
 }
 

@@ -20,6 +20,7 @@ struct SuiteOptions {
   int jobs = 1;            // entries evaluated in parallel (the results do not depend on it)
   std::string only;        // only this scenario of the suite
   std::string report_dir;  // "" : no report
+  int sessions = 20;       // eval lifelong: sessions repeated after the teach's
   // Called once with the number of entries, then once per entry done (from any thread).
   std::function<void(int total)> on_start;
   std::function<void(const std::string& line)> on_entry_done;
@@ -43,5 +44,11 @@ SuiteOutput RunEigenspaceSuite(const SuiteOptions& options);
 // "places": [...]}.
 SuiteOutput RunExperiencesEval(const std::string& sessions_dir,
                                const eval::ExperiencesEvalOptions& options);
+// Routes that last (eval/lifelong.h): each changing-world scenario taught on session 0 and
+// repeated on sessions 1..`options.sessions` in order, `options.runs` times, with experiences and
+// with the taught views alone: {"suite": "lifelong", "sessions", "results": [{"scenario", "learn",
+// "runs", "successes", "route_views", "route_features", "lateral_rms_ratio_max", "per_session":
+// [...]}]}.
+SuiteOutput RunLifelongSuite(const SuiteOptions& options);
 
 }  // namespace mapless::run

@@ -16,8 +16,8 @@ namespace {
 
 const Eigen::Vector3d kLightDir = Eigen::Vector3d(0.35, 0.55, 0.76).normalized();
 
-float ShadeFor(const Eigen::Vector3d& normal) {
-  return static_cast<float>(0.6 + 0.4 * std::abs(normal.normalized().dot(kLightDir)));
+float ShadeFor(const Eigen::Vector3d& normal, const Eigen::Vector3d& light) {
+  return static_cast<float>(0.6 + 0.4 * std::abs(normal.normalized().dot(light)));
 }
 
 // log2 approximation (max error ~0.01) for mip selection.
@@ -522,8 +522,15 @@ void RenderOptions::Validate() const {
                 "RenderOptions.anisotropy = " << anisotropy << "; must be in [0, 1]");
 }
 
+Eigen::Vector3d LightDirection(const World& world) {
+  if (!world.light_azimuth_deg) return kLightDir;
+  const double a = DegToRad(*world.light_azimuth_deg);
+  const double horizontal = std::hypot(kLightDir.x(), kLightDir.y());
+  return Eigen::Vector3d(horizontal * std::cos(a), horizontal * std::sin(a), kLightDir.z());
+}
+
 void AppendObjectSurfaces(const WorldObject& o, std::shared_ptr<const Texture> texture,
-                          std::vector<Surface>* out) {
+                          std::vector<Surface>* out, const Eigen::Vector3d& light) {
   auto add = [&](Surface::Shape shape, const Eigen::Vector3d& origin, const Eigen::Vector3d& e1,
                  const Eigen::Vector3d& e2, bool one_sided) {
     Surface s;
@@ -532,7 +539,7 @@ void AppendObjectSurfaces(const WorldObject& o, std::shared_ptr<const Texture> t
     s.e1 = e1;
     s.e2 = e2;
     s.one_sided = one_sided;
-    s.shade = ShadeFor(e1.cross(e2));
+    s.shade = ShadeFor(e1.cross(e2), light);
     s.texture = texture;
     out->push_back(s);
   };
@@ -605,8 +612,9 @@ Renderer::Renderer(const World& world, RenderOptions options) : options_(options
     if (it == cache.end()) it = cache.emplace(key, GenerateTexture(spec)).first;
     return it->second;
   };
+  const Eigen::Vector3d light = LightDirection(world);
   for (const WorldObject& o : world.objects)
-    AppendObjectSurfaces(o, texture_for(o.texture), &surfaces_);
+    AppendObjectSurfaces(o, texture_for(o.texture), &surfaces_, light);
   Surface ground;
   ground.shape = Surface::Shape::kPlane;
   ground.origin = Eigen::Vector3d::Zero();

@@ -44,9 +44,13 @@ struct Surface {
   std::shared_ptr<const Texture> texture;
 };
 
-// Appends the surfaces of one object (its texture must be generated already).
+// The direction towards the light of a world (World::light_azimuth_deg), unit length.
+Eigen::Vector3d LightDirection(const World& world);
+
+// Appends the surfaces of one object (its texture must be generated already), shaded by a light
+// in `light` (unit; LightDirection).
 void AppendObjectSurfaces(const WorldObject& object, std::shared_ptr<const Texture> texture,
-                          std::vector<Surface>* out);
+                          std::vector<Surface>* out, const Eigen::Vector3d& light);
 
 class Renderer {
  public:

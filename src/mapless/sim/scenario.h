@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -55,6 +56,7 @@ struct Scenario {
   Pose2 repeat_start;
   WorldVariant repeat_variant;
   std::vector<Eigen::Vector2d> destinations;  // goals for destination-guided navigation
+  std::optional<WorldChange> sessions;        // how the world changes between sessions
 
   void Validate() const;
   // Length of the taught path (sum of straight legs), metres.

@@ -125,7 +125,7 @@ std::vector<Surface> Simulation::OtherRobots(int robot) const {
     body.center = Eigen::Vector2d(robots_[j].pose().x_m, robots_[j].pose().y_m);
     body.radius_m = robots_[j].options().radius_m;
     body.height_m = options_.robot_body_height_m;
-    AppendObjectSurfaces(body, body_textures_[j], &out);
+    AppendObjectSurfaces(body, body_textures_[j], &out, LightDirection(world_));
   }
   return out;
 }

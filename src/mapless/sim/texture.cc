@@ -224,7 +224,43 @@ cv::Mat Checker(int size) {
 
 bool IsPowerOfTwo(int v) { return v > 0 && (v & (v - 1)) == 0; }
 
+// Where a surface changes first: a smooth field of patches (a few per tile) and the level below
+// which a share `changed` of it lies (measured on a 64 x 64 grid). Rising shares cover growing
+// patches around the same places.
+cv::Mat ChangeWeights(int size, std::uint64_t seed, double changed) {
+  Rng rng(seed * 0x9E3779B97F4A7C15ULL + 0xC4A26EDULL);
+  const cv::Mat field = FractalNoise(size, Scaled(3, size), 4, &rng, 0.5);
+  std::vector<float> grid;
+  const int step = std::max(1, size / 64);
+  for (int y = 0; y < size; y += step)
+    for (int x = 0; x < size; x += step) grid.push_back(field.at<float>(y, x));
+  std::sort(grid.begin(), grid.end());
+  const auto at = static_cast<std::size_t>(changed * static_cast<double>(grid.size() - 1));
+  const float level = changed >= 1.0 ? grid.back() + 1.0f : grid[at];
+  // A soft edge a twentieth of the field's range wide: the patches' borders are not a pixel step.
+  const float soft = std::max(1e-6f, 0.05f * (grid.back() - grid.front()));
+  cv::Mat weights = (level - field) / soft + 0.5;
+  return cv::min(cv::max(weights, 0.0), 1.0);
+}
+
 }  // namespace
+
+cv::Mat ChangedTexture(const TextureSpec& spec) {
+  TextureSpec before = spec;
+  before.changed = 0.0;
+  TextureSpec after = before;
+  after.seed = spec.seed * 0xD1B54A32D192ED03ULL + 0x5E55;
+  if (after.type == TextureType::kImage) after.type = TextureType::kNoise;
+  cv::Mat a;
+  cv::Mat b;
+  GenerateTextureImage(before).convertTo(a, CV_32F);
+  GenerateTextureImage(after).convertTo(b, CV_32F);
+  const cv::Mat w = ChangeWeights(spec.size_px, spec.seed, spec.changed);
+  const cv::Mat mixed = a.mul(1.0 - w) + b.mul(w);
+  cv::Mat out;
+  mixed.convertTo(out, CV_8U);
+  return out;
+}
 
 TextureType ParseTextureType(const std::string& name) {
   for (const auto& t : kTypeNames) {
@@ -243,7 +279,7 @@ const char* TextureTypeName(TextureType type) {
 
 TextureKey TextureKeyOf(const TextureSpec& spec) {
   return std::make_tuple(static_cast<int>(spec.type), spec.seed, spec.texel_m, spec.fit, spec.mean,
-                         spec.contrast, spec.size_px, spec.file);
+                         spec.contrast, spec.size_px, spec.file, spec.changed);
 }
 
 void TextureSpec::Validate() const {
@@ -257,10 +293,13 @@ void TextureSpec::Validate() const {
                 "TextureSpec.size_px = " << size_px << "; must be a power of two in [64, 2048]");
   MAPLESS_CHECK(type != TextureType::kImage || !file.empty(),
                 "TextureSpec.file is empty; an image texture needs a file");
+  MAPLESS_CHECK(changed >= 0.0 && changed <= 1.0,
+                "TextureSpec.changed = " << changed << "; must be in [0, 1]");
 }
 
 cv::Mat GenerateTextureImage(const TextureSpec& spec) {
   spec.Validate();
+  if (spec.changed > 0.0) return ChangedTexture(spec);
   Rng rng(spec.seed * 0x9E3779B97F4A7C15ULL + static_cast<std::uint64_t>(spec.type));
   const int size = spec.size_px;
   if (spec.type == TextureType::kImage) {

@@ -29,13 +29,18 @@ struct TextureSpec {
   int size_px = 1024;     // side of the texture image, a power of two (64..2048); 1024 keeps
                           // exact repeats (which fool feature matching) metres apart
   std::string file;       // image file for kImage (grayscale; resized to size_px)
+  // The share of the surface (0..1) that has changed since it was taught (a world that changes
+  // between sessions, sim/sessions.h): patches of a second texture of the same kind (another
+  // seed) cover that share, growing from the same places as it rises (leaves, wet ground, snow).
+  double changed = 0.0;
 
   void Validate() const;  // throws InputError naming the field and value
 };
 
 // What makes two texture specs the same texture (the renderer generates each distinct one once):
-// type, seed, texel_m, fit, mean, contrast, size_px, file.
-using TextureKey = std::tuple<int, std::uint64_t, double, bool, double, double, int, std::string>;
+// type, seed, texel_m, fit, mean, contrast, size_px, file, changed.
+using TextureKey =
+    std::tuple<int, std::uint64_t, double, bool, double, double, int, std::string, double>;
 TextureKey TextureKeyOf(const TextureSpec& spec);
 
 // A tileable texture with its mip pyramid: levels[0] is size_px x size_px, each next level half.
@@ -56,5 +61,10 @@ std::shared_ptr<const Texture> GenerateTexture(const TextureSpec& spec);
 
 // Only the base image, without mip levels (for tests and previews).
 cv::Mat GenerateTextureImage(const TextureSpec& spec);
+
+// The image of a texture of which a share `spec.changed` has changed (GenerateTextureImage calls
+// it when that share is above 0): the texture with `changed` 0, covered in patches by another
+// texture of the same type.
+cv::Mat ChangedTexture(const TextureSpec& spec);
 
 }  // namespace mapless::sim

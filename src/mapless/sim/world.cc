@@ -57,6 +57,9 @@ void World::Validate() const {
   MAPLESS_CHECK(
       sky_top >= 0.0 && sky_top <= 255.0 && sky_horizon >= 0.0 && sky_horizon <= 255.0,
       "World.sky: top " << sky_top << ", horizon " << sky_horizon << "; grey levels in [0, 255]");
+  MAPLESS_CHECK(
+      !light_azimuth_deg || std::isfinite(*light_azimuth_deg),
+      "World.light_azimuth_deg = " << light_azimuth_deg.value_or(0.0) << "; must be finite");
   MAPLESS_CHECK(objects.size() <= kMaxWorldObjects,
                 "World.objects: " << objects.size() << " objects (after rooms and repeats); the "
                                   << "limit is " << kMaxWorldObjects);
@@ -156,6 +159,21 @@ World ApplyVariant(const World& world, const WorldVariant& variant) {
     if (!o.tag.empty() && it != variant.leave_s.end()) o.leaves_s = it->second;
   }
   return out;
+}
+
+void WorldChange::Validate() const {
+  MAPLESS_CHECK(std::abs(brightness) <= 50.0,
+                "sessions.brightness = " << brightness << "; must be in [-50, 50] grey levels");
+  MAPLESS_CHECK(std::abs(contrast) <= 0.2,
+                "sessions.contrast = " << contrast << "; must be in [-0.2, 0.2]");
+  MAPLESS_CHECK(light_swing >= 0.0 && light_swing <= 100.0,
+                "sessions.light_swing = " << light_swing << "; must be in [0, 100] grey levels");
+  MAPLESS_CHECK(std::abs(light_turn_deg) <= 180.0,
+                "sessions.light_turn_deg = " << light_turn_deg << "; must be in [-180, 180]");
+  MAPLESS_CHECK(texture >= 0.0 && texture <= 1.0,
+                "sessions.texture = " << texture << "; must be in [0, 1]");
+  MAPLESS_CHECK(presence >= 0.0 && presence <= 1.0,
+                "sessions.presence = " << presence << "; must be in [0, 1]");
 }
 
 World WorldAt(const World& world, double t_s) {

@@ -55,6 +55,9 @@ struct World {
   double ceiling_height_m = 2.6;
   double sky_top = 205.0;      // sky intensity at the top of the image
   double sky_horizon = 175.0;  // sky intensity at the bottom of the image
+  // Where the light comes from, degrees counter-clockwise from +x (its elevation is fixed, about
+  // 50 degrees): which faces of walls and boxes are lit. Unset: 57.5 degrees.
+  std::optional<double> light_azimuth_deg;
   std::vector<WorldObject> objects;
 
   void Validate() const;  // throws InputError naming the object and field
@@ -67,6 +70,18 @@ struct WorldVariant {
   std::map<std::string, Eigen::Vector2d> move_m;  // tag -> displacement (dx, dy)
   std::vector<WorldObject> add;                   // new objects (they may carry their own times)
   std::map<std::string, double> leave_s;          // tag -> simulated time (s) it leaves at
+};
+
+// How a world changes from one session to the next (sim/sessions.h; a scenario's `sessions:`).
+struct WorldChange {
+  double brightness = -1.5;     // grey levels per session (negative: towards dusk)
+  double contrast = -0.015;     // camera gain per session (1 at session 0)
+  double light_swing = 8.0;     // grey levels: each session's brightness varies by up to +-this
+  double light_turn_deg = 9.0;  // the light's direction turns by this per session
+  double texture = 0.03;        // share of every surface's texture changed per session
+  std::vector<std::string> come_and_go;  // tags of objects that are there on a session or not
+  double presence = 0.5;                 // the chance that each of them is there
+  void Validate() const;                 // throws InputError naming the field
 };
 
 // Returns the world with the variant applied (remove, move, add, then the leaving times); throws
