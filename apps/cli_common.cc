@@ -34,10 +34,43 @@ std::vector<double> ParseNumbers(const std::string& text, const std::string& opt
   return v;
 }
 
-bool ParseEndByLocalScale(const std::string& end) {
+void SwitchingArgs::ApplyTo(navigation::RepeatOptions* options) const {
   if (end != "scale" && end != "switching")
     throw InputError("--end '" + end + "': expected scale or switching");
-  return end == "scale";
+  options->switching = navigation::ParseSwitching(switching);
+  options->end_by_local_scale = end == "scale";
+  options->redetect_every_frames = redetect_every;
+  options->recovery_keyframes = recover_keyframes;
+  options->carry_on.max_distance_m = carry_on_m;
+}
+
+void AddSwitchingOptions(CLI::App* cmd, SwitchingArgs* a) {
+  cmd->add_option("--switching", a->switching,
+                  "stdratio (Kassir et al.), mse (Chen & Birchfield) or scale (local scale of "
+                  "nearby features, not in the papers)")
+      ->capture_default_str();
+  cmd->add_option("--end", a->end,
+                  "How the last keyframe is passed: scale (local scale of nearby features, robust "
+                  "to a lateral offset) or switching (like every other keyframe)")
+      ->capture_default_str();
+  cmd->add_option("--redetect-every", a->redetect_every,
+                  "Detect and match afresh every N frames, KLT tracking in between (0: only when "
+                  "features run short, as in Algorithm 1)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000));
+  cmd->add_option("--recover-keyframes", a->recover_keyframes,
+                  "Keyframe recovery: after 2 s waiting for an unmatched keyframe, also try up to "
+                  "N following keyframes (0: off, as in the paper; "
+                  "docs/teach_and_repeat.md#keyframe-recovery)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 20));
+  cmd->add_option("--carry-on-m", a->carry_on_m,
+                  "When no keyframe matches and recovery finds none: drive the taught path by "
+                  "odometry for at most this many metres, matching the following keyframes "
+                  "(needs a route taught with odometry; 0: off; docs/teach_and_repeat.md, "
+                  "Carrying on)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0));
 }
 
 Pose2 ParsePoseDeg(const std::string& text, const std::string& option) {

@@ -12,6 +12,7 @@
 
 #include "mapless/core/pose.h"
 #include "mapless/io/journal.h"
+#include "mapless/navigation/repeat.h"
 #include "mapless/sim/simulation.h"
 
 namespace mapless::app {
@@ -32,9 +33,17 @@ std::vector<double> ParseNumbers(const std::string& text, const std::string& opt
                                  const std::string& form);
 // Parses "X,Y,THETA_DEG"; throws InputError naming the option.
 Pose2 ParsePoseDeg(const std::string& text, const std::string& option);
-// Parses --end ("scale" or "switching") into RepeatOptions::end_by_local_scale; throws InputError
-// naming the value.
-bool ParseEndByLocalScale(const std::string& end);
+// The funnel-lane repeat's switching options, the same in `repeat` and `eval table1|...`.
+struct SwitchingArgs {
+  std::string switching = "stdratio";
+  std::string end = "scale";
+  int redetect_every = navigation::RepeatOptions{}.redetect_every_frames;
+  int recover_keyframes = navigation::RepeatOptions{}.recovery_keyframes;
+  double carry_on_m = navigation::RepeatOptions{}.carry_on.max_distance_m;
+  // Into `options`; throws InputError naming a value that is not one (--switching, --end).
+  void ApplyTo(navigation::RepeatOptions* options) const;
+};
+void AddSwitchingOptions(CLI::App* cmd, SwitchingArgs* a);
 
 // Decision logs, one JSON object per line. To a file, each line is a journal record
 // (io/journal.h): a run killed at any moment leaves every line it finished, whole.

@@ -75,52 +75,31 @@ void RunSuite(SuiteArgs a, const std::function<run::SuiteOutput(const run::Suite
 
 // table1, funnel-scenarios, obstacles: the funnel-lane repeat and its options.
 void AddRepeatSuite(CLI::App* eval, const std::string& name, const std::string& what) {
-  struct Args : SuiteArgs {
-    std::string switching = "stdratio";
-    std::string end = "scale";
-    int redetect_every = navigation::RepeatOptions{}.redetect_every_frames;
-    int recover_keyframes = navigation::RepeatOptions{}.recovery_keyframes;
-    double carry_on_m = navigation::RepeatOptions{}.carry_on.max_distance_m;
+  struct Args : SuiteArgs, SwitchingArgs {
     std::string on_obstacle = "stop";
+    bool learn = false;
   };
   auto a = std::make_shared<Args>();
   CLI::App* cmd = eval->add_subcommand(name, what);
   AddSuiteOptions(cmd, a.get());
-  cmd->add_option("--switching", a->switching, "Keyframe switching: stdratio, mse or scale")
-      ->capture_default_str();
-  cmd->add_option("--end", a->end,
-                  "The last keyframe by scale, or by the switching rule (switching)")
-      ->capture_default_str();
-  cmd->add_option("--redetect-every", a->redetect_every,
-                  "Detect and match afresh every N frames, KLT in between (0: Algorithm 1's)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 1000));
-  cmd->add_option("--recover-keyframes", a->recover_keyframes,
-                  "Keyframe recovery, up to N following keyframes (0: off)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 20));
-  cmd->add_option("--carry-on-m", a->carry_on_m,
-                  "Carrying on along the taught odometry, at most this many metres (0: off)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 100.0));
+  AddSwitchingOptions(cmd, a.get());
   cmd->add_option("--on-obstacle", a->on_obstacle,
                   "The obstacle watch: stop (as in `repeat`), avoid (go round it; the objects "
                   "added at repeat time then stay for the whole run) or off (the paper's repeat)")
       ->capture_default_str()
       ->check(CLI::IsMember({"stop", "avoid", "off"}));
+  cmd->add_flag("--learn", a->learn, "Learn how the route's places look today (each run in turn)");
   cmd->callback([a, name] {
     eval::RepeatRunOptions base;
-    base.repeat.switching = navigation::ParseSwitching(a->switching);
-    base.repeat.end_by_local_scale = ParseEndByLocalScale(a->end);
-    base.repeat.redetect_every_frames = a->redetect_every;
-    base.repeat.recovery_keyframes = a->recover_keyframes;
-    base.repeat.carry_on.max_distance_m = a->carry_on_m;
+    a->ApplyTo(&base.repeat);
     base.repeat.obstacle.enabled = a->on_obstacle != "off";
     base.repeat.obstacle.avoid = a->on_obstacle == "avoid";
+    base.repeat.learn = a->learn;
     const nlohmann::json settings = {{"switching", a->switching},
                                      {"redetect_every", a->redetect_every},
                                      {"recover_keyframes", a->recover_keyframes},
                                      {"on_obstacle", a->on_obstacle},
+                                     {"learn", a->learn},
                                      {"end", a->end}};
     RunSuite(*a, [&](const run::SuiteOptions& o) {
       return run::RunRepeatSuite(name, o, base, settings);

@@ -30,15 +30,10 @@
 namespace mapless::app {
 namespace {
 
-struct RepeatArgs {
+struct RepeatArgs : SwitchingArgs {
   std::string route;
   std::string source;
   std::string controller = "sloped";
-  std::string switching = "stdratio";
-  std::string end = "scale";
-  int redetect_every = navigation::RepeatOptions{}.redetect_every_frames;
-  int recover_keyframes = navigation::RepeatOptions{}.recovery_keyframes;
-  double carry_on_m = navigation::RepeatOptions{}.carry_on.max_distance_m;
   std::string on_obstacle;  // empty: the robot file's, else stop
   std::string log;
   std::uint64_t seed = 1;
@@ -114,11 +109,7 @@ void Repeat(const RepeatArgs& r) {
                  route->keyframes.size());
   navigation::RepeatOptions options;
   options.controller = navigation::ParseController(r.controller);
-  options.switching = navigation::ParseSwitching(r.switching);
-  options.end_by_local_scale = ParseEndByLocalScale(r.end);
-  options.redetect_every_frames = r.redetect_every;
-  options.recovery_keyframes = r.recover_keyframes;
-  options.carry_on.max_distance_m = r.carry_on_m;
+  r.ApplyTo(&options);
   options.features.type = features::ParseDetectorType(route->detector);
   options.obstacle = ObstacleWatchFor(r.robot, r.on_obstacle, options.obstacle, true);
   options.learn = r.learn;
@@ -203,37 +194,7 @@ static void AddRepeatCommand(CLI::App* app) {
   repeat->add_flag("--learn", r->learn,
                    "Learn how the route's places look today: views of keyframes whose appearance "
                    "changed, written into the route when the repeat ends");
-  repeat
-      ->add_option("--switching", r->switching,
-                   "stdratio (Kassir et al.), mse (Chen & Birchfield) or scale (local scale of "
-                   "nearby features, not in the papers)")
-      ->capture_default_str();
-  repeat
-      ->add_option("--end", r->end,
-                   "How the last keyframe is passed: scale (local scale of nearby features, "
-                   "robust to a lateral offset) or switching (like every other keyframe)")
-      ->capture_default_str();
-  repeat
-      ->add_option("--redetect-every", r->redetect_every,
-                   "Detect and match afresh every N frames, KLT tracking in between (0: only "
-                   "when features run short, as in Algorithm 1)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 1000));
-  repeat
-      ->add_option("--recover-keyframes", r->recover_keyframes,
-                   "Keyframe recovery: after 2 s waiting for an unmatched keyframe, also try up "
-                   "to N following keyframes (0: off, as in the paper; "
-                   "docs/teach_and_repeat.md#keyframe-recovery)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 20));
-  repeat
-      ->add_option(
-          "--carry-on-m", r->carry_on_m,
-          "When no keyframe matches and recovery finds none: drive the taught path by "
-          "odometry for at most this many metres, matching the following keyframes "
-          "(needs a route taught with odometry; 0: off; docs/teach_and_repeat.md, Carrying on)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 100.0));
+  AddSwitchingOptions(repeat, r.get());
   AddOnObstacleOption(repeat, &r->on_obstacle, true);
   repeat->add_option("--log", r->log,
                      "Per-frame decisions as JSON lines to this file (default: stdout; on a robot: "

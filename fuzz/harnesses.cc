@@ -158,7 +158,7 @@ void ScenarioWorld(const std::string& input) {
         sim::ParseScenario(input, "fuzz.yaml", "/nonexistent-mapless-fuzz");
     for (const sim::WorldObject& o : scenario.world.objects) {
       std::vector<sim::Surface> surfaces;
-      sim::AppendObjectSurfaces(o, nullptr, &surfaces);
+      sim::AppendObjectSurfaces(o, nullptr, &surfaces, sim::LightDirection(scenario.world));
     }
     sim::Simulation simulation(scenario.world, scenario.camera, sim::SimulationOptions{},
                                scenario.seed);

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "mapless/core/check.h"
+#include "mapless/navigation/experiences.h"
 
 namespace mapless::eval {
 namespace {
@@ -108,6 +109,9 @@ EntryResult RunEntry(const sim::Scenario& scenario, const TaughtRoute& taught,
   std::vector<double> finals;
   double lateral_sum_sq = 0.0;
   std::size_t lateral_count = 0;
+  // With base.repeat.learn, the runs are one route's repeats in order: each successful run's
+  // learned views go into the route the next run repeats (as `repeat --learn` writes them).
+  TaughtRoute route = taught;
   for (int i = 0; i < runs; ++i) {
     RepeatRunOptions o = base;
     o.seed = seed + static_cast<std::uint64_t>(i);
@@ -116,7 +120,13 @@ EntryResult RunEntry(const sim::Scenario& scenario, const TaughtRoute& taught,
     o.repeat.sloped.max_speed_mps = speed;
     o.repeat.standard.forward_speed_mps = speed;
     const RepeatRun run =
-        RepeatOnSimulator(scenario, taught, o, i == 0 ? first_run : RepeatObserver{});
+        RepeatOnSimulator(scenario, route, o, i == 0 ? first_run : RepeatObserver{});
+    if (base.repeat.learn && run.success) {
+      auto learned = std::make_shared<route::Route>(*route.route);
+      r.learned +=
+          navigation::ApplyVisit(learned.get(), run.used_views, run.learned, o.repeat.experiences);
+      route.route = learned;
+    }
     r.paths.push_back(run.path);
     finals.push_back(run.final_error_m);
     for (const Pose2& p : run.path) {

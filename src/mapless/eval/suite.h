@@ -48,6 +48,7 @@ struct EntryResult {
   int obstacle_stops = 0;
   int stops_at_added_object = 0;
   int went_round = 0;  // runs that went round an obstacle at least once (--on-obstacle avoid)
+  int learned = 0;     // with repeat.learn: views the runs learned into the route, in order
   double min_clearance_m = std::numeric_limits<double>::infinity();
   std::vector<std::string> failures;  // one status line per failed run
   // Ground truth for reports: the reference path (taught, or the leader's) and each run's path.
@@ -58,7 +59,8 @@ struct EntryResult {
 // Runs one entry: the route is taught once (clean), then repeated `runs` times with seeds
 // seed, seed + 1, ... The repeat drives at the scenario's teach speed, capped at
 // base.max_repeat_speed_mps but not below half the teach speed. `first_run` (if set) observes
-// every frame of the first run (for reports).
+// every frame of the first run (for reports). With base.repeat.learn the runs repeat one route
+// in order, each learning into it for the next (`repeat --learn`).
 EntryResult RunEntry(const sim::Scenario& scenario, const TaughtRoute& taught,
                      navigation::Controller controller, int runs, std::uint64_t seed,
                      const RepeatRunOptions& base, const RepeatObserver& first_run = {});

@@ -68,6 +68,7 @@ nlohmann::json EntryJson(const eval::EntryResult& r) {
           {"collisions", r.collisions},
           {"obstacle_stops", r.obstacle_stops},
           {"went_round", r.went_round},
+          {"learned", r.learned},
           {"stops_at_added_object", r.stops_at_added_object},
           {"min_clearance_m",
            std::isfinite(r.min_clearance_m) ? nlohmann::json(r.min_clearance_m) : nlohmann::json()},
