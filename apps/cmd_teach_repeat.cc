@@ -232,6 +232,14 @@ static void AddRouteCommand(CLI::App* app) {
     const nlohmann::json j = run::RouteInfo(i->route);
     std::cout << (i->json ? j.dump() : run::RouteInfoLine(i->route, j)) << "\n";
   });
+  auto p = std::make_shared<std::pair<std::string, int>>("", 5);
+  CLI::App* prune = route_cmd->add_subcommand(
+      "prune", "Keep at most N views per keyframe, dropping the learned views used least recently");
+  prune->add_option("ROUTE", p->first, "Route directory")->required();
+  prune->add_option("--max-views", p->second, "Views per place, the taught one included")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 64));
+  prune->callback([p] { std::cout << run::PruneRouteViews(p->first, p->second) << "\n"; });
 }
 
 void AddTeachRepeatCommands(CLI::App* app) {

@@ -40,7 +40,7 @@ need_drive() {  # $TMP/d1: a recorded drive of rotation_in_place (frames, poses)
 
 section_basics() {
   # Every subcommand answers --help with exit 0 and a usage text.
-  for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench" "shift" "teach" "repeat" "route" "route info" "eval" "eval table1" "eval obstacles" "soak" "flow" "ground" "navigate" "localize" "follow" "sim serve" "teleop" "lead" "fleet"; do
+  for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench" "shift" "teach" "repeat" "route" "route info" "route prune" "eval" "eval table1" "eval obstacles" "soak" "flow" "ground" "navigate" "localize" "follow" "sim serve" "teleop" "lead" "fleet"; do
     # shellcheck disable=SC2086
     expect_exit "help: mapless $sub --help" 0 "$MAPLESS" $sub --help
     grep -qi "usage" "$TMP/out"; check "help text: mapless $sub" $?
@@ -204,6 +204,9 @@ section_routes() {
   expect_exit "repeat open loop" 0 "$MAPLESS" repeat --route "$TMP/route" --source "$TMP/d1/frames" --log "$TMP/rep.jsonl"
   [ "$(wc -l <"$TMP/rep.jsonl")" -eq "$n_frames" ]; check "one decision line per frame" $?
   head -1 "$TMP/rep.jsonl" | grep -q '"destination":' && head -1 "$TMP/rep.jsonl" | grep -q '"v_mps":'; check "decision lines carry segment and command" $?
+  expect_exit "route prune to the taught views" 0 "$MAPLESS" route prune "$TMP/route" --max-views 1
+  grep -q "route: 0 learned views pruned, 0 left" "$TMP/out"; check "route prune says what it pruned" $?
+  expect_exit "route prune --max-views 0 exits 2" 2 "$MAPLESS" route prune "$TMP/route" --max-views 0
   # An image folder with TUM poses as its odometry (--poses): the eigenspace teach needs odometry.
   expect_exit "eigenspace teach of a folder without poses exits 2" 2 "$MAPLESS" teach --method eigenspace --source "$TMP/d1/frames" --out "$TMP/eroute0"
   grep -q "with --poses FILE.tum" "$TMP/err"; check "eigenspace teach asks for --poses" $?

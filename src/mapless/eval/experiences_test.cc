@@ -62,6 +62,27 @@ TEST(Experiences, ALearnedViewStoresTheChainedOffsetAndTheLeastRecentlyUsedMakes
   EXPECT_EQ(taught_only.size(), 1u);
 }
 
+TEST(Experiences, PruningARouteKeepsTheTaughtViewAndTheMostRecentlyUsed) {
+  route::Route route;
+  route.keyframes.resize(2);
+  for (int i = 1; i <= 4; ++i) {
+    route::KeyframeView v;
+    v.learned_at = i;
+    v.last_used = i == 1 ? 4 : i;  // the oldest view is also the one used last
+    route.keyframes[0].views.push_back(v);
+  }
+  route.keyframes[1].views.resize(1);
+  EXPECT_EQ(navigation::PruneViews(&route, 5), 0);
+  EXPECT_EQ(navigation::PruneViews(&route, 3), 2);  // 2 learned views kept on keyframe 0
+  ASSERT_EQ(route.keyframes[0].views.size(), 2u);
+  EXPECT_EQ(route.keyframes[0].views[0].learned_at, 1);
+  EXPECT_EQ(route.keyframes[0].views[1].learned_at, 4);
+  EXPECT_EQ(route.keyframes[1].views.size(), 1u);
+  EXPECT_EQ(navigation::PruneViews(&route, 1), 3);  // the taught views alone
+  EXPECT_TRUE(route.keyframes[0].views.empty());
+  EXPECT_THROW(navigation::PruneViews(&route, 0), InputError);
+}
+
 TEST(Experiences, OptionsRefuseImpossibleValues) {
   ExperienceOptions o;
   o.max_views = 0;

@@ -51,10 +51,11 @@ namespace {
 
 // While `max_learned` or more learned views stand from `first_learned` on, the one used least
 // recently (then the oldest) makes room.
+// Removes learned views (from index `first_learned` on), least recently used first (then the
+// oldest), until at most `keep` are left.
 template <typename View>
-void MakeRoom(std::vector<View>* views, std::size_t first_learned, int max_learned) {
-  while (views->size() > first_learned &&
-         static_cast<int>(views->size() - first_learned) >= max_learned) {
+void KeepAtMost(std::vector<View>* views, std::size_t first_learned, int keep) {
+  while (views->size() > first_learned && static_cast<int>(views->size() - first_learned) > keep) {
     const auto victim = std::min_element(views->begin() + static_cast<long>(first_learned),
                                          views->end(), [](const View& a, const View& b) {
                                            return std::make_pair(a.last_used, a.learned_at) <
@@ -62,6 +63,11 @@ void MakeRoom(std::vector<View>* views, std::size_t first_learned, int max_learn
                                          });
     views->erase(victim);
   }
+}
+
+template <typename View>
+void MakeRoom(std::vector<View>* views, std::size_t first_learned, int max_learned) {
+  KeepAtMost(views, first_learned, max_learned - 1);
 }
 
 }  // namespace
@@ -107,6 +113,17 @@ int ApplyVisit(route::Route* route, const std::vector<int>& used_views,
     ++added;
   }
   return added;
+}
+
+int PruneViews(route::Route* route, int max_views) {
+  MAPLESS_CHECK(max_views >= 1, "max_views = " << max_views << "; must be >= 1 (the taught view)");
+  int removed = 0;
+  for (route::Keyframe& kf : route->keyframes) {
+    const std::size_t before = kf.views.size();
+    KeepAtMost(&kf.views, 0, max_views - 1);
+    removed += static_cast<int>(before - kf.views.size());
+  }
+  return removed;
 }
 
 }  // namespace mapless::navigation

@@ -79,4 +79,10 @@ struct LearnedView {
 int ApplyVisit(route::Route* route, const std::vector<int>& used_views,
                std::vector<LearnedView> learned, const ExperienceOptions& options);
 
+// Keeps at most `max_views` views per keyframe (the taught one included, so max_views - 1
+// learned): the learned views used least recently (then the oldest) go first, as when a place
+// makes room. `mapless route prune`. Returns the number of views removed; throws InputError when
+// max_views < 1.
+int PruneViews(route::Route* route, int max_views);
+
 }  // namespace mapless::navigation

@@ -1,5 +1,6 @@
 #include "mapless/run/learn.h"
 
+#include "mapless/io/output_dir.h"
 #include "mapless/route/route_store.h"
 
 namespace mapless::run {
@@ -20,6 +21,17 @@ std::string SaveVisit(const std::string& dir, const route::Route& route,
          " view" + (added == 1 ? "" : "s") + " learned" +
          (keyframes.empty() ? "" : " (keyframes " + keyframes + ")") + ", " +
          std::to_string(views) + " learned views in all";
+}
+
+std::string PruneRouteViews(const std::string& dir, int max_views) {
+  const io::DirectoryLock lock(dir);
+  route::Route route = route::LoadRoute(dir);
+  const int removed = navigation::PruneViews(&route, max_views);
+  if (removed > 0) route::SaveViews(dir, &route);
+  std::size_t left = 0;
+  for (const auto& kf : route.keyframes) left += kf.views.size();
+  return dir + ": " + std::to_string(removed) + " learned view" + (removed == 1 ? "" : "s") +
+         " pruned, " + std::to_string(left) + " left";
 }
 
 }  // namespace mapless::run

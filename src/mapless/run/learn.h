@@ -17,4 +17,9 @@ std::string SaveVisit(const std::string& dir, const route::Route& route,
                       std::vector<navigation::LearnedView> learned,
                       const navigation::ExperienceOptions& options);
 
+// `mapless route prune ROUTE --max-views N`: locks the route directory, keeps at most N views per
+// keyframe (navigation::PruneViews) and writes what changed (route::SaveViews: the manifest, then
+// the pruned files removed). Returns one line: "ROUTE: 3 learned views pruned, 12 left".
+std::string PruneRouteViews(const std::string& dir, int max_views);
+
 }  // namespace mapless::run
