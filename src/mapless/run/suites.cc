@@ -359,6 +359,12 @@ nlohmann::json LifelongRowJson(const std::string& scenario, bool learn,
         {{"session", s}, {"successes", ok}, {"lateral_rms_m", rms}, {"learned", learned}});
     line += Format(" %2d", ok);
   }
+  row["failures"] = nlohmann::json::array();
+  for (std::size_t r = 0; r < runs.size(); ++r)
+    for (const auto& x : runs[r].sessions)
+      if (!x.success)
+        row["failures"].push_back("run " + std::to_string(r + 1) + " session " +
+                                  std::to_string(x.session) + ": " + x.status);
   row["lateral_rms_m_session1"] = first_rms;
   row["lateral_rms_ratio_max"] = ratio_max;
   *table += line + Format("  %5.2f %6.1f %8.0f\n", ratio_max, views / n, features / n);
