@@ -8,8 +8,9 @@
 #                                    built when they are present (about 180 Debian packages, so
 #                                    the demo does without)
 #        scripts/setup.sh --test     --ros and what the test command (README command 2) uses
-#                                    besides: Chromium (the report opened headless), clang-format
-#                                    (the style check), dpkg-dev (the .deb's dependencies)
+#                                    besides: Chromium (the report opened headless), clang (the
+#                                    sanitizer build), clang-format (the style check), dpkg-dev
+#                                    (the .deb's dependencies)
 set -euo pipefail
 WITH_ROS=0
 WITH_TEST=0
@@ -49,6 +50,7 @@ fi
 if [ "$WITH_TEST" = "1" ]; then
   PACKAGES+=(
     chromium               # the HTML report opened headless (no console error, a screenshot)
+    clang                  # the sanitizer build (docs/ci.md: 0.6x GCC's compile time under ASan)
     clang-format           # the style check (scripts/check_format.sh)
     dpkg-dev               # dpkg-shlibdeps: the Depends of the .deb (cpack)
   )

@@ -49,10 +49,12 @@ fleet::Record BenchRecord(fleet::RouteKind kind, int index) {
   kf.thumbnail = cv::Mat(60, 80, CV_8UC1);
   cv::RNG fill(static_cast<std::uint64_t>(index) + 13);
   fill.fill(kf.thumbnail, cv::RNG::UNIFORM, 0, 256);
-  for (int i = 0; i < 500; ++i)
-    kf.keypoints.emplace_back(static_cast<float>(rng.Uniform(0, 319)),
-                              static_cast<float>(rng.Uniform(0, 239)), 31.0f,
-                              static_cast<float>(rng.Uniform(0, 360)), 0.001f, 0);
+  for (int i = 0; i < 500; ++i) {
+    const auto angle = static_cast<float>(rng.Uniform(0, 360));  // one order for every compiler
+    const auto y = static_cast<float>(rng.Uniform(0, 239));
+    const auto x = static_cast<float>(rng.Uniform(0, 319));
+    kf.keypoints.emplace_back(x, y, 31.0f, angle, 0.001f, 0);
+  }
   kf.descriptors = cv::Mat(500, 32, CV_8UC1);
   fill.fill(kf.descriptors, cv::RNG::UNIFORM, 0, 256);
   if (index > 0) {

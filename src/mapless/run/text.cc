@@ -8,7 +8,7 @@
 namespace mapless::run {
 
 namespace {
-std::string VFormat(const char* format, va_list args) {
+__attribute__((format(printf, 1, 0))) std::string VFormat(const char* format, va_list args) {
   va_list copy;
   va_copy(copy, args);
   const int n = std::vsnprintf(nullptr, 0, format, copy);

@@ -56,26 +56,33 @@ cv::Mat FractalNoise(int size, int base_cells, int octaves, Rng* rng, double per
   return sum * (2.0 / total);
 }
 
-// Draws a filled rectangle that wraps around the tile border.
+// Draws a filled rectangle that wraps around the tile border: the copies shifted by a whole tile
+// that touch the image, each filled once (what cv::rectangle with cv::FILLED fills, clipped).
 void WrappedRect(cv::Mat* img, int x, int y, int w, int h, float value) {
   const int size = img->cols;
-  for (int dy = -size; dy <= 0; dy += size) {
-    for (int dx = -size; dx <= 0; dx += size) {
-      cv::rectangle(*img, cv::Rect(x + dx, y + dy, w, h), cv::Scalar(value), cv::FILLED);
-      cv::rectangle(*img, cv::Rect(x + dx + size, y + dy + size, w, h), cv::Scalar(value),
-                    cv::FILLED);
-      cv::rectangle(*img, cv::Rect(x + dx + size, y + dy, w, h), cv::Scalar(value), cv::FILLED);
-      cv::rectangle(*img, cv::Rect(x + dx, y + dy + size, w, h), cv::Scalar(value), cv::FILLED);
+  const cv::Rect bounds(0, 0, size, img->rows);
+  for (int oy = -size; oy <= size; oy += size) {
+    for (int ox = -size; ox <= size; ox += size) {
+      const cv::Rect r = cv::Rect(x + ox, y + oy, w, h) & bounds;
+      if (r.area() > 0) (*img)(r).setTo(cv::Scalar(value));
     }
   }
 }
 
+// The same for an anti-aliased filled ellipse: only the copies whose bounding square (the longer
+// axis and the anti-aliasing's pixel around it) touches the image are drawn.
 void WrappedEllipse(cv::Mat* img, int x, int y, int ax, int ay, double angle, float value) {
   const int size = img->cols;
+  const int reach = std::max(ax, ay) + 2;
   for (int oy = -size; oy <= size; oy += size) {
     for (int ox = -size; ox <= size; ox += size) {
-      cv::ellipse(*img, cv::Point(x + ox, y + oy), cv::Size(ax, ay), angle, 0, 360,
-                  cv::Scalar(value), cv::FILLED, cv::LINE_AA);
+      const int cx = x + ox;
+      const int cy = y + oy;
+      if (cx + reach < 0 || cy + reach < 0 || cx - reach >= size || cy - reach >= img->rows) {
+        continue;
+      }
+      cv::ellipse(*img, cv::Point(cx, cy), cv::Size(ax, ay), angle, 0, 360, cv::Scalar(value),
+                  cv::FILLED, cv::LINE_AA);
     }
   }
 }
@@ -171,8 +178,11 @@ cv::Mat Blobs(int size, Rng* rng) {
     if (rng->Uniform() < 0.5) {
       WrappedRect(&img, x, y, extent, 3 + static_cast<int>(rng->UniformInt(extent + 1)), value);
     } else {
-      WrappedEllipse(&img, x, y, extent, 2 + static_cast<int>(rng->UniformInt(extent + 1)),
-                     rng->Uniform(0, 180), value);
+      // Drawn in this order (the angle first) so that every compiler makes the same texture:
+      // the order in which a call's arguments are evaluated is unspecified in C++.
+      const double angle = rng->Uniform(0, 180);
+      const int ay = 2 + static_cast<int>(rng->UniformInt(extent + 1));
+      WrappedEllipse(&img, x, y, extent, ay, angle, value);
     }
   }
   return img;
@@ -184,8 +194,8 @@ cv::Mat Poster(int size, Rng* rng) {
   img += FractalNoise(size, 4, 4, rng) * 0.2;
   const int shapes = 6 + static_cast<int>(rng->UniformInt(6));
   for (int i = 0; i < shapes; ++i) {
-    const cv::Point c(static_cast<int>(rng->UniformInt(size)),
-                      static_cast<int>(rng->UniformInt(size)));
+    const int cy = static_cast<int>(rng->UniformInt(size));  // y first, as above: one order
+    const cv::Point c(static_cast<int>(rng->UniformInt(size)), cy);
     const int r = size / 16 + static_cast<int>(rng->UniformInt(size / 5));
     const double value = rng->Uniform(-1.0, 1.0);
     if (i % 2 == 0) {
