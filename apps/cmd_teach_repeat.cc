@@ -219,27 +219,35 @@ static void AddRepeatCommand(CLI::App* app) {
 static void AddRouteCommand(CLI::App* app) {
   CLI::App* route_cmd = app->add_subcommand("route", "Inspect a taught route");
   route_cmd->require_subcommand(1);
-  struct InfoArgs {
-    std::string route;
-    bool json = false;
+  struct Args {
+    std::string route, other;
+    bool json = false, views = false;
+    int max_views = 5;
   };
-  auto i = std::make_shared<InfoArgs>();
+  auto a = std::make_shared<Args>();
   CLI::App* info =
       route_cmd->add_subcommand("info", "Load a route (checking every file) and describe it");
-  info->add_option("ROUTE", i->route, "Route directory")->required();
-  info->add_flag("--json", i->json, "Print one JSON object");
-  info->callback([i] {
-    const nlohmann::json j = run::RouteInfo(i->route);
-    std::cout << (i->json ? j.dump() : run::RouteInfoLine(i->route, j)) << "\n";
+  info->add_option("ROUTE", a->route, "Route directory")->required();
+  info->add_flag("--json", a->json, "Print one JSON object");
+  info->add_flag("--views", a->views, "List each keyframe's learned views (repeat --learn)");
+  info->callback([a] {
+    const nlohmann::json j = run::RouteInfo(a->route, a->views);
+    std::cout << (a->json ? j.dump() : run::RouteInfoLine(a->route, j)) << "\n";
   });
-  auto p = std::make_shared<std::pair<std::string, int>>("", 5);
   CLI::App* prune = route_cmd->add_subcommand(
       "prune", "Keep at most N views per keyframe, dropping the learned views used least recently");
-  prune->add_option("ROUTE", p->first, "Route directory")->required();
-  prune->add_option("--max-views", p->second, "Views per place, the taught one included")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 64));
-  prune->callback([p] { std::cout << run::PruneRouteViews(p->first, p->second) << "\n"; });
+  CLI::App* merge = route_cmd->add_subcommand(
+      "merge", "Add the views another copy of the route learned (repeat --learn elsewhere)");
+  for (CLI::App* c : {prune, merge}) {
+    c->add_option("ROUTE", a->route, "Route directory")->required();
+    if (c == merge) c->add_option("OTHER", a->other, "The other copy (only read)")->required();
+    c->add_option("--max-views", a->max_views, "Views per place, the taught one included")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 64));
+  }
+  prune->callback([a] { std::cout << run::PruneRouteViews(a->route, a->max_views) << "\n"; });
+  merge->callback(
+      [a] { std::cout << run::MergeRouteViews(a->route, a->other, a->max_views) << "\n"; });
 }
 
 void AddTeachRepeatCommands(CLI::App* app) {

@@ -78,6 +78,32 @@ function(mapless_test)
   endif()
   gtest_discover_tests(${ARG_NAME} WORKING_DIRECTORY ${PROJECT_BINARY_DIR} DISCOVERY_TIMEOUT 60
                        PROPERTIES ${properties})
+  # README command 2 runs in the release build only the cases that tests/release_only_tests.txt
+  # names (and the middleware's): with MAPLESS_RELEASE_ONLY_TESTS, the binaries that have none
+  # are left out of `all` (scripts/test.sh; about 100 CPU-seconds of compiling).
+  if(MAPLESS_RELEASE_ONLY_TESTS AND NOT ARG_MIDDLEWARE AND NOT MAPLESS_SANITIZE)
+    mapless_has_release_only_case(has ${ARG_SRCS})
+    if(NOT has)
+      set_target_properties(${ARG_NAME} PROPERTIES EXCLUDE_FROM_ALL ON)
+    endif()
+  endif()
+endfunction()
+
+# Sets `out` to TRUE when one of the sources defines a case named in tests/release_only_tests.txt.
+function(mapless_has_release_only_case out)
+  file(STRINGS ${PROJECT_SOURCE_DIR}/tests/release_only_tests.txt lines REGEX "^[A-Za-z]")
+  set(${out} FALSE PARENT_SCOPE)
+  foreach(src ${ARGN})
+    get_filename_component(path ${src} ABSOLUTE)
+    file(READ ${path} text)
+    foreach(line ${lines})
+      string(REGEX MATCH "^([A-Za-z0-9_]+)\\.([A-Za-z0-9_]+)" name "${line}")
+      if(name AND text MATCHES "TEST(_F)?\\(${CMAKE_MATCH_1}, *${CMAKE_MATCH_2}\\)")
+        set(${out} TRUE PARENT_SCOPE)
+        return()
+      endif()
+    endforeach()
+  endforeach()
 endfunction()
 
 # mapless_register_middleware(MODULE HEADER FUNCTION): a module that implements a middleware of the

@@ -207,6 +207,20 @@ section_routes() {
   expect_exit "route prune to the taught views" 0 "$MAPLESS" route prune "$TMP/route" --max-views 1
   grep -q "route: 0 learned views pruned, 0 left" "$TMP/out"; check "route prune says what it pruned" $?
   expect_exit "route prune --max-views 0 exits 2" 2 "$MAPLESS" route prune "$TMP/route" --max-views 0
+  # Views learned by another copy of the route (issue 45): merged; the route itself and a route
+  # taught otherwise refused; each keyframe's views listed.
+  cp -r "$TMP/route" "$TMP/route_copy" && rm -f "$TMP/route_copy/.lock"
+  expect_exit "repeat --learn on the copy" 0 "$MAPLESS" repeat --route "$TMP/route_copy" --source "$TMP/d1/frames" --learn
+  expect_exit "route merge of the copy" 0 "$MAPLESS" route merge "$TMP/route" "$TMP/route_copy"
+  grep -Eq "route: [0-9]+ learned views? merged from .*route_copy, [0-9]+ in all" "$TMP/out"; check "route merge says what it merged" $?
+  expect_exit "route info --views --json" 0 "$MAPLESS" route info "$TMP/route" --views --json
+  grep -q '"visits":1' "$TMP/out" && grep -q '"views":\[\[' "$TMP/out"; check "route info lists the views per keyframe, the copy's visit counted" $?
+  expect_exit "route merge of the route itself exits 2" 2 "$MAPLESS" route merge "$TMP/route" "$TMP/route/"
+  grep -q "is the route itself" "$TMP/err"; check "merging a route into itself is refused" $?
+  mkdir -p "$TMP/half" && find "$TMP/d1/frames" -name '*.png' | sort | head -n $((n_frames / 2)) | xargs cp -t "$TMP/half"
+  expect_exit "teach half of the drive" 0 "$MAPLESS" teach --source "$TMP/half" --out "$TMP/route_other"
+  expect_exit "route merge of another route exits 2" 2 "$MAPLESS" route merge "$TMP/route" "$TMP/route_other"
+  grep -q "were not taught together" "$TMP/err"; check "merging a route taught otherwise is refused" $?
   # An image folder with TUM poses as its odometry (--poses): the eigenspace teach needs odometry.
   expect_exit "eigenspace teach of a folder without poses exits 2" 2 "$MAPLESS" teach --method eigenspace --source "$TMP/d1/frames" --out "$TMP/eroute0"
   grep -q "with --poses FILE.tum" "$TMP/err"; check "eigenspace teach asks for --poses" $?

@@ -83,6 +83,57 @@ TEST(Experiences, PruningARouteKeepsTheTaughtViewAndTheMostRecentlyUsed) {
   EXPECT_THROW(navigation::PruneViews(&route, 0), InputError);
 }
 
+route::KeyframeView ViewWith(int value, double offset_px, int visit) {
+  route::KeyframeView v;
+  v.descriptors = cv::Mat(3, 32, CV_8UC1, cv::Scalar(value));
+  v.keypoints.resize(3);
+  v.offset_px = offset_px;
+  v.learned_at = visit;
+  v.last_used = visit;
+  return v;
+}
+
+TEST(Experiences, MergingAddsTheOtherCopysNewViewsAfterItsOwnVisits) {
+  route::Route route;
+  route.keyframes.resize(2);
+  for (auto& kf : route.keyframes) kf.descriptors = cv::Mat(4, 32, CV_8UC1, cv::Scalar(7));
+  route.keyframes[0].views.push_back(ViewWith(1, 2.0, 1));
+  route.visits = 2;
+  route::Route other = route;  // a copy that was repeated elsewhere, 3 visits more
+  other.visits = 5;
+  other.keyframes[0].views.push_back(ViewWith(2, -3.0, 4));
+  other.keyframes[1].views.push_back(ViewWith(3, 1.5, 5));
+  other.keyframes[1].views.back().file = "views/000001_5.yml";
+  EXPECT_EQ(navigation::MergeViews(&route, other, 5), 2);  // the shared view is not added twice
+  EXPECT_EQ(route.visits, 7);
+  ASSERT_EQ(route.keyframes[0].views.size(), 2u);
+  EXPECT_EQ(route.keyframes[0].views[1].learned_at, 6);  // visit 4 of the other, after 2 here
+  EXPECT_EQ(route.keyframes[0].views[1].offset_px, -3.0);
+  ASSERT_EQ(route.keyframes[1].views.size(), 1u);
+  EXPECT_EQ(route.keyframes[1].views[0].last_used, 7);
+  EXPECT_TRUE(route.keyframes[1].views[0].file.empty());   // written anew
+  EXPECT_EQ(navigation::MergeViews(&route, other, 5), 0);  // all there already
+  // With room for one learned view per place, the most recently useful one stays.
+  route::Route full = route;
+  EXPECT_EQ(navigation::MergeViews(&full, other, 2), 0);
+  EXPECT_EQ(full.keyframes[0].views.size(), 1u);
+  EXPECT_EQ(full.keyframes[0].views[0].offset_px, -3.0);
+  // Another route, or another teach of this one, is refused.
+  route::Route shorter = other;
+  shorter.keyframes.pop_back();
+  EXPECT_THROW(navigation::MergeViews(&route, shorter, 5), InputError);
+  route::Route retaught = other;
+  retaught.keyframes[1].descriptors = other.keyframes[1].descriptors.clone();  // not shared
+  retaught.keyframes[1].descriptors.at<std::uint8_t>(2, 5) = 8;
+  try {
+    navigation::MergeViews(&route, retaught, 5);
+    ADD_FAILURE() << "a route taught otherwise was merged";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("keyframe 1 differs"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(navigation::MergeViews(&route, other, 0), InputError);
+}
+
 TEST(Experiences, OptionsRefuseImpossibleValues) {
   ExperienceOptions o;
   o.max_views = 0;

@@ -1,6 +1,7 @@
 #include "mapless/navigation/experiences.h"
 
 #include <algorithm>
+#include <opencv2/core.hpp>
 #include <utility>
 
 #include "mapless/core/check.h"
@@ -124,6 +125,53 @@ int PruneViews(route::Route* route, int max_views) {
     removed += static_cast<int>(before - kf.views.size());
   }
   return removed;
+}
+
+namespace {
+
+bool SameMat(const cv::Mat& a, const cv::Mat& b) {
+  if (a.size() != b.size() || a.type() != b.type()) return false;
+  return a.empty() || cv::norm(a, b, cv::NORM_INF) == 0.0;
+}
+
+bool SameView(const route::KeyframeView& a, const route::KeyframeView& b) {
+  return a.offset_px == b.offset_px && a.keypoints.size() == b.keypoints.size() &&
+         SameMat(a.descriptors, b.descriptors);
+}
+
+}  // namespace
+
+int MergeViews(route::Route* into, const route::Route& from, int max_views) {
+  MAPLESS_CHECK(max_views >= 1, "max_views = " << max_views << "; must be >= 1 (the taught view)");
+  MAPLESS_CHECK(into->keyframes.size() == from.keyframes.size() && into->detector == from.detector,
+                "the routes were not taught together: "
+                    << into->keyframes.size() << " " << into->detector << " keyframes against "
+                    << from.keyframes.size() << " " << from.detector);
+  for (std::size_t k = 0; k < from.keyframes.size(); ++k) {
+    const route::Keyframe& a = into->keyframes[k];
+    const route::Keyframe& b = from.keyframes[k];
+    MAPLESS_CHECK(a.keypoints.size() == b.keypoints.size() && SameMat(a.descriptors, b.descriptors),
+                  "the routes were not taught together: keyframe " << k << " differs");
+  }
+  const int shift = into->visits;
+  into->visits += from.visits;
+  int added = 0;
+  for (std::size_t k = 0; k < from.keyframes.size(); ++k) {
+    auto& views = into->keyframes[k].views;
+    for (const route::KeyframeView& v : from.keyframes[k].views) {
+      if (std::any_of(views.begin(), views.end(),
+                      [&](const route::KeyframeView& w) { return SameView(v, w); }))
+        continue;
+      route::KeyframeView copy = v;
+      copy.learned_at += shift;
+      copy.last_used += shift;
+      copy.file.clear();  // written anew into the route it joins
+      views.push_back(std::move(copy));
+      ++added;
+    }
+    KeepAtMost(&views, 0, max_views - 1);
+  }
+  return added;
 }
 
 }  // namespace mapless::navigation

@@ -85,4 +85,14 @@ int ApplyVisit(route::Route* route, const std::vector<int>& used_views,
 // max_views < 1.
 int PruneViews(route::Route* route, int max_views);
 
+// Adds to `into` the learned views of `from`, a route taught together with it (a copy that another
+// robot or another run repeated with --learn: the same keyframes, feature for feature; otherwise
+// InputError naming the first keyframe that differs). A view `into` has already (the same
+// features and offset) is skipped. The merged views keep their order of visits, after every
+// visit of `into` (their visit numbers are shifted by into->visits, which grows by
+// from.visits), and each keyframe keeps at most max_views views, the least recently useful
+// making room. `mapless route merge`. Returns the number of views merged (some may have made
+// room again at once, when they were used less recently than the views there).
+int MergeViews(route::Route* into, const route::Route& from, int max_views);
+
 }  // namespace mapless::navigation

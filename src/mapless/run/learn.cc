@@ -1,5 +1,8 @@
 #include "mapless/run/learn.h"
 
+#include <filesystem>
+
+#include "mapless/core/check.h"
 #include "mapless/io/output_dir.h"
 #include "mapless/route/route_store.h"
 
@@ -32,6 +35,20 @@ std::string PruneRouteViews(const std::string& dir, int max_views) {
   for (const auto& kf : route.keyframes) left += kf.views.size();
   return dir + ": " + std::to_string(removed) + " learned view" + (removed == 1 ? "" : "s") +
          " pruned, " + std::to_string(left) + " left";
+}
+
+std::string MergeRouteViews(const std::string& dir, const std::string& other, int max_views) {
+  MAPLESS_CHECK(!std::filesystem::exists(other) || !std::filesystem::equivalent(dir, other),
+                "route merge: " << other << " is the route itself");
+  const io::DirectoryLock lock(dir);
+  const io::DirectoryLock other_lock(other);  // not while a repeat learns into it
+  route::Route route = route::LoadRoute(dir);
+  const int merged = navigation::MergeViews(&route, route::LoadRoute(other), max_views);
+  route::SaveViews(dir, &route);
+  std::size_t views = 0;
+  for (const auto& kf : route.keyframes) views += kf.views.size();
+  return dir + ": " + std::to_string(merged) + " learned view" + (merged == 1 ? "" : "s") +
+         " merged from " + other + ", " + std::to_string(views) + " in all";
 }
 
 }  // namespace mapless::run

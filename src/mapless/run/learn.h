@@ -22,4 +22,9 @@ std::string SaveVisit(const std::string& dir, const route::Route& route,
 // the pruned files removed). Returns one line: "ROUTE: 3 learned views pruned, 12 left".
 std::string PruneRouteViews(const std::string& dir, int max_views);
 
+// `mapless route merge ROUTE OTHER --max-views N`: the views OTHER learned, merged into ROUTE
+// (navigation::MergeViews; both directories locked, OTHER only read). Returns one line:
+// "ROUTE: 4 learned views merged from OTHER, 9 in all".
+std::string MergeRouteViews(const std::string& dir, const std::string& other, int max_views);
+
 }  // namespace mapless::run

@@ -8,7 +8,40 @@
 
 namespace mapless::run {
 
-nlohmann::json RouteInfo(const std::string& dir) {
+namespace {
+
+nlohmann::json ViewsOf(const route::Route& route) {
+  nlohmann::json all = nlohmann::json::array();
+  for (const auto& kf : route.keyframes) {
+    nlohmann::json views = nlohmann::json::array();
+    for (const auto& v : kf.views) {
+      views.push_back({{"learned_at", v.learned_at},
+                       {"last_used", v.last_used},
+                       {"offset_px", v.offset_px},
+                       {"features", v.keypoints.size()}});
+    }
+    all.push_back(views);
+  }
+  return all;
+}
+
+std::string ViewLines(const nlohmann::json& views) {
+  std::string out;
+  for (std::size_t k = 0; k < views.size(); ++k) {
+    if (views[k].empty()) continue;
+    out += Format("\n  keyframe %zu: taught view + %zu learned:", k, views[k].size());
+    for (const auto& v : views[k]) {
+      out += Format(" visit %d (used at %d, %+.1f px, %zu features)", v["learned_at"].get<int>(),
+                    v["last_used"].get<int>(), v["offset_px"].get<double>(),
+                    v["features"].get<std::size_t>());
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+nlohmann::json RouteInfo(const std::string& dir, bool list_views) {
   const std::filesystem::path path(dir);
   nlohmann::json j;
   if (std::filesystem::exists(path / "appearance.json") &&
@@ -44,6 +77,7 @@ nlohmann::json RouteInfo(const std::string& dir) {
   j["duration_s"] = route.keyframes.empty()
                         ? 0.0
                         : ToSeconds(route.keyframes.back().t_ns - route.keyframes.front().t_ns);
+  if (list_views) j["views"] = ViewsOf(route);
   return j;
 }
 
@@ -62,7 +96,8 @@ std::string RouteInfoLine(const std::string& dir, const nlohmann::json& j) {
   return Format("%s: %zu keyframes (%s), %s features, %dx%d, %.1f s%s", dir.c_str(),
                 j["keyframes"].get<std::size_t>(), state, j["detector"].get<std::string>().c_str(),
                 j["image_width"].get<int>(), j["image_height"].get<int>(),
-                j["duration_s"].get<double>(), learned.c_str());
+                j["duration_s"].get<double>(), learned.c_str()) +
+         (j.contains("views") ? ViewLines(j["views"]) : "");
 }
 
 }  // namespace mapless::run

@@ -404,11 +404,13 @@ void SupersampleEdges(const std::vector<Prepared>& prepared, const Buffers& buf,
   const float sub_y = static_cast<float>(1.0 / cam.fy);
   // Mark both pixels of every horizontally or vertically adjacent pair that sees different
   // surfaces (or a surface and the sky).
-  std::vector<std::int32_t> group(npix);
+  thread_local std::vector<std::int32_t> group;  // kept between renders, as Render's buffers
+  thread_local std::vector<std::uint8_t> edge;
+  group.resize(npix);
   for (std::size_t i = 0; i < npix; ++i) {
     group[i] = id[i] < 0 ? -1 : prepared[static_cast<std::size_t>(id[i])].group;
   }
-  std::vector<std::uint8_t> edge(npix, 0);
+  edge.assign(npix, 0);
   for (int y = 0; y < h; ++y) {
     const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
     for (int x = 0; x < w; ++x) {
@@ -650,7 +652,11 @@ cv::Mat Renderer::Render(const CameraModel& cam, const Rigid3& world_from_camera
     yd[static_cast<std::size_t>(y)] = static_cast<float>((y - cam.cy) / cam.fy);
 
   const std::size_t npix = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-  Buffers buf;
+  // Per thread, kept from one render to the next: a frame's buffers are megabytes, and allocating
+  // them anew for every frame costs page faults (most of all under AddressSanitizer, which maps
+  // every large block afresh). alpha, beta and nd are read only where id says a surface was hit,
+  // where pass 1 wrote them.
+  thread_local Buffers buf;
   buf.depth.assign(npix, std::numeric_limits<float>::infinity());
   buf.id.assign(npix, -1);
   buf.alpha.resize(npix);
