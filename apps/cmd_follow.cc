@@ -68,9 +68,14 @@ void AddFollowCommand(CLI::App* app) {
                   "Appearance route directory; with --connect, where the copy of the leader's "
                   "route is kept (resumed from when it exists)")
       ->required();
-  cmd->add_option("--connect", a->fleet.connect,
-                  "Follow the route a leader serves (mapless lead --bind), while it is taught: "
-                  "funnel or eigenspace, as the leader teaches");
+  CLI::Option* connect = cmd->add_option(
+      "--connect", a->fleet.connect,
+      "Follow the route a leader serves (mapless lead --bind), while it is taught: funnel or "
+      "eigenspace, as the leader teaches");
+  cmd->add_flag("--learn", a->fleet.learn,
+                "With --connect, a funnel route: offer the leader the views this repeat learned "
+                "(mapless lead --take-views)")
+      ->needs(connect);
   cmd->add_option("--real-time-factor", a->fleet.rate,
                   "With --connect on the simulator: simulated seconds per wall-clock second")
       ->capture_default_str()

@@ -19,7 +19,9 @@
 #include "mapless/robot/link_bench.h"
 #include "mapless/robot/methods.h"
 #include "mapless/robot/robot_file.h"
+#include "mapless/run/fleet_follow.h"
 #include "mapless/run/leader_sink.h"
+#include "mapless/run/learn.h"
 #include "mapless/run/sim_episode.h"
 #include "mapless/run/teach.h"
 #include "robot_run.h"
@@ -41,6 +43,7 @@ struct LeadArgs {
   std::string curve_key;
   std::vector<std::string> curve_allow;
   double rate = 1.0;
+  int take_views = 0;  // views per keyframe the route may hold with the followers' (0: none)
 };
 
 void Lead(const LeadArgs& a) {
@@ -50,6 +53,9 @@ void Lead(const LeadArgs& a) {
   if (!a.source.empty() && !run::IsSim(a.source))
     throw InputError("--source " + a.source + ": lead runs on sim:SCENARIO or --robot");
   features::ParseDetectorType(a.detector);
+  if (a.take_views == 1 || (a.take_views > 0 && kind != fleet::RouteKind::kFunnel))
+    throw InputError("--take-views " + std::to_string(a.take_views) +
+                     ": a funnel route's keyframes hold their taught view and 1-63 more (2-64)");
   std::optional<sim::Scenario> scenario;
   if (run::IsSim(a.source)) {
     scenario = sim::LoadScenario(a.source.substr(4));
@@ -65,6 +71,10 @@ void Lead(const LeadArgs& a) {
     throw InputError(a.route + ": holds a " +
                      std::string(fleet::RouteKindName(copy.header()->kind)) +
                      " route; this leader teaches " + a.method);
+  if (a.take_views > 0)
+    server_options.take_view = [&copy, &a](const fleet::Record& r) {
+      return copy.TakeView(r, a.take_views);
+    };
   fleet::LeaderServer server(copy, server_options, FleetLog);
   spdlog::info("lead: serving {} on {}{}", a.route, server.endpoint(),
                server_options.security.enabled() ? " (CURVE)" : "");
@@ -136,47 +146,6 @@ void WaitForLeader(const fleet::RouteCopy& copy, const fleet::FollowerClient& cl
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-}
-
-// The method for the route the header announces, reading the copy as it grows.
-std::unique_ptr<robot::Method> FollowerMethod(const fleet::RouteHeader& header,
-                                              const fleet::RouteCopy& copy,
-                                              const FollowConnectArgs& a,
-                                              const std::optional<sim::Scenario>& scenario) {
-  const cv::Size size(header.image_width, header.image_height);
-  if (header.kind == fleet::RouteKind::kEigenspace) {
-    navigation::AppearanceFollowerOptions follower;
-    follower.obstacle = ObstacleWatchFor(a.robot, a.on_obstacle, follower.obstacle, false);
-    SetFollowerRecovery(a.carry_on_m, &follower);
-    return std::make_unique<robot::FollowMethod>(
-        [&copy] {
-          auto route = copy.AppearanceRoute();
-          if (!route && copy.complete())  // waiting for more cannot help
-            throw RunFailed("follow: the leader completed its route without route images");
-          return route;
-        },
-        follower, size);
-  }
-  navigation::RepeatOptions repeat;
-  repeat.features.type = features::ParseDetectorType(header.detector);
-  repeat.obstacle = ObstacleWatchFor(a.robot, a.on_obstacle, repeat.obstacle, true);
-  repeat.carry_on.max_distance_m = a.carry_on_m;
-  if (scenario) {
-    const double speed =
-        eval::RepeatSpeedFor(*scenario, eval::RepeatRunOptions{}.max_repeat_speed_mps);
-    repeat.sloped.max_speed_mps = speed;
-    repeat.standard.forward_speed_mps = speed;
-  }
-  return std::make_unique<robot::RepeatMethod>(
-      robot::RepeatMethod::RouteUpdates([&copy](route::Route* route) {
-        const bool changed = copy.UpdateFunnel(route);
-        if (route->complete && route->keyframes.size() < 2)
-          throw RunFailed("follow: the leader completed its route with " +
-                          std::to_string(route->keyframes.size()) +
-                          " keyframes; a route to follow needs at least 2");
-        return changed;
-      }),
-      repeat, size);
 }
 
 // The follower on the simulator, in step with the wall clock; its summary for `eval fleet`.
@@ -257,17 +226,33 @@ void FollowConnected(const FollowConnectArgs& a) {
   StopCleanlyOnInterrupt();
   WaitForLeader(copy, client, a);
   const fleet::RouteHeader header = *copy.header();
-  const std::unique_ptr<robot::Method> method = FollowerMethod(header, copy, a, scenario);
+  if (a.learn && header.kind != fleet::RouteKind::kFunnel)
+    throw InputError("--learn: " + a.connect +
+                     " serves an eigenspace route; views are learned "
+                     "on funnel routes");
+  run::FollowerSetup setup;
+  setup.follower.obstacle =
+      ObstacleWatchFor(a.robot, a.on_obstacle, setup.follower.obstacle, false);
+  SetFollowerRecovery(a.carry_on_m, &setup.follower);
+  setup.repeat.obstacle = ObstacleWatchFor(a.robot, a.on_obstacle, setup.repeat.obstacle, true);
+  setup.repeat.carry_on.max_distance_m = a.carry_on_m;
+  setup.repeat.learn = a.learn;
+  const std::unique_ptr<robot::Method> method =
+      run::FollowerMethod(header, copy, setup, scenario ? &*scenario : nullptr);
   spdlog::info("follow: a {} route from {}", fleet::RouteKindName(header.kind), a.connect);
   if (scenario) {
     FollowOnSim(*method, *scenario, header, copy, client, a);
-    return;
+  } else {
+    SourceRunArgs args;
+    args.log = a.log;
+    args.robot = true;
+    args.live = a.live;
+    RunOnSource(*method, a.robot, args);
   }
-  SourceRunArgs args;
-  args.log = a.log;
-  args.robot = true;
-  args.live = a.live;
-  RunOnSource(*method, a.robot, args);
+  auto* repeat = dynamic_cast<robot::RepeatMethod*>(method.get());
+  if (a.learn && repeat != nullptr && repeat->session())
+    spdlog::info("follow: {}",
+                 run::ShareLearnedViews(copy, client, repeat->session()->TakeLearned(), 10.0));
 }
 
 void AddLeadCommand(CLI::App* app) {
@@ -292,6 +277,10 @@ void AddLeadCommand(CLI::App* app) {
       ->capture_default_str()
       ->check(ZeroOrIn(0.01, 100.0));
   AddOldName(cmd, "--rate", "--real-time-factor", &a->rate)->check(ZeroOrIn(0.01, 100.0));
+  cmd->add_option("--take-views", a->take_views,
+                  "Funnel: take the views followers learn (follow --connect --learn) into the "
+                  "route, up to N per keyframe with the taught one (0: none; 2-64)")
+      ->check(CLI::Range(0, 64));
   cmd->add_option("--curve-key", a->curve_key, "CURVE: the leader's key file (fleet keygen)");
   cmd->add_option("--curve-allow", a->curve_allow,
                   "CURVE: public key files of the followers admitted (default: any that has the "

@@ -25,6 +25,7 @@ struct FollowConnectArgs {
   double motion_noise = 0.1;
   std::string on_obstacle;  // the obstacle watch: stop, off, or empty (the robot file's, else stop)
   double carry_on_m = 6.0;  // carrying on where the route no longer matches (0: off)
+  bool learn = false;       // funnel: offer the leader the views the repeat learned
   live::LiveArgs live;      // --live
 };
 void FollowConnected(const FollowConnectArgs& a);

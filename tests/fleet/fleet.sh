@@ -90,3 +90,26 @@ tail -n +$((before + 1)) "$work/lead.log" | grep -Eq "refused a connection|conne
 [ $((after - before)) -le 3 ] || fail "garbage flooded the log ($((after - before)) lines)"
 kill -0 "${pids[0]}" || fail "the leader died of garbage"
 echo "garbage on the leader's port: refused and logged; the leader serves on"
+
+# Shared views (issue 45): a leader that takes views serves a route taught on session 0 of a
+# changing world; a follower repeats it on session 8 with --learn and offers what it learned; the
+# leader takes it into the route and it comes back to the follower's copy, equal to the leader's.
+port=$((20000 + RANDOM % 20000))
+"$mapless" lead --source sim:lifelong_indoor --route "$work/views_leader" --bind "tcp://127.0.0.1:$port" \
+  --real-time-factor 0 --take-views 5 > "$work/views_lead.log" 2>&1 &
+pids+=($!)
+for _ in $(seq 600); do grep -q "serving it" "$work/views_lead.log" && break; sleep 0.1; done
+grep -q "serving it" "$work/views_lead.log" || fail "the leader did not teach lifelong_indoor"
+timeout 300 "$mapless" follow --connect "tcp://127.0.0.1:$port" --source sim:lifelong_indoor@8 \
+  --route "$work/views_copy" --real-time-factor 0 --learn > "$work/views_follow.log" 2>&1 ||
+  fail "the follower on session 8: exit $?"
+line=$(grep -o "offered [0-9]* views* to the leader; [0-9]* in the route now.*" "$work/views_follow.log") ||
+  fail "the follower did not offer its views"
+offered=$(echo "$line" | sed 's/offered \([0-9]*\).*/\1/')
+taken=$(echo "$line" | sed 's/.*; \([0-9]*\) in the route.*/\1/')
+[ "$offered" -ge 1 ] && [ "$taken" = "$offered" ] || fail "views offered and taken: $line"
+grep -q "took a view of keyframe" "$work/views_lead.log" || fail "the leader did not log the views it took"
+"$mapless" route info "$work/views_leader" --json > "$work/views_info.json" 2>&1
+grep -q "\"visits\":$taken" "$work/views_info.json" || fail "the leader's route: $(cat "$work/views_info.json")"
+diff -r --exclude=.lock "$work/views_leader" "$work/views_copy" > /dev/null || fail "the copy differs from the leader's route"
+echo "shared views: the follower on session 8 learned $offered views, the leader took them, the copy has them"

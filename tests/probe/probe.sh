@@ -347,6 +347,14 @@ probe "lead into a directory that holds something else" 2 "holds something else 
 probe "lead an eigenspace route into a funnel route" 2 "holds a funnel route; this leader teaches eigenspace" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$FX/route" --bind tcp://127.0.0.1:1 --method eigenspace
 probe "follow --connect to an endpoint that is not one" 2 "--connect nonsense" -- "$MAPLESS" follow --connect nonsense --source sim:table1_almost_straight --route "$NEW/c1"
 probe "follow --connect with a key but no leader key" 2 "--curve-key and --curve-leader go together" -- "$MAPLESS" follow --connect tcp://127.0.0.1:1 --source sim:table1_almost_straight --route "$NEW/c2" --curve-key "$FX/fleet.key"
+# Shared views (issue 45): a leader takes 0 or 2-64 a keyframe, funnel routes only; --learn needs a leader.
+probe "lead --take-views 1" 2 "--take-views 1" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/l5" --bind tcp://127.0.0.1:1 --take-views 1
+probe "lead --take-views on an eigenspace route" 2 "--take-views 5" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/l6" --bind tcp://127.0.0.1:1 --method eigenspace --take-views 5
+probe "lead --take-views 65" 2 "--take-views" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/l7" --bind tcp://127.0.0.1:1 --take-views 65
+probe "follow --learn without --connect" 2 "--learn requires --connect" -- "$MAPLESS" follow --route "$FX/aroute" --source sim:table1_almost_straight --learn
+# Sessions of a changing world (sim:NAME@S): a world without sessions, a session out of range.
+probe "a session of a world that does not change" 2 "has no sessions: block" -- "$MAPLESS" teach --source sim:table1_almost_straight@3 --out "$NEW/t5"
+probe "session 99999" 2 "session 99999" -- "$MAPLESS" teach --source sim:lifelong_indoor@99999 --out "$NEW/t6"
 probe "fleet keygen over an existing file" 2 "fleet.key: exists" -- "$MAPLESS" fleet keygen "$FX/fleet.key"
 probe "navigate --robot without a calibration" 2 "needs --calibration" -- "$MAPLESS" navigate --robot "$FX/robot_ros3.yaml" --destination 1,1
 probe "sim serve --like an unknown run" 2 "--like dance" -- "$MAPLESS" sim serve --scenario table1_almost_straight --robot "$FX/robot_ok.yaml" --like dance

@@ -60,6 +60,7 @@ struct FollowerClient::Impl {
   std::atomic<std::size_t> queued{0};  // queue.size()
   std::atomic<bool> resync{false};     // a record was refused: drop the queue, ask from the copy
   std::string refusal;                 // under stats_mutex: why this follower takes nothing more
+  std::deque<std::string> outbox;      // under queue_mutex: views to offer the leader, encoded
   std::string refused() {
     std::lock_guard<std::mutex> lock(stats_mutex);
     return refusal;
@@ -235,6 +236,22 @@ struct FollowerClient::Impl {
     return gap;
   }
 
+  // The views waiting to be offered, as far as the connection takes them now.
+  void SendOutbox() {
+    std::uint64_t sent = 0;
+    {
+      std::lock_guard<std::mutex> lock(queue_mutex);
+      while (!outbox.empty() &&
+             dealer.send(zmq::buffer(outbox.front()), zmq::send_flags::dontwait)) {
+        outbox.pop_front();
+        ++sent;
+      }
+    }
+    if (sent == 0) return;
+    std::lock_guard<std::mutex> lock(stats_mutex);
+    stats.views_offered += sent;
+  }
+
   void RunNetwork() {
     expected = copy.next_sequence();
     verify_pending = expected > 0;
@@ -264,6 +281,7 @@ struct FollowerClient::Impl {
         hold_until = now + std::chrono::duration_cast<Clock::duration>(
                                std::chrono::duration<double>(options.resubscribe_s));
       }
+      SendOutbox();
       bool gap = false;
       if (item.revents & ZMQ_POLLIN) gap = Receive();
       const double silent = std::chrono::duration<double>(now - last_heard).count();
@@ -368,6 +386,37 @@ FollowerClient::~FollowerClient() {
   }
   if (impl_->network.joinable()) impl_->network.join();
   if (impl_->applier.joinable()) impl_->applier.join();
+}
+
+void FollowerClient::Share(std::vector<Record> views) {
+  constexpr std::size_t kMaxOutbox = 1024;
+  std::size_t dropped = 0;
+  std::size_t too_large = 0;
+  {
+    std::lock_guard<std::mutex> lock(impl_->queue_mutex);
+    for (Record& r : views) {
+      MAPLESS_CHECK(r.type == RecordType::kView,
+                    "FollowerClient::Share: a " << RecordTypeName(r.type) << " record");
+      if (impl_->outbox.size() >= kMaxOutbox) {
+        ++dropped;
+        continue;
+      }
+      r.sequence = 0;
+      r.written_ns = WallClockNs();
+      std::string bytes = EncodeRecord(r);
+      if (bytes.size() > kMaxViewOfferBytes) {
+        ++too_large;
+        continue;
+      }
+      impl_->outbox.push_back(std::move(bytes));
+    }
+  }
+  if (dropped > 0)
+    impl_->Log("fleet: " + std::to_string(dropped) + " views not offered: " +
+               std::to_string(kMaxOutbox) + " are waiting for the connection already");
+  if (too_large > 0)
+    impl_->Log("fleet: " + std::to_string(too_large) + " views not offered: larger than " +
+               std::to_string(kMaxViewOfferBytes) + " bytes");
 }
 
 bool FollowerClient::Verified() const {

@@ -39,6 +39,7 @@ struct ClientStats {
   std::uint64_t ahead_dropped = 0;       // newer than the next one needed (a gap, asked again)
   std::uint64_t rejected = 0;            // malformed or refused by the copy
   std::uint64_t subscriptions = 0;       // "from n" sent
+  std::uint64_t views_offered = 0;       // learned views sent to the leader (Share)
   std::uint64_t leader_records = 0;      // the leader's log size at its last heartbeat
   bool leader_complete = false;
   double silent_s = 0.0;           // since the last message from the leader
@@ -61,6 +62,11 @@ class FollowerClient {
   // disk) is of another route, the leader refused its CURVE key, the handshake failed three times
   // in a row, or the link's thread stopped. It then takes nothing more.
   std::string Refusal() const;
+  // Offers the leader views this follower's repeat learned (ShareViewRecord records, issue 45);
+  // sent by the link's thread as the connection takes them (at most 1,024 waiting; more are
+  // dropped with a line). The leader that takes one appends it to the route, and it comes back to
+  // this copy as a record like every other.
+  void Share(std::vector<Record> views);
   // True once the copy is known to be the leader's route: at once for a new copy; for one resumed
   // from disk, when the leader's copy of its last record matched.
   bool Verified() const;

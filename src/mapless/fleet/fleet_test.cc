@@ -13,84 +13,14 @@
 #include "mapless/fleet/record.h"
 #include "mapless/fleet/route_log.h"
 #include "mapless/fleet/server.h"
+#include "mapless/fleet/test_support.h"
 #include "mapless/io/atomic_file.h"
 #include "mapless/io/limits.h"
 
 namespace mapless::fleet {
 namespace {
 
-namespace fs = std::filesystem;
-
-std::string FreshDir(const std::string& name) {
-  const std::string dir = ::testing::TempDir() + "mapless_fleet_" + name;
-  fs::remove_all(dir);
-  return dir;
-}
-
-route::Keyframe MakeKeyframe(int index) {
-  Rng rng(static_cast<std::uint64_t>(index) + 1);
-  route::Keyframe kf;
-  kf.index = index;
-  kf.t_ns = 100'000'000LL * (index + 1);
-  kf.thumbnail = cv::Mat(60, 80, CV_8UC1, cv::Scalar(10 * index));
-  for (int i = 0; i < 40; ++i)
-    kf.keypoints.emplace_back(static_cast<float>(rng.Uniform(0, 320)),
-                              static_cast<float>(rng.Uniform(0, 240)), 31.0f);
-  kf.descriptors = cv::Mat(40, 32, CV_8UC1);
-  for (int r = 0; r < 40; ++r)
-    for (int c = 0; c < 32; ++c)
-      kf.descriptors.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(rng.UniformInt(256));
-  return kf;
-}
-
-route::StoredAppearanceImage MakeImage(int index) {
-  Rng rng(static_cast<std::uint64_t>(index) + 7);
-  route::StoredAppearanceImage image;
-  image.low = cv::Mat(64, 64, CV_8UC1);
-  for (int r = 0; r < 64; ++r)
-    for (int c = 0; c < 64; ++c)
-      image.low.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(rng.UniformInt(256));
-  image.distance_m = 0.2 * index;
-  image.odometry = Pose2{0.2 * index, 0.01 * index, 0.001 * index};
-  return image;
-}
-
-// A funnel route of `keyframes` keyframes as a leader's records (sequence numbers set).
-std::vector<Record> FunnelRecords(int keyframes, bool end) {
-  RouteHeader h;
-  h.kind = RouteKind::kFunnel;
-  h.image_width = 320;
-  h.image_height = 240;
-  std::vector<Record> records = {HeaderRecord(h)};
-  for (int i = 0; i < keyframes; ++i) records.push_back(KeyframeRecord(MakeKeyframe(i)));
-  if (end) records.push_back(EndRecord());
-  for (std::size_t i = 0; i < records.size(); ++i) records[i].sequence = i;
-  return records;
-}
-
-std::vector<Record> ImageRecords(int images, bool end) {
-  RouteHeader h;
-  h.kind = RouteKind::kEigenspace;
-  h.image_width = 320;
-  h.image_height = 240;
-  h.low_width = 64;
-  h.low_height = 64;
-  std::vector<Record> records = {HeaderRecord(h)};
-  for (int i = 0; i < images; ++i) records.push_back(ImageRecord(MakeImage(i)));
-  if (end) records.push_back(EndRecord());
-  for (std::size_t i = 0; i < records.size(); ++i) records[i].sequence = i;
-  return records;
-}
-
-// Every file of a directory, by relative path, with its bytes.
-std::map<std::string, std::string> Files(const std::string& dir) {
-  std::map<std::string, std::string> out;
-  for (const auto& e : fs::recursive_directory_iterator(dir)) {
-    if (!e.is_regular_file()) continue;
-    out[fs::relative(e.path(), dir).string()] = io::ReadFile(e.path().string(), 1 << 26);
-  }
-  return out;
-}
+using namespace test;  // NOLINT(build/namespaces): the fixtures of fleet tests
 
 TEST(FleetRecord, RoundTripsAndRejectsMalformedBytesWithOneLine) {
   Record r;
@@ -277,15 +207,6 @@ TEST(FleetRouteCopy, OwnRecordsEncodedOnceAndTheRouteReadInPieces) {
     images_own.ApplyOwn(image_records[i], std::nullopt, low);
   }
   EXPECT_EQ(Files(images_applied.dir()), Files(images_own.dir()));
-}
-
-bool WaitFor(const std::function<bool()>& done, double seconds) {
-  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (std::chrono::steady_clock::now() < until) {
-    if (done()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  return done();
 }
 
 TEST(FleetLink, AFollowerCatchesUpThenReceivesLiveRecordsOnLoopback) {

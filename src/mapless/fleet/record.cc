@@ -89,6 +89,8 @@ const char* RecordTypeName(RecordType type) {
       return "end";
     case RecordType::kHeartbeat:
       return "heartbeat";
+    case RecordType::kView:
+      return "view";
   }
   return "?";
 }
@@ -119,7 +121,7 @@ Record DecodeRecord(std::string_view bytes) {
   Record r;
   const auto type = in.Get<std::uint8_t>("type");
   if (type < static_cast<std::uint8_t>(RecordType::kHeader) ||
-      type > static_cast<std::uint8_t>(RecordType::kHeartbeat))
+      type > static_cast<std::uint8_t>(RecordType::kView))
     throw InputError("fleet message: unknown record type " + std::to_string(type));
   r.type = static_cast<RecordType>(type);
   if (in.Get<std::uint16_t>("reserved") != 0)
@@ -143,6 +145,7 @@ Record DecodeRecord(std::string_view bytes) {
   const std::size_t expected = r.type == RecordType::kHeader      ? 1
                                : r.type == RecordType::kKeyframe  ? 2
                                : r.type == RecordType::kImage     ? 2
+                               : r.type == RecordType::kView      ? 2
                                : r.type == RecordType::kHeartbeat ? 1
                                                                   : 0;
   if (r.parts.size() != expected)

@@ -1,7 +1,8 @@
 // The records a leader serves to its followers (the route as an append-only log, issue 19).
 //
 // A route is a log of records with sequence numbers: 0 the route header, 1..n the route's elements
-// in order (funnel-lane keyframes or eigenspace route images), n+1 the end of the route. The
+// in order (funnel-lane keyframes or eigenspace route images), n+1 the end of the route, then the
+// views of its places that repeats learned (issue 45; funnel routes; route_log.h). The
 // sequence number of a record follows from the route on disk, so a leader that restarts and
 // reloads its route serves the same numbers. A record carries the bytes the route store writes
 // (the keyframe's YAML and PNG, the route image's PNG), so a follower's copy can be compared with
@@ -13,6 +14,8 @@
 // written_ns is the leader's wall clock when it appended the record (latency measurement only).
 // A follower's control message, "from sequence n" (also its heartbeat):
 //   magic "MLFC" | version u8 (1) | type u8 (1) | reserved u16 | from u64
+// A follower's learned view, offered to the leader (route_log.h: ShareViewRecord): a record of
+// type kView, sequence 0, as below.
 // A leader's heartbeat when it has nothing to send: a record of type kHeartbeat whose sequence is
 // the number of records in the log and whose single part is "1" when the route is complete.
 //
@@ -39,6 +42,8 @@ enum class RecordType : std::uint8_t {
   kImage = 3,      // part 0: the manifest entry as JSON, part 1: images/NNNNNN.png
   kEnd = 4,        // the route is complete (no parts)
   kHeartbeat = 5,  // not in the log; see above
+  kView =
+      6,  // part 0: {"keyframe", "offset_px", "learned_at", "last_used"}, part 1: the view's file
 };
 const char* RecordTypeName(RecordType type);
 

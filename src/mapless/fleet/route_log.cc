@@ -177,11 +177,12 @@ void RouteCopy::Load() {
                 dir_ << ": holds two routes (manifest.json and appearance.json)");
   // Records are rebuilt from the files and applied to an in-memory state; the files stay as they
   // are (Reopen keeps writing after them).
-  std::vector<Record> records;
+  std::vector<Record> views;  // after the end record
   if (funnel) {
-    keyframe_writer_ = route::RouteWriter::Reopen(dir_);
     const std::string path = (fs::path(dir_) / "manifest.json").string();
     const route::Manifest m = route::ParseManifest(io::ReadFile(path, io::kMaxManifestBytes), path);
+    // A complete route takes no more keyframes (and one with views cannot be reopened for them).
+    if (!m.complete) keyframe_writer_ = route::RouteWriter::Reopen(dir_);
     RouteHeader h;
     h.kind = RouteKind::kFunnel;
     h.image_width = m.image_width;
@@ -201,6 +202,7 @@ void RouteCopy::Load() {
       log_.push_back(std::move(r));
     }
     complete_ = m.complete;
+    views = LoadViewRecords(m);
   } else {
     image_writer_ = route::AppearanceRouteWriter::Reopen(dir_);
     const route::StoredAppearanceRoute& stored = image_writer_->header();
@@ -233,6 +235,7 @@ void RouteCopy::Load() {
     complete_ = route.complete;
   }
   if (complete_) log_.push_back(EndRecord());
+  for (Record& r : views) log_.push_back(std::move(r));
   const std::int64_t now = WallClockNs();
   for (std::size_t i = 0; i < log_.size(); ++i) {
     log_[i].sequence = i;
@@ -325,10 +328,17 @@ bool RouteCopy::UpdateFunnel(route::Route* route) const {
     route->image_width = header_->image_width;
     route->image_height = header_->image_height;
   }
+  for (std::size_t i = 0; i < route->keyframes.size() && i < keyframes_.size(); ++i) {
+    if (route->keyframes[i].views.size() != keyframes_[i].views.size()) {  // views shared since
+      route->keyframes[i].views = keyframes_[i].views;
+      changed = true;
+    }
+  }
   for (std::size_t i = route->keyframes.size(); i < keyframes_.size(); ++i) {
     route->keyframes.push_back(keyframes_[i]);
     changed = true;
   }
+  route->visits = visits_;
   if (route->complete != complete_) {
     route->complete = complete_;
     changed = true;
@@ -342,7 +352,8 @@ void RouteCopy::ApplyOne(const Record& record, std::optional<route::Keyframe>* d
       std::string(RecordTypeName(record.type)) + " record " + std::to_string(record.sequence);
   if (record.sequence != log_.size())
     throw InputError(what + ": expected sequence " + std::to_string(log_.size()));
-  if (complete_) throw InputError(what + ": after the end of the route");
+  if (complete_ && record.type != RecordType::kView)
+    throw InputError(what + ": after the end of the route");
   Record kept = record;
   if (record.type == RecordType::kHeader) {
     const RouteHeader h = ParseHeader(record);  // sequence 0 (checked by the decoder)
@@ -397,11 +408,14 @@ void RouteCopy::ApplyOne(const Record& record, std::optional<route::Keyframe>* d
   } else if (record.type == RecordType::kEnd) {
     if (keyframe_writer_) {
       keyframe_writer_->Finish();
+      keyframe_writer_.reset();  // done: the views that may follow write the manifest themselves
       funnel_cache_.reset();
     } else {
       image_writer_->Finish();
     }
     complete_ = true;
+  } else if (record.type == RecordType::kView) {
+    ApplyView(record, what);
   } else {
     throw InputError(what + ": not a route record");
   }
@@ -417,6 +431,7 @@ std::shared_ptr<const route::Route> RouteCopy::FunnelRoute() const {
     r->image_width = header_->image_width;
     r->image_height = header_->image_height;
     r->complete = complete_;
+    r->visits = visits_;
     r->keyframes = keyframes_;
     funnel_cache_ = std::move(r);
   }

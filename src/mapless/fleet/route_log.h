@@ -7,6 +7,13 @@
 // store's crash safety (files flushed before the manifest that lists them), and a copy left by a
 // killed process is reopened where it stopped: its next sequence number follows from the files.
 //
+// A funnel route's places may hold views that repeats learned (issue 45, navigation/experiences.h):
+// they follow the end record, one view record each, in the order of the visits that learned them
+// (shared_views.cc). A follower offers the leader a view it learned (ShareViewRecord); a leader
+// that takes views (TakeView) appends it to its log as the next record, and every follower applies
+// it to its copy. The log stays append-only: a place full of views takes no more (no pruning of
+// a served route).
+//
 // For the eigenspace route the records carry the route images, not the model: the incremental PCA
 // is deterministic given the same images in the same order, so RouteCopy rebuilds exactly the
 // leader's eigenspace (navigation::AppearanceLeader::AddStored), one image per record.
@@ -27,6 +34,9 @@
 
 namespace mapless::io {
 class DirectoryLock;
+}
+namespace mapless::route {
+struct Manifest;
 }
 
 namespace mapless::fleet {
@@ -51,6 +61,12 @@ RouteHeader ParseHeader(const Record& record);  // throws InputError
 Record KeyframeRecord(const route::Keyframe& keyframe);
 Record ImageRecord(const route::StoredAppearanceImage& image);  // image.low: 8-bit
 Record EndRecord();
+// A view a follower's repeat learned of `keyframe`, as it offers it to the leader (sequence 0;
+// part 0 keyframe and offset, part 1 the view's keyframe file).
+Record ShareViewRecord(const route::Keyframe& keyframe, const route::KeyframeView& view);
+// A stored view as a log record (its visits with it; `file_bytes`: its file as stored).
+Record StoredViewRecord(const route::Keyframe& keyframe, const route::KeyframeView& view,
+                        std::string file_bytes);
 
 class RouteCopy {
  public:
@@ -77,6 +93,12 @@ class RouteCopy {
   // record's 8-bit route image): as Apply({record}), without decoding what was just encoded.
   void ApplyOwn(const Record& record, std::optional<route::Keyframe> keyframe,
                 const cv::Mat& image_low = {});
+  // A leader's: takes a view a follower offers (ShareViewRecord) into a complete funnel route as
+  // the next record, learned at the route's next visit. Throws InputError (one line: why) when the
+  // route is not a complete funnel route, the record is malformed or does not fit the route, the
+  // keyframe has max_views views (the taught one included) or this view already. Returns a line
+  // for the log.
+  std::string TakeView(const Record& offered, int max_views);
   // Record `sequence` as it goes on the wire (EncodeRecord): encoded once, when first asked, and
   // shared by every follower it is sent to; null when there is no such record yet.
   std::shared_ptr<const std::string> Encoded(std::uint64_t sequence) const;
@@ -88,9 +110,9 @@ class RouteCopy {
   std::shared_ptr<const route::Route> FunnelRoute() const;
   std::shared_ptr<const route::AppearanceRoute> AppearanceRoute() const;
   // The funnel route read in pieces (a follower's method, on its own thread): appends to `route`
-  // the keyframes it lacks, sets its header fields and completeness, and says whether anything
-  // changed. Its work is the new keyframes', whatever the route's length (FunnelRoute() copies
-  // the whole route each time it changed).
+  // the keyframes it lacks and the views its keyframes lack, sets its header fields and
+  // completeness, and says whether anything changed. Its work is the new keyframes', whatever the
+  // route's length (FunnelRoute() copies the whole route each time it changed).
   bool UpdateFunnel(route::Route* route) const;
 
   const std::string& dir() const { return dir_; }
@@ -100,6 +122,10 @@ class RouteCopy {
   // `low`: the image record's image, when it is known (empty: decoded from the record).
   void ApplyOne(const Record& record, std::optional<route::Keyframe>* decoded,
                 const cv::Mat& low = {});
+  void ApplyView(const Record& record, const std::string& what);  // shared_views.cc
+  // The views of a loaded route's keyframes (keyframes_), in keyframes_ and as their records in
+  // the order they were learned (shared_views.cc).
+  std::vector<Record> LoadViewRecords(const route::Manifest& manifest);
   void Load();
 
   std::string dir_;
@@ -115,6 +141,8 @@ class RouteCopy {
   mutable std::vector<route::StoredAppearanceImage> model_pending_;  // applied, not in the model
   std::size_t images_ = 0;
   double last_distance_m_ = 0.0;
+  int visits_ = 0;           // the route's visits (views learned at 1..visits_)
+  int last_view_visit_ = 0;  // the last view record's learned_at (they come in order)
   mutable std::shared_ptr<const route::Route> funnel_cache_;
   // The eigenspace, under its own lock (building it does not hold up Apply).
   mutable std::mutex model_mutex_;

@@ -156,6 +156,10 @@ struct LeaderServer::Impl {
         continue;
       }
       const std::string id = msg[0].to_string();
+      if (msg[1].size() >= 4 && std::memcmp(msg[1].data(), "MLFR", 4) == 0) {
+        TakeView(msg[1].to_string_view());
+        continue;
+      }
       std::uint64_t from = 0;
       try {
         from = DecodeSubscribe(msg[1].to_string_view());
@@ -191,6 +195,24 @@ struct LeaderServer::Impl {
       }
       peer.next = from;
       peer.last_heard = Clock::now();
+    }
+  }
+
+  // A view a follower offers (a record of type kView): into the route when the leader takes views.
+  void TakeView(std::string_view bytes) {
+    try {
+      if (!options.take_view)
+        throw InputError("this leader takes no views (mapless lead --take-views)");
+      const Record offered = DecodeRecord(bytes);
+      if (offered.type != RecordType::kView)
+        throw InputError(std::string("a follower sent a ") + RecordTypeName(offered.type) +
+                         " record; it may offer views only");
+      const std::string line = options.take_view(offered);
+      Count(&ServerStats::views_taken);
+      LogLimited("views taken", "fleet: " + line);
+    } catch (const InputError& e) {
+      Count(&ServerStats::views_refused);
+      LogLimited("views refused", std::string("fleet: refused a view: ") + e.what());
     }
   }
 
@@ -346,8 +368,14 @@ LeaderServer::LeaderServer(const RouteCopy& log, ServerOptions options, FleetLog
     }
     s.router.set(zmq::sockopt::router_mandatory, 1);
     // Subscriptions are 16 bytes: a larger message still reaches the decoder (and its log line) up
-    // to 64 KiB; beyond that ZeroMQ drops the connection.
-    s.router.set(zmq::sockopt::maxmsgsize, static_cast<std::int64_t>(64 << 10));
+    // to 64 KiB; beyond that ZeroMQ drops the connection. A leader that takes views takes messages
+    // up to kMaxViewOfferBytes (a view of 500 ORB features is about 100 KB), 8 queued a follower.
+    if (s.options.take_view) {
+      s.router.set(zmq::sockopt::maxmsgsize, static_cast<std::int64_t>(kMaxViewOfferBytes));
+      s.router.set(zmq::sockopt::rcvhwm, 8);
+    } else {
+      s.router.set(zmq::sockopt::maxmsgsize, static_cast<std::int64_t>(64 << 10));
+    }
     MAPLESS_CHECK(s.options.peer_queue >= 1 && s.options.max_followers >= 1,
                   "fleet: peer_queue and max_followers must be >= 1");
     s.router.set(zmq::sockopt::sndhwm, s.options.peer_queue);

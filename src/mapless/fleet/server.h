@@ -35,6 +35,9 @@ using FleetLogger = std::function<void(const std::string&)>;
 // follower not heard from for stall_drop_s with records queued is dropped too: one that reads
 // asks again when the leader falls silent), and at most max_followers are served at once (one
 // more is told nothing and logged).
+// The largest view a follower may offer, encoded (ServerOptions::take_view).
+inline constexpr std::size_t kMaxViewOfferBytes = std::size_t{1} << 20;
+
 struct ServerOptions {
   std::string bind = "tcp://127.0.0.1:5600";
   LeaderSecurity security;
@@ -45,6 +48,11 @@ struct ServerOptions {
   std::size_t total_queue_bytes = std::size_t{96} << 20;  // queued to all followers together
   int max_followers = 256;
   double stall_drop_s = 10.0;  // a follower whose queue stayed full this long is dropped
+  // Views followers offer (issue 45; route_log.h): taken by this (RouteCopy::TakeView, which
+  // throws InputError saying why it refuses one; it returns a line for the log). Empty: the
+  // leader takes none, and says so once a second at most. Only followers the leader admits
+  // offer anything (with CURVE, only admitted keys).
+  std::function<std::string(const Record&)> take_view;
 };
 
 struct ServerStats {
@@ -54,7 +62,9 @@ struct ServerStats {
   std::uint64_t rejected = 0;     // malformed messages
   std::uint64_t dropped = 0;      // followers that stopped reading (or left) while records were due
   std::uint64_t turned_away = 0;  // subscriptions beyond max_followers
-  int followers = 0;              // known now
+  std::uint64_t views_taken = 0;  // views followers offered, taken into the route
+  std::uint64_t views_refused = 0;
+  int followers = 0;  // known now
   std::size_t queued_bytes =
       0;  // the bound on what the queues hold now (at most total_queue_bytes)
 };

@@ -132,6 +132,8 @@ void RepeatSession::Extend(std::shared_ptr<const route::Route> route) {
                     route->image_width == route_->image_width &&
                     route->image_height == route_->image_height,
                 "RepeatSession::Extend: not a continuation of the route");
+  for (std::size_t i = 0; i < keyframe_features_.size(); ++i)
+    AddNewViews(i, route->keyframes[i]);  // views shared since (a fleet's copy)
   for (std::size_t i = keyframe_features_.size(); i < route->keyframes.size(); ++i)
     AddKeyframeFeatures(route->keyframes[i]);
   route_ = std::move(route);

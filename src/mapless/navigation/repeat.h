@@ -270,6 +270,8 @@ class RepeatSession {
   std::vector<int> chosen_view_;
   std::vector<LearnedView> learned_;
   void AddKeyframeFeatures(const route::Keyframe& kf);
+  // The views of keyframe `at` (kf) not in learned_views_[at] yet.
+  void AddNewViews(std::size_t at, const route::Keyframe& kf);
   // Matches keyframe k's view v (0: the taught one), keyframe points in the taught view's pixels.
   void MatchView(int k, int v, std::vector<cv::Point2f>* current_px,
                  std::vector<cv::Point2f>* keyframe_px,

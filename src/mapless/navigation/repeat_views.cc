@@ -10,23 +10,27 @@
 namespace mapless::navigation {
 
 void RepeatSession::AddKeyframeFeatures(const route::Keyframe& kf) {
-  const bool binary = options_.features.type != features::DetectorType::kSift;
   features::Features f;
   f.keypoints = kf.keypoints;
   f.descriptors = kf.descriptors;
-  f.binary = binary;
+  f.binary = options_.features.type != features::DetectorType::kSift;
   keyframe_features_.push_back(std::move(f));
-  std::vector<View> views;
-  for (const route::KeyframeView& v : kf.views) {
+  learned_views_.emplace_back();
+  chosen_view_.push_back(-1);
+  AddNewViews(learned_views_.size() - 1, kf);
+}
+
+void RepeatSession::AddNewViews(std::size_t at, const route::Keyframe& kf) {
+  std::vector<View>& views = learned_views_[at];
+  for (std::size_t i = views.size(); i < kf.views.size(); ++i) {
+    const route::KeyframeView& v = kf.views[i];
     View view;
     view.features.keypoints = v.keypoints;
     view.features.descriptors = v.descriptors;
-    view.features.binary = binary;
+    view.features.binary = options_.features.type != features::DetectorType::kSift;
     view.offset_px = v.offset_px;
     views.push_back(std::move(view));
   }
-  learned_views_.push_back(std::move(views));
-  chosen_view_.push_back(-1);
 }
 
 void RepeatSession::MatchKeyframe(int k, std::vector<cv::Point2f>* current_px,

@@ -348,6 +348,29 @@ Keyframe DecodeKeyframe(const std::string& yml, const std::string& png, const Ma
   return kf;
 }
 
+KeyframeView DecodeView(const std::string& yml, const Keyframe& keyframe, const Manifest& header,
+                        const std::string& name) {
+  features::DetectorType detector = features::DetectorType::kOrb;
+  try {
+    detector = features::ParseDetectorType(header.detector);
+  } catch (const InputError& e) {
+    throw InputError(name + ": detector: " + e.what());
+  }
+  Keyframe kf = ParseKeyframe(yml, name);
+  if (kf.index != keyframe.index) {
+    throw InputError(name + ": a view of keyframe " + std::to_string(kf.index) +
+                     ", offered as a view of keyframe " + std::to_string(keyframe.index));
+  }
+  ManifestEntry entry;
+  entry.index = keyframe.index;
+  entry.t_s = ToSeconds(keyframe.t_ns);
+  CheckKeyframe(kf, entry, header, features::DescriptorLayoutOf(detector), name);
+  KeyframeView view;
+  view.keypoints = std::move(kf.keypoints);
+  view.descriptors = kf.descriptors;
+  return view;
+}
+
 Route LoadRoute(const std::string& dir) {
   const std::string manifest_path = (std::filesystem::path(dir) / "manifest.json").string();
   if (!std::filesystem::exists(manifest_path)) {

@@ -89,6 +89,15 @@ Route LoadRoute(const std::string& dir);
 // (io::DirectoryLock) for the whole run that learned them.
 void SaveViews(const std::string& dir, Route* route);
 
+// Where a keyframe's view learned at visit `learned_at` is stored
+// ("keyframes/NNNNNN-visit-VVVV.yml").
+std::string ViewFileName(int keyframe, int learned_at);
+// A learned view of `keyframe` from its file's bytes (a fleet record), checked as LoadRoute checks
+// a stored view against the route's `header` (detector, image size) and the keyframe (index,
+// time). Errors name `name`. The view's offset and visits are the caller's.
+KeyframeView DecodeView(const std::string& yml, const Keyframe& keyframe, const Manifest& header,
+                        const std::string& name);
+
 // The parsers behind LoadRoute, on bytes already read (`name` stands for the file in errors).
 // Fuzzed by fuzz/fuzz_route_manifest.cc and fuzz/fuzz_route_keyframe.cc.
 struct ManifestView {

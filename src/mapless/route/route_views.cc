@@ -15,15 +15,11 @@
 
 namespace mapless::route {
 
-namespace {
-
 std::string ViewFileName(int keyframe, int learned_at) {
   char name[64];
   std::snprintf(name, sizeof(name), "-visit-%04d.yml", learned_at);
   return KeyframeFileStem(keyframe) + name;
 }
-
-}  // namespace
 
 void SaveViews(const std::string& dir, Route* route) {
   MAPLESS_CHECK(route->visits >= 0, "SaveViews: visits = " << route->visits);

@@ -1,8 +1,13 @@
 #include "mapless/run/learn.h"
 
+#include <chrono>
 #include <filesystem>
+#include <set>
+#include <thread>
 
 #include "mapless/core/check.h"
+#include "mapless/fleet/client.h"
+#include "mapless/fleet/route_log.h"
 #include "mapless/io/output_dir.h"
 #include "mapless/route/route_store.h"
 
@@ -49,6 +54,44 @@ std::string MergeRouteViews(const std::string& dir, const std::string& other, in
   for (const auto& kf : route.keyframes) views += kf.views.size();
   return dir + ": " + std::to_string(merged) + " learned view" + (merged == 1 ? "" : "s") +
          " merged from " + other + ", " + std::to_string(views) + " in all";
+}
+
+std::string ShareLearnedViews(const fleet::RouteCopy& copy, fleet::FollowerClient& client,
+                              const std::vector<navigation::LearnedView>& learned, double wait_s) {
+  const std::shared_ptr<const route::Route> route = copy.FunnelRoute();
+  if (learned.empty() || !route) return "learned no views to offer the leader";
+  std::vector<fleet::Record> offers;
+  for (const navigation::LearnedView& l : learned) {
+    MAPLESS_CHECK(l.keyframe >= 0 && l.keyframe < static_cast<int>(route->keyframes.size()),
+                  "ShareLearnedViews: keyframe " << l.keyframe);
+    route::KeyframeView view;
+    view.keypoints = l.features.keypoints;
+    view.descriptors = l.features.descriptors;
+    view.offset_px = l.offset_px;
+    offers.push_back(
+        fleet::ShareViewRecord(route->keyframes[static_cast<std::size_t>(l.keyframe)], view));
+  }
+  std::set<std::string> files;  // what comes back: the same view file (other views may come too)
+  for (const fleet::Record& r : offers) files.insert(r.parts[1]);
+  const std::uint64_t before = copy.next_sequence();
+  const std::size_t n = offers.size();
+  client.Share(std::move(offers));
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(wait_s);
+  std::vector<std::uint64_t> back;
+  while (true) {
+    back.clear();
+    for (const fleet::Record& r : copy.RecordsFrom(before, 1u << 16))
+      if (r.type == fleet::RecordType::kView && files.count(r.parts[1])) back.push_back(r.sequence);
+    if (back.size() >= n || std::chrono::steady_clock::now() >= end) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::string line = "offered " + std::to_string(n) + " view" + (n == 1 ? "" : "s") +
+                     " to the leader; " + std::to_string(back.size()) + " in the route now";
+  if (!back.empty())
+    line += " (records " + std::to_string(back.front()) + "-" + std::to_string(back.back()) + ")";
+  if (back.size() < n)
+    line += "; the leader's log says why it took fewer (a leader without --take-views takes none)";
+  return line;
 }
 
 }  // namespace mapless::run

@@ -7,6 +7,11 @@
 #include "mapless/navigation/experiences.h"
 #include "mapless/route/route.h"
 
+namespace mapless::fleet {
+class RouteCopy;
+class FollowerClient;
+}  // namespace mapless::fleet
+
 namespace mapless::run {
 
 // Applies the visit (navigation::ApplyVisit) to a copy of `route` and writes it into `dir`
@@ -26,5 +31,12 @@ std::string PruneRouteViews(const std::string& dir, int max_views);
 // (navigation::MergeViews; both directories locked, OTHER only read). Returns one line:
 // "ROUTE: 4 learned views merged from OTHER, 9 in all".
 std::string MergeRouteViews(const std::string& dir, const std::string& other, int max_views);
+
+// `follow --connect --learn` (issue 45): offers the leader the views a follower's repeat learned
+// (fleet::ShareViewRecord) and waits up to wait_s for the leader to take them into the route and
+// for them to come back to `copy` as records. Returns one line: "offered 2 views to the leader;
+// 2 are in the route now (records 21-22)" (fewer when the leader took fewer: its log says why).
+std::string ShareLearnedViews(const fleet::RouteCopy& copy, fleet::FollowerClient& client,
+                              const std::vector<navigation::LearnedView>& learned, double wait_s);
 
 }  // namespace mapless::run

@@ -10,6 +10,7 @@
 #include "mapless/io/limits.h"
 #include "mapless/io/yaml_reader.h"
 #include "mapless/sim/builtin_scenarios.h"
+#include "mapless/sim/sessions.h"
 #include "mapless/sim/world_yaml.h"
 
 namespace mapless::sim {
@@ -305,6 +306,15 @@ std::string BuiltinScenarioText(const std::string& name) {
 }
 
 Scenario LoadScenario(const std::string& name_or_path) {
+  // NAME@S: session S of a changing world (sessions.h).
+  const std::size_t at = name_or_path.rfind('@');
+  if (at != std::string::npos && at + 1 < name_or_path.size() &&
+      name_or_path.find_first_not_of("0123456789", at + 1) == std::string::npos) {
+    const std::string digits = name_or_path.substr(at + 1);
+    if (digits.size() > 4)
+      throw InputError(name_or_path + ": session " + digits + " (at most 9999)");
+    return SessionScenario(LoadScenario(name_or_path.substr(0, at)), std::stoi(digits));
+  }
   const bool looks_like_path = name_or_path.find('/') != std::string::npos ||
                                std::filesystem::path(name_or_path).extension() == ".yaml" ||
                                std::filesystem::path(name_or_path).extension() == ".yml";

@@ -71,7 +71,8 @@ Eigen::Vector4d ScenarioBounds(const Scenario& scenario, double margin_m);
 Scenario ParseScenario(const std::string& yaml_text, const std::string& source,
                        const std::string& base_dir);
 // Loads a scenario by built-in name or by file path (a name containing '/' or ending in .yaml is a
-// path); throws InputError naming it when it is neither.
+// path); throws InputError naming it when it is neither. NAME@S (a number S): session S of a world
+// that changes between sessions (sessions.h: SessionScenario; `sim:lifelong_indoor@12`).
 Scenario LoadScenario(const std::string& name_or_path);
 // Built-in scenario names, sorted.
 std::vector<std::string> BuiltinScenarioNames();

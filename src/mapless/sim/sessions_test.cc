@@ -45,6 +45,20 @@ TEST(Sessions, TheSameSessionIsTheSameWorld) {
   EXPECT_NE(DescribeSession(s, 3), DescribeSession(s, 4));
 }
 
+TEST(Sessions, ASourceNamesASessionAfterAnAt) {
+  const Scenario s = LoadScenario("lifelong_car_park");
+  const Scenario seven = LoadScenario("lifelong_car_park@7");
+  const Scenario expected = SessionScenario(s, 7);
+  EXPECT_EQ(seven.name, expected.name);
+  EXPECT_EQ(seven.camera.effects.bias, expected.camera.effects.bias);
+  EXPECT_EQ(seven.world.ground.changed, expected.world.ground.changed);
+  EXPECT_EQ(seven.repeat_variant.remove, expected.repeat_variant.remove);
+  EXPECT_EQ(LoadScenario("lifelong_car_park@0").world.ground.changed, 0.0);
+  EXPECT_THROW(LoadScenario("table1_almost_straight@2"), InputError);  // no sessions: block
+  EXPECT_THROW(LoadScenario("lifelong_car_park@123456"), InputError);
+  EXPECT_THROW(LoadScenario("lifelong_car_park@x"), InputError);  // not a number: a name
+}
+
 TEST(Sessions, ParkedCarsComeAndGo) {
   const Scenario s = LoadScenario("lifelong_car_park");
   ASSERT_EQ(s.sessions->come_and_go.size(), 6u);
