@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -234,6 +235,57 @@ void FleetRecord(const std::string& input) {
   });
 }
 
+// A leader's route for FleetViewOffer: 3 keyframes of 40 ORB-sized features, 320x240, complete.
+std::unique_ptr<fleet::RouteCopy> FuzzLeaderRoute(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::remove_all(dir, ec);
+  auto copy = std::make_unique<fleet::RouteCopy>(dir.string());
+  fleet::RouteHeader h;
+  h.image_width = 320;
+  h.image_height = 240;
+  std::vector<fleet::Record> records = {fleet::HeaderRecord(h)};
+  for (int k = 0; k < 3; ++k) {
+    route::Keyframe kf;
+    kf.index = k;
+    kf.t_ns = 100'000'000LL * (k + 1);
+    kf.thumbnail = cv::Mat(60, 80, CV_8UC1, cv::Scalar(40 * k));
+    kf.descriptors = cv::Mat(40, 32, CV_8UC1);
+    for (int i = 0; i < 40; ++i) {
+      kf.keypoints.emplace_back(static_cast<float>(7 * i % 320), static_cast<float>(11 * i % 240),
+                                31.0f);
+      for (int c = 0; c < 32; ++c)
+        kf.descriptors.at<std::uint8_t>(i, c) = static_cast<std::uint8_t>(i * 31 + c * 7 + k);
+    }
+    records.push_back(fleet::KeyframeRecord(kf));
+  }
+  records.push_back(fleet::EndRecord());
+  for (std::size_t i = 0; i < records.size(); ++i) records[i].sequence = i;
+  copy->Apply(records);
+  return copy;
+}
+
+void FleetViewOffer(const std::string& input) {
+  static const std::filesystem::path dir = [] {
+    const std::filesystem::path shm("/dev/shm");
+    return (std::filesystem::is_directory(shm) ? shm : std::filesystem::temp_directory_path()) /
+           ("mapless-fuzz-leader-" + std::to_string(::getpid()));
+  }();
+  static std::unique_ptr<fleet::RouteCopy> leader;
+  if (!leader || leader->next_sequence() != 5) {  // a view taken: back to the bare route
+    leader.reset();
+    leader = FuzzLeaderRoute(dir);
+  }
+  AcceptInputError([&] {
+    const fleet::Record r = fleet::DecodeRecord(input);
+    if (r.type != fleet::RecordType::kView) return;
+    leader->TakeView(r, 3);
+    const std::vector<fleet::Record> log = leader->RecordsFrom(5, 1);
+    if (log.size() != 1 || log[0].type != fleet::RecordType::kView) std::abort();
+    const std::shared_ptr<const route::Route> route = leader->FunnelRoute();
+    if (!route || route->visits != 1) std::abort();  // the view taken is visit 1
+  });
+}
+
 void FleetFollower(const std::string& input) {
   static const std::filesystem::path dir = [] {
     const std::filesystem::path shm("/dev/shm");
@@ -425,6 +477,7 @@ const std::vector<NamedHarness>& Harnesses() {
                                                       {"camera_message", CameraMessage},
                                                       {"fleet_record", FleetRecord},
                                                       {"fleet_follower", FleetFollower},
+                                                      {"fleet_view_offer", FleetViewOffer},
                                                       {"ros2_message", Ros2Message},
                                                       {"mcap", McapFile},
                                                       {"rosbag", RosBag},

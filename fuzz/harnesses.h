@@ -57,6 +57,10 @@ void FleetRecord(const std::string& input);
 // /dev/shm: the files are written, as a follower writes them), then the route built from the copy
 // as the follower's method asks for it.
 void FleetFollower(const std::string& input);
+// The leader's side of shared views (issue 45): the input as a message a follower sends, decoded
+// and, when it is a view, offered to a leader's complete 3-keyframe route (in /dev/shm), which
+// takes it (RouteCopy::TakeView: written, as a leader writes it) or refuses it with one line.
+void FleetViewOffer(const std::string& input);
 // A ROS 2 sample from the network (issue 40): the first byte chooses the type mapless reads
 // (Image, CompressedImage, Odometry, Bool, Clock, Twist, String); the rest is the serialized data
 // with its encapsulation header, decoded by Cyclone DDS as a received sample is and used as the

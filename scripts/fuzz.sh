@@ -11,7 +11,8 @@
 #                 500,000 executions (docs/recordings.md)
 #     TARGET      route_manifest route_keyframe scenario config calibration flo tum image_folder
 #                 video_file scenario_world robot_file appearance_manifest camera_message
-#                 fleet_record fleet_follower ros2_message mcap rosbag camera_info live_client
+#                 fleet_record fleet_follower fleet_view_offer ros2_message mcap rosbag camera_info
+#                 live_client
 #                 (default: all)
 #
 # Each target starts from fuzz/corpus/<target>/ (kept inputs) and grows a working corpus in
@@ -38,7 +39,7 @@ shift $((OPTIND - 1))
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
   targets=(route_manifest route_keyframe scenario config calibration flo tum image_folder video_file
-           scenario_world robot_file appearance_manifest camera_message fleet_record fleet_follower ros2_message mcap rosbag
+           scenario_world robot_file appearance_manifest camera_message fleet_record fleet_follower fleet_view_offer ros2_message mcap rosbag
            camera_info live_client)
 fi
 
