@@ -54,7 +54,8 @@ middleware=$(ctest --preset release -N -L '^unit-middleware$' | sed -n 's/^ *Tes
 
 asan_build=""
 if [ "${MAPLESS_SKIP_SANITIZERS:-0}" != "1" ]; then
-  cmake --preset asan
+  # Its binaries whose every case is release-only are left out (MAPLESS_RELEASE_ONLY_TESTS).
+  cmake --preset asan -DMAPLESS_RELEASE_ONLY_TESTS=ON
   # A process group of its own (job control), stopped whole if this script ends early; the same
   # session, so that its nice value counts against the tests (a new session, as setsid makes, is a
   # scheduling group of its own under Linux's autogroup, and would take half of the machine).
@@ -104,5 +105,5 @@ tail -1 build/asan.log
 # The bad-input probe makes its fixtures (taught routes, rendered frames) with the release build:
 # they are its inputs, computed identically by both builds; what it probes runs sanitized.
 MAPLESS_FIXTURES="$PWD/build/release/apps/mapless" \
-  ctest --preset asan -j "$jobs" -E "$(as_regex "$release_only")" "$@" || exit $?
+  ctest --preset asan -j "$jobs" -E "$(as_regex "$release_only")|_NOT_BUILT\$" "$@" || exit $?
 exit "$release_rc"

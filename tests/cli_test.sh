@@ -308,12 +308,15 @@ section_crash() {
 
 section_bench() {
   # Bench: one JSON object with the render stage and its reference.
-  expect_exit "bench --json" 0 "$MAPLESS" bench --json --repeats 3
+  # Every stage, on the smallest work that runs it (one scenario, 160x120): a check of the
+  # command and its JSON, not a measurement (README's figures: `mapless bench --repeats 30`).
+  expect_exit "bench --json" 0 "$MAPLESS" bench --json --repeats 3 --scenario narrow_room_sharp_turn --size 160x120
   grep -q '"sim_render_320x240_ms":[0-9.]*' "$TMP/out" && grep -q '"opencv_dis_fast_320x240_ms"' "$TMP/out"; check "bench JSON has the render stage and DIS reference" $?
   grep -q '"dominant_plane_step_ms":[0-9.]*' "$TMP/out" && grep -q '"opencv_dis_fast_ground_320x240_ms"' "$TMP/out"; check "bench JSON has the potential step and its DIS reference" $?
   grep -q '"repeat_step_default_over_orb_interleaved":[0-9.]*' "$TMP/out" && grep -q '"orb_detector_over_opencv_same_settings":[0-9.]*' "$TMP/out"; check "bench JSON has the default step against ORB-500 timed after each step, and OrbDetector against OpenCV's ORB" $?
   grep -Eq '"repeat_step_5_views_over_1":[0-9.]+' "$TMP/out"; check "bench JSON has the step with 5 views against 1 (issue 45)" $?
   [ "$(wc -l <"$TMP/out")" -eq 1 ]; check "bench JSON is one line" $?
+  grep -q '"frame":"160x120"' "$TMP/out" && grep -q '"scenarios":\["narrow_room_sharp_turn"\]' "$TMP/out"; check "bench JSON says the frame size and scenario it ran" $?
 }
 
 for section in $SECTIONS; do
