@@ -32,14 +32,6 @@ int HeaderInt(const nlohmann::json& j, const char* key, int lo, int hi) {
   return static_cast<int>(v);
 }
 
-route::Manifest FunnelManifest(const RouteHeader& h) {
-  route::Manifest m;
-  m.detector = h.detector;
-  m.image_width = h.image_width;
-  m.image_height = h.image_height;
-  return m;
-}
-
 // Catching up, a batch holds many keyframes, and parsing their files is most of what applying
 // them costs: they are decoded on two threads first, each checked as it would be on its own (its
 // index is its place in the batch; its time is checked against the previous keyframe's in order,
@@ -82,6 +74,14 @@ std::vector<std::optional<route::Keyframe>> PreDecodeKeyframes(const std::vector
 }
 
 }  // namespace
+
+route::Manifest FunnelManifest(const RouteHeader& h) {
+  route::Manifest m;
+  m.detector = h.detector;
+  m.image_width = h.image_width;
+  m.image_height = h.image_height;
+  return m;
+}
 
 const char* RouteKindName(RouteKind kind) {
   return kind == RouteKind::kFunnel ? "funnel" : "eigenspace";

@@ -35,9 +35,6 @@
 namespace mapless::io {
 class DirectoryLock;
 }
-namespace mapless::route {
-struct Manifest;
-}
 
 namespace mapless::fleet {
 
@@ -56,6 +53,9 @@ struct RouteHeader {
 };
 Record HeaderRecord(const RouteHeader& header);
 RouteHeader ParseHeader(const Record& record);  // throws InputError
+// The route store's header of a funnel route (detector, image size), what its records are checked
+// against (route::DecodeKeyframe, route::DecodeView).
+route::Manifest FunnelManifest(const RouteHeader& header);
 
 // The records of a leader's teach (sequence numbers are set by RouteCopy::Apply's caller).
 Record KeyframeRecord(const route::Keyframe& keyframe);

@@ -74,14 +74,6 @@ ViewFields ParseViewFields(const Record& record, std::size_t keyframes, int widt
   return f;
 }
 
-route::Manifest ViewManifest(const RouteHeader& h) {
-  route::Manifest m;
-  m.detector = h.detector;
-  m.image_width = h.image_width;
-  m.image_height = h.image_height;
-  return m;
-}
-
 bool SameView(const route::KeyframeView& a, const route::KeyframeView& b) {
   if (a.offset_px != b.offset_px || a.keypoints.size() != b.keypoints.size() ||
       a.descriptors.size() != b.descriptors.size() || a.descriptors.type() != b.descriptors.type())
@@ -121,7 +113,7 @@ std::string RouteCopy::TakeView(const Record& offered, int max_views) {
   const ViewFields f =
       ParseViewFields(offered, keyframes_.size(), header_->image_width, false, what);
   route::Keyframe& kf = keyframes_[static_cast<std::size_t>(f.keyframe)];
-  route::KeyframeView view = route::DecodeView(offered.parts[1], kf, ViewManifest(*header_),
+  route::KeyframeView view = route::DecodeView(offered.parts[1], kf, FunnelManifest(*header_),
                                                what + " of keyframe " + std::to_string(f.keyframe));
   view.offset_px = f.offset_px;
   MAPLESS_CHECK(static_cast<int>(kf.views.size()) + 1 < max_views,
@@ -152,7 +144,7 @@ void RouteCopy::ApplyView(const Record& record, const std::string& what) {
       kf.views.size() < static_cast<std::size_t>(route::kMaxViewsPerKeyframe),
       what << ": keyframe " << f.keyframe << " has " << kf.views.size() << " views (the limit)");
   route::KeyframeView view =
-      route::DecodeView(record.parts[1], kf, ViewManifest(*header_), what + " view");
+      route::DecodeView(record.parts[1], kf, FunnelManifest(*header_), what + " view");
   view.offset_px = f.offset_px;
   view.learned_at = f.learned_at;
   view.last_used = f.last_used;
@@ -198,7 +190,7 @@ std::vector<Record> RouteCopy::LoadViewRecords(const route::Manifest& m) {
     for (const route::ManifestView& v : m.keyframes[i].views) {
       const std::string path = (fs::path(dir_) / v.data).string();
       std::string bytes = io::ReadFile(path, io::kMaxKeyframeFileBytes);
-      route::KeyframeView view = route::DecodeView(bytes, kf, ViewManifest(*header_), path);
+      route::KeyframeView view = route::DecodeView(bytes, kf, FunnelManifest(*header_), path);
       view.offset_px = v.offset_px;
       view.learned_at = v.learned_at;
       view.last_used = v.last_used;
