@@ -115,6 +115,7 @@ void Repeat(const RepeatArgs& r) {
   options.learn = r.learn;
   if (!r.robot.empty() || !run::IsSim(r.source)) {
     if (!r.robot.empty()) {
+      options.threads = robot::LoadRobotFile(r.robot).threads;
       options.sloped.max_speed_mps = r.speed;
       options.standard.forward_speed_mps = r.speed;
     }

@@ -56,6 +56,7 @@ void Teach(const TeachArgs& t) {
   std::unique_ptr<robot::RobotLink> link;
   const bool robot = !t.robot.empty();
   bool live = robot;
+  int threads = 1;
   if (!robot && run::IsSim(t.source)) {
     scenario = sim::LoadScenario(t.source.substr(4));
   } else {
@@ -65,7 +66,7 @@ void Teach(const TeachArgs& t) {
     request.warn = [](const std::string& m) { spdlog::warn("{}", m); };
     const run::LinkKind& kind = robot ? Links().Named("robot") : Links().For(t.source);
     live = kind.live;
-    if (robot) robot::LoadRobotFile(t.robot);  // a bad robot file is refused before the output
+    if (robot) threads = robot::LoadRobotFile(t.robot).threads;  // refused before the output
     link = kind.open(robot ? t.robot : t.source, request);
   }
   const auto recorder = OpenRecorder(
@@ -78,6 +79,7 @@ void Teach(const TeachArgs& t) {
   run::TeacherOptions teacher_options;
   teacher_options.kind = eigenspace ? run::RouteKind::kEigenspace : run::RouteKind::kFunnel;
   teacher_options.detector = t.detector;
+  teacher_options.threads = threads;
   // A video or folder without --poses never has odometry; a recording's first frames may come
   // before its first odometry message, as a robot's do.
   teacher_options.never_odometry =

@@ -109,20 +109,26 @@ void BenchTeachStep(const std::vector<cv::Mat>& frames, nlohmann::json* j) {
   auto stock_orb = cv::ORB::create(500);
   std::vector<cv::KeyPoint> kp;
   cv::Mat desc;
+  // TeachOptions::threads 2 (the features tracked in two halves, the same keyframes) is timed on
+  // the same frame right after the one-thread step, so both see the same load.
   navigation::TeachSession teach(navigation::TeachOptions{});
+  navigation::TeachOptions two_threads;
+  two_threads.threads = 2;
+  navigation::TeachSession two(two_threads);
   std::vector<double> ms;
+  std::vector<double> two_ms;
   std::vector<double> orb_ms;
   for (std::size_t i = 0; i < frames.size(); ++i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    teach.Update(frames[i], FromSeconds(0.1 * static_cast<double>(i)));
-    const auto t1 = std::chrono::steady_clock::now();
-    stock_orb->detectAndCompute(frames[i], cv::noArray(), kp, desc);
-    const auto t2 = std::chrono::steady_clock::now();
-    ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
-    orb_ms.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
+    const Timestamp t = FromSeconds(0.1 * static_cast<double>(i));
+    ms.push_back(TimesMs(1, [&](int) { teach.Update(frames[i], t); })[0]);
+    two_ms.push_back(TimesMs(1, [&](int) { two.Update(frames[i], t); })[0]);
+    orb_ms.push_back(TimesMs(
+        1, [&](int) { stock_orb->detectAndCompute(frames[i], cv::noArray(), kp, desc); })[0]);
   }
   (*j)["teach_step_ms"] = Median(ms);
   (*j)["teach_step_over_orb_interleaved"] = Median(ms) / Median(orb_ms);
+  (*j)["teach_step_2_threads_ms"] = Median(two_ms);
+  (*j)["teach_step_2_threads_over_orb_interleaved"] = Median(two_ms) / Median(orb_ms);
 }
 
 // Experiences (issue 45): the default step on the route with 4 learned views per keyframe (5
@@ -250,12 +256,26 @@ void BenchTeachRepeat(nlohmann::json* j) {
     std::sort(ms.begin(), ms.end());
     (*j)["repeat_step_default_p90_ms"] =
         ms.empty() ? 0.0 : ms[static_cast<std::size_t>(0.9 * static_cast<double>(ms.size() - 1))];
-    // What `repeat` runs by default: the step with the obstacle watch.
-    std::vector<double> orb_watch;
-    const std::vector<double> watch_ms = default_step(true, &orb_watch);
+    // What `repeat` runs by default: the step with the obstacle watch, one thread and
+    // RepeatOptions::threads 2 (the watch beside the feature detection, the only repeat row with a
+    // second thread; the same decisions), each timed on the same frame, then ORB-500.
+    navigation::RepeatOptions o;
+    navigation::RepeatSession one(taught.route, o);
+    o.threads = 2;
+    navigation::RepeatSession two(taught.route, o);
+    std::vector<double> watch_ms, two_ms, orb_watch;
+    for (int i = 0; i < n && !one.finished() && !two.finished(); ++i) {
+      const cv::Mat& frame = frames[static_cast<std::size_t>(i)];
+      watch_ms.push_back(TimesMs(1, [&](int) { one.Update(frame, FromSeconds(0.1 * i)); })[0]);
+      two_ms.push_back(TimesMs(1, [&](int) { two.Update(frame, FromSeconds(0.1 * i)); })[0]);
+      time_stock_orb(frame, &orb_watch);
+    }
     (*j)["repeat_step_default_with_watch_ms"] = Median(watch_ms);
     (*j)["repeat_step_default_with_watch_over_orb_interleaved"] =
         Median(watch_ms) / Median(orb_watch);
+    (*j)["repeat_step_default_with_watch_2_threads_ms"] = Median(two_ms);
+    (*j)["repeat_step_default_with_watch_2_threads_over_orb_interleaved"] =
+        Median(two_ms) / Median(orb_watch);
   }
   BenchViews(taught.route, frames, j);
   const std::vector<cv::Mat> grey = GreyFrames(frames);

@@ -69,6 +69,23 @@ TEST(Avoid, ARepeatGoesRoundABoxOnTheRouteAndCompletesIt) {
   const sim::World added = ObjectsAddedAtRepeat(scenario);
   ASSERT_EQ(added.objects.size(), 1u);
   EXPECT_FALSE(std::isfinite(added.objects[0].leaves_s));
+
+  // Issue 44: with the watch on a second thread beside the feature detection (a robot file's
+  // `threads: 2`), every frame's decision is the same: watching, stopping, going round and
+  // finding the route again.
+  o.repeat.threads = 2;
+  const RepeatRun two = RepeatOnSimulator(scenario, taught, o);
+  ASSERT_EQ(two.steps.size(), run.steps.size());
+  for (std::size_t i = 0; i < run.steps.size(); ++i) {
+    const navigation::RepeatStep& a = run.steps[i];
+    const navigation::RepeatStep& b = two.steps[i];
+    ASSERT_TRUE(a.status == b.status && a.reason == b.reason && a.destination == b.destination &&
+                a.matches == b.matches && a.avoiding == b.avoiding &&
+                a.command.v_mps == b.command.v_mps &&
+                a.command.omega_radps == b.command.omega_radps && a.current_px == b.current_px)
+        << "frame " << i << ": " << a.reason << " / " << b.reason;
+  }
+  EXPECT_EQ(two.final_error_m, run.final_error_m);
 }
 
 // `stop` on the standard funnel lane, table1's box, the eval's run with `seed`: the robot stops

@@ -59,6 +59,22 @@ TEST(TeachSession, FirstAndLastFramesAreKeyframesAndSegmentsCarryTheirTracks) {
   }
 }
 
+// Issue 44: the features tracked in two halves on two threads give the same keyframes, bit for bit.
+TEST(TeachSession, TwoThreadsTeachTheSameKeyframes) {
+  const auto one = Teach(TeachOptions{});
+  TeachOptions two_threads;
+  two_threads.threads = 2;
+  const auto two = Teach(two_threads);
+  ASSERT_EQ(two->keyframes.size(), one->keyframes.size());
+  for (std::size_t k = 0; k < one->keyframes.size(); ++k) {
+    const auto& a = one->keyframes[k];
+    const auto& b = two->keyframes[k];
+    EXPECT_EQ(a.t_ns, b.t_ns) << k;
+    EXPECT_EQ(a.segment_start_px, b.segment_start_px) << k;
+    EXPECT_EQ(a.segment_end_px, b.segment_end_px) << k;
+  }
+}
+
 TEST(TeachSession, AHigherTrackedFractionGivesDenserKeyframes) {
   TeachOptions sparse;
   sparse.keyframe_tracked_fraction = 0.4;

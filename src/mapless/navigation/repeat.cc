@@ -57,6 +57,8 @@ const char* RepeatStatusName(RepeatStatus s) {
 
 void RepeatOptions::Validate() const {
   experiences.Validate();
+  MAPLESS_CHECK(threads == 1 || threads == 2,
+                "RepeatOptions.threads = " << threads << "; must be 1 or 2");
   MAPLESS_CHECK(route_end_margin_m >= 0.0,
                 "RepeatOptions.route_end_margin_m = " << route_end_margin_m << "; must be >= 0");
   features.Validate();
@@ -200,7 +202,7 @@ void RepeatSession::MatchView(int k, int v, std::vector<cv::Point2f>* current_px
 }
 
 void RepeatSession::DetectAndMatch(const cv::Mat& grey, RepeatStep* step) {
-  current_ = extractor_.Extract(grey);
+  current_ = FrameFeatures(grey);
   MatchKeyframe(destination_, &current_px_, &destination_px_, &scene_px_);
   last_matches_ = static_cast<int>(current_px_.size());
   step->view = std::max(0, chosen_view_[static_cast<std::size_t>(destination_)]);
@@ -220,6 +222,7 @@ RepeatStep RepeatSession::Stop(RepeatStep step, RepeatStatus status, const std::
 RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns,
                                  const std::optional<Pose2>& odometry) {
   odometry_ = odometry;
+  frame_features_.reset();
   // At the start the robot stands at keyframe 0, where the first segment begins.
   if (!have_last_t_ && destination_ == 1) switch_odometry_ = odometry;
   RepeatStep step;
@@ -241,11 +244,7 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns,
     step = Stop(step, RepeatStatus::kWaiting, camera.reason);
   } else {
     // The obstacle watch first: a blocked robot does not look for its keyframe.
-    // The taught scene: the features whose descriptors matched the route on the previous frame.
-    // Going round an obstacle, the last frame's match with the route is stale: no known scene.
-    const ObstacleCheck obstacle =
-        watch_.Update(grey, t_ns, last_command_.v_mps * dt, last_command_.omega_radps * dt,
-                      detour_ ? std::vector<cv::Point2f>{} : scene_px_, RouteLeftM());
+    const ObstacleCheck obstacle = WatchAndDetect(grey, t_ns, dt);
     const bool started = !detour_ && obstacle.blocked && StartDetour(obstacle, grey.size());
     if (detour_) {
       // Going round it (--on-obstacle avoid) until back on the route; the obstacle that started
@@ -264,6 +263,7 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns,
     }
     step.obstacle = obstacle;
   }
+  frame_features_.reset();
   last_command_ = step.command;
   return step;
 }

@@ -22,6 +22,7 @@
 #include "mapless/control/detour.h"
 #include "mapless/control/funnel_lane.h"
 #include "mapless/control/taught_path.h"
+#include "mapless/core/worker.h"
 #include "mapless/features/features.h"
 #include "mapless/features/klt.h"
 #include "mapless/navigation/camera_check.h"
@@ -138,6 +139,10 @@ struct RepeatOptions {
   // experiences.changed_inliers (it looks different today). TakeLearned() hands them over.
   bool learn = false;
   ExperienceOptions experiences{5, 20, 60};
+  // 2: on a frame that detects features afresh, the detection runs on a second thread beside
+  // the obstacle watch (both only read the frame), so a robot's second core takes the watch's
+  // time off the frame's latency. The decisions are the same as with 1 (repeat_detect.cc).
+  int threads = 1;
   void Validate() const;
 };
 
@@ -253,9 +258,17 @@ class RepeatSession {
   std::vector<control::FeaturePair> Pairs() const;
   RepeatStep Stop(RepeatStep step, RepeatStatus status, const std::string& reason);
 
+  // The obstacle watch on this frame, `dt` after the last; with threads 2, on a second thread
+  // while this one detects the frame's features, when the frame will likely need them
+  // (repeat_detect.cc). FrameFeatures: this frame's features, detected once.
+  ObstacleCheck WatchAndDetect(const cv::Mat& grey, Timestamp t_ns, double dt);
+  const features::Features& FrameFeatures(const cv::Mat& grey);
+
   std::shared_ptr<const route::Route> route_;
   RepeatOptions options_;
   features::FeatureExtractor extractor_;
+  std::optional<features::Features> frame_features_;
+  std::unique_ptr<Worker> watcher_;  // threads 2: the watch's thread
   CameraMonitor camera_;
   ObstacleWatch watch_;
   Twist2 last_command_;

@@ -10,6 +10,8 @@
 namespace mapless::navigation {
 
 void TeachOptions::Validate() const {
+  MAPLESS_CHECK(threads == 1 || threads == 2,
+                "TeachOptions.threads = " << threads << "; must be 1 or 2");
   features.Validate();
   klt.Validate();
   MAPLESS_CHECK(keyframe_tracked_fraction > 0.0 && keyframe_tracked_fraction < 1.0,
@@ -73,6 +75,29 @@ std::optional<route::Keyframe> TeachSession::MakeKeyframe(const cv::Mat& grey, T
   return kf;
 }
 
+features::KltResult TeachSession::Track(const features::KltPyramid& pyramid) {
+  if (options_.threads < 2 || current_.size() < 2)
+    return features::TrackKlt(previous_pyramid_, pyramid, current_, options_.klt);
+  const auto half = static_cast<std::ptrdiff_t>(current_.size() / 2);
+  const std::vector<cv::Point2f> first(current_.begin(), current_.begin() + half);
+  const std::vector<cv::Point2f> second(current_.begin() + half, current_.end());
+  if (!tracker_) tracker_ = std::make_unique<Worker>();
+  features::KltResult a;
+  tracker_->Start([&] { a = features::TrackKlt(previous_pyramid_, pyramid, first, options_.klt); });
+  features::KltResult b;
+  try {
+    b = features::TrackKlt(previous_pyramid_, pyramid, second, options_.klt);
+  } catch (...) {
+    tracker_->Wait();  // it reads the pyramids: it ends before they go
+    throw;
+  }
+  tracker_->Wait();
+  a.points.insert(a.points.end(), b.points.begin(), b.points.end());
+  a.ok.insert(a.ok.end(), b.ok.begin(), b.ok.end());
+  a.tracked += b.tracked;
+  return a;
+}
+
 std::optional<route::Keyframe> TeachSession::Update(const cv::Mat& image, Timestamp t_ns,
                                                     const std::optional<Pose2>& odometry) {
   MAPLESS_CHECK(!image.empty(), "TeachSession: empty frame");
@@ -86,8 +111,7 @@ std::optional<route::Keyframe> TeachSession::Update(const cv::Mat& image, Timest
     MAPLESS_CHECK(grey.size() == previous_.size(), "TeachSession: frame size changed from "
                                                        << previous_.cols << "x" << previous_.rows
                                                        << " to " << grey.cols << "x" << grey.rows);
-    const features::KltResult tracked =
-        features::TrackKlt(previous_pyramid_, pyramid, current_, options_.klt);
+    const features::KltResult tracked = Track(pyramid);
     std::vector<cv::Point2f> kept_start;
     std::vector<cv::Point2f> kept_current;
     for (std::size_t i = 0; i < current_.size(); ++i) {

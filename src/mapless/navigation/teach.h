@@ -5,10 +5,12 @@
 // Pure: frames in, keyframes out; storing them is the caller's business (route::RouteWriter).
 #pragma once
 
+#include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <vector>
 
+#include "mapless/core/worker.h"
 #include "mapless/features/features.h"
 #include "mapless/features/klt.h"
 #include "mapless/route/route.h"
@@ -37,6 +39,9 @@ struct TeachOptions {
   // on the full-resolution tracker it cost the sloped lane a run of 10 on
   // outdoor_loop_cars_removed (docs/teach_and_repeat.md), so it is off.
   int max_tracked_features = 0;
+  // 2: the features are tracked in two halves, one on a second thread (KLT tracks each point on
+  // its own, so the tracks and keyframes are those of 1, bit for bit; issue 44).
+  int threads = 1;
   int thumbnail_width_px = 160;  // width of the stored downscaled image
   void Validate() const;
 };
@@ -64,8 +69,12 @@ class TeachSession {
   std::optional<route::Keyframe> MakeKeyframe(const cv::Mat& grey, Timestamp t_ns,
                                               const std::optional<Pose2>& odometry);
 
+  // KLT from the previous frame to this one, on two threads with threads 2.
+  features::KltResult Track(const features::KltPyramid& pyramid);
+
   TeachOptions options_;
   features::FeatureExtractor extractor_;
+  std::unique_ptr<Worker> tracker_;  // threads 2: tracks the first half of the features
   int next_index_ = 0;
   cv::Mat previous_;
   features::KltPyramid previous_pyramid_;

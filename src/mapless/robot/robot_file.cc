@@ -151,7 +151,7 @@ RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
   return io::WithYamlErrors(name, [&] {
     const io::YamlMap map = io::YamlMap::LoadString(text, name);
     map.CheckKnownKeys({"middleware", "name", "namespace", "node_name", "topics", "limits",
-                        "obstacles", "camera", "safety", "use_sim_time"});
+                        "obstacles", "camera", "safety", "use_sim_time", "threads"});
     RobotFile r;
     r.source = name;
     r.middleware = map.GetString("middleware", r.middleware);
@@ -211,6 +211,8 @@ RobotFile ParseRobotFile(const std::string& text, const std::string& name) {
     }
     if (map.Has("obstacles")) ParseObstacles(map.GetMap("obstacles"), &r);
     r.use_sim_time = map.GetBool("use_sim_time", false);
+    r.threads = map.GetInt("threads", r.threads);
+    if (r.threads != 1 && r.threads != 2) map.Fail("threads", "must be 1 or 2");
     r.Validate();
     return r;
   });

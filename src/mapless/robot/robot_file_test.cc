@@ -14,6 +14,8 @@ TEST(RobotFile, DefaultsAreTheRosConventions) {
   EXPECT_EQ(r.Resolve(r.topics.odometry), "/odom");
   EXPECT_EQ(r.Resolve(r.topics.cmd_vel), "/cmd_vel");
   EXPECT_FALSE(r.use_sim_time);
+  EXPECT_EQ(r.threads, 2);
+  EXPECT_EQ(ParseRobotFile("threads: 1\n", "robot.yaml").threads, 1);
 }
 
 TEST(RobotFile, NamespaceAppliesToRelativeTopicsOnly) {
@@ -60,6 +62,8 @@ TEST(RobotFile, BadFieldsAreNamed) {
   ExpectError("obstacles: {on_obstacle: swerve}\n", "on_obstacle");
   ExpectError("obstacles: {region_width: 0}\n", "obstacles.region_width");
   ExpectError("obstacles: {horizon: 0.8}\n", "obstacles.horizon");  // below region_top
+  ExpectError("threads: 3\n", "threads");
+  ExpectError("threads: two\n", "threads");
   // Issue 40: a key named twice, and one topic for two roles.
   ExpectError("middleware: ros2\nmiddleware: ros1\n", "duplicate key 'middleware'");
   ExpectError("topics: {cmd_vel: camera/image_raw}\n", "topics.cmd_vel");

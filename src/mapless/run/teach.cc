@@ -53,6 +53,7 @@ void StoreSink::Finish() {
 Teacher::Teacher(const TeacherOptions& options, RouteSink& sink) : options_(options), sink_(sink) {
   if (options_.kind == RouteKind::kFunnel) {
     teach_options_.features.type = features::ParseDetectorType(options_.detector);
+    teach_options_.threads = options_.threads;
     teach_options_.Validate();
     session_ = std::make_unique<navigation::TeachSession>(teach_options_);
   }

@@ -74,6 +74,7 @@ struct TeacherOptions {
   // Eigenspace: the source never has odometry (a video or folder without poses): refuse at the
   // first frame instead of waiting for it (a robot's first frames may come before its odometry).
   bool never_odometry = false;
+  int threads = 1;  // funnel: navigation::TeachOptions::threads (a robot file's `threads`)
 };
 
 // Makes the route from frames: keyframes (navigation/teach.h) or route images (the appearance
