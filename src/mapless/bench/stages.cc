@@ -79,6 +79,7 @@ void BenchPotential(int repeats, nlohmann::json* j) {
   auto time_step = [&](flow::FlowMethod method) {
     navigation::PotentialNavOptions o = nav;
     o.flow.method = method;
+    if (method == flow::FlowMethod::kDisFast) o.flow.dis_max_flow_width_px = 0;  // the preset's
     navigation::PotentialNavigator navigator(calibration, o);
     Pose2 odometry;
     int calls = 0;
@@ -92,6 +93,9 @@ void BenchPotential(int repeats, nlohmann::json* j) {
   };
   (*j)["dominant_plane_step_ms"] = time_step(flow::FlowMethod::kDisFast);
   (*j)["dominant_plane_step_dis_medium_ms"] = time_step(flow::FlowMethod::kDisMedium);
+  (*j)["navigator_default_over_dis_fast"] =
+      (*j)["dominant_plane_step_dis_medium_ms"].get<double>() /
+      (*j)["opencv_dis_fast_ground_320x240_ms"].get<double>();
   (*j)["dominant_plane_step_over_dis_fast"] =
       (*j)["dominant_plane_step_ms"].get<double>() /
       (*j)["opencv_dis_fast_ground_320x240_ms"].get<double>();

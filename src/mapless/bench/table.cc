@@ -150,6 +150,8 @@ void PrintStageTable(const nlohmann::json& j) {
               j["pyrlk_every_pixel_over_dense_lk"].get<double>());
   std::printf("%-34s %10.2f  (issue 4: <= 2.0)\n", "dominant_plane_step / dis_fast",
               j["dominant_plane_step_over_dis_fast"].get<double>());
+  std::printf("%-34s %10.2f  (issue 44: <= 2.0; the navigator's default, DIS medium)\n",
+              "navigator_default / dis_fast", j["navigator_default_over_dis_fast"].get<double>());
   for (const char* key : {"ipca_add_1000", "markov_update_10000", "subwindow_control"}) {
     std::printf("%-34s %10.2f  (issue 5: <= 1.5)\n", (std::string(key) + " / dis_fast").c_str(),
                 j[std::string(key) + "_over_dis_fast"].get<double>());

@@ -90,7 +90,11 @@ void DenseLkOptions::Validate() const {
   MAPLESS_CHECK(min_eigen >= 0.0, "DenseLkOptions.min_eigen = " << min_eigen << "; must be >= 0");
 }
 
-void FlowOptions::Validate() const { lk.Validate(); }
+void FlowOptions::Validate() const {
+  MAPLESS_CHECK(dis_max_flow_width_px >= 0, "FlowOptions.dis_max_flow_width_px = "
+                                                << dis_max_flow_width_px << "; must be >= 0");
+  lk.Validate();
+}
 
 std::vector<cv::Mat> BuildPyramid(const cv::Mat& grey, int levels) {
   std::vector<cv::Mat> pyramid;
@@ -178,6 +182,11 @@ cv::Mat ComputeFlow(const cv::Mat& first, const cv::Mat& second, const FlowOptio
       const auto dis = cv::DISOpticalFlow::create(options.method == FlowMethod::kDisFast
                                                       ? cv::DISOpticalFlow::PRESET_FAST
                                                       : cv::DISOpticalFlow::PRESET_MEDIUM);
+      if (options.dis_max_flow_width_px > 0) {
+        int scale = 0;
+        while ((a.cols >> scale) > options.dis_max_flow_width_px) ++scale;
+        dis->setFinestScale(scale);
+      }
       dis->calc(a, b, flow);
       break;
     }

@@ -35,6 +35,11 @@ struct DenseLkOptions {
 
 struct FlowOptions {
   FlowMethod method = FlowMethod::kDisFast;
+  // DIS only: > 0 estimates the flow on the finest pyramid level at most this wide (then
+  // upsampled, as DIS does) instead of the preset's finest level (fast: a quarter of the width,
+  // medium: half). Nearly all of DIS's time is spent on that level, so a larger camera then costs
+  // about what a smaller one does. 0: the preset's.
+  int dis_max_flow_width_px = 0;
   DenseLkOptions lk;
   void Validate() const;
 };

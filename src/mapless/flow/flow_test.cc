@@ -65,6 +65,31 @@ TEST_P(EveryMethod, RecoversAKnownTranslation) {
 INSTANTIATE_TEST_SUITE_P(Flow, EveryMethod,
                          ::testing::Values("dis", "dis_medium", "farneback", "lk"));
 
+// Issue 44: DIS's finest level chosen by width (the navigator's 160 px): at 320x240 DIS medium's
+// own level, bit for bit; at 640x480 one level coarser (OpenCV's finest scale 2), still right.
+TEST(ComputeFlow, DisFlowWidthPicksTheFinestLevel) {
+  FlowOptions medium;
+  medium.method = FlowMethod::kDisMedium;
+  FlowOptions capped = medium;
+  capped.dis_max_flow_width_px = 160;
+  const cv::Mat a = Texture(320, 240, 5);
+  const cv::Mat b = Translate(a, 2.2, 1.1);
+  EXPECT_EQ(cv::norm(ComputeFlow(a, b, medium), ComputeFlow(a, b, capped), cv::NORM_INF), 0.0);
+
+  const cv::Mat a2 = Texture(640, 480, 5);
+  const cv::Mat b2 = Translate(a2, 4.4, 2.2);
+  cv::Mat expected;
+  const auto dis = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_MEDIUM);
+  dis->setFinestScale(2);
+  dis->calc(a2, b2, expected);
+  const cv::Mat flow = ComputeFlow(a2, b2, capped);
+  EXPECT_EQ(cv::norm(flow, expected, cv::NORM_INF), 0.0);
+  EXPECT_GT(cv::norm(flow, ComputeFlow(a2, b2, medium), cv::NORM_INF), 0.0);
+  EXPECT_LT(InteriorError(flow, 4.4, 2.2), 0.3);
+  capped.dis_max_flow_width_px = -1;
+  EXPECT_THROW(ComputeFlow(a, b, capped), std::exception);
+}
+
 TEST(DenseLucasKanade, RecoversALargeMotionThroughThePyramid) {
   const cv::Mat a = Texture(320, 240, 5);
   const cv::Mat b = Translate(a, -12.0, 6.0);  // far beyond a 5x5 window at level 0
