@@ -8,9 +8,9 @@
 // heartbeat every second), the follower asks again: after a link outage, a leader restart or a
 // follower restart, the copy goes on from its last whole record.
 //
-// Runs its own threads. A malformed record is rejected with one log line (at most one a second,
-// with counts) and changes nothing. What it holds is bounded: 32 messages in ZeroMQ's queue, 1,024
-// records waiting to be applied.
+// Runs its own threads. A malformed record is rejected with one log line (at most one a second of
+// each kind, with counts) and changes nothing. What it holds is bounded: 32 messages in ZeroMQ's
+// queue, 1,024 records waiting to be applied.
 #pragma once
 
 #include <cstdint>

@@ -1,7 +1,8 @@
 // Log lines about what the network did (bad messages, peers joining, dropped or refused), at most
-// one a second: a peer sending garbage, or 200 peers connecting, cannot flood the log. The lines
-// held back are counted by kind and said in the next line, or by Flush() a second later.
-// Internal to fleet/; one thread.
+// one a second of each kind: a peer sending garbage, or 200 peers connecting, cannot flood the log,
+// and a follower joining does not hide why a message was refused in the same second. The kinds are
+// the code's own few strings, never the network's. The lines held back are counted by kind and
+// said with that kind's next line, or by Flush() a second later. Internal to fleet/; one thread.
 #pragma once
 
 #include <chrono>
@@ -20,34 +21,41 @@ class LimitedLog {
   // `kind` counts the line when it is held back ("messages rejected", "followers joined").
   void Say(const std::string& kind, const std::string& line) {
     const auto now = Clock::now();
-    if (said_ && now - last_ < std::chrono::seconds(1)) {
-      ++held_[kind];
+    Kind& k = kinds_[kind];
+    if (k.said && now - k.last < std::chrono::seconds(1)) {
+      ++k.held;
       return;
     }
-    const std::string held = Held();
-    Write(line + (held.empty() ? "" : " (held back since the last line: " + held + ")"));
-    last_ = now;
-    said_ = true;
+    const std::string held = Held(kind, &k);
+    Write(line + (held.empty() ? "" : " (held back since the last such line: " + held + ")"));
+    k.last = now;
+    k.said = true;
   }
-  // Says what was held back, once a second has passed since the last line.
+  // Says what was held back, for each kind whose last line is a second old.
   void Flush() {
-    if (held_.empty() || Clock::now() - last_ < std::chrono::seconds(1)) return;
-    Write("fleet: in the last second also " + Held());
-    last_ = Clock::now();
+    const auto now = Clock::now();
+    for (auto& [name, k] : kinds_) {
+      if (k.held == 0 || now - k.last < std::chrono::seconds(1)) continue;
+      Write("fleet: in the last second also " + Held(name, &k));
+      k.last = now;
+    }
   }
 
  private:
   using Clock = std::chrono::steady_clock;
-  std::string Held() {
-    std::string text;
-    for (const auto& [kind, n] : held_) {
-      std::string what = kind;  // "followers joined"; one: "follower joined"
-      const std::size_t space = what.find(' ');
-      if (n == 1 && space != std::string::npos && space > 0 && what[space - 1] == 's')
-        what.erase(space - 1, 1);
-      text += (text.empty() ? "" : ", ") + std::to_string(n) + " " + what;
-    }
-    held_.clear();
+  struct Kind {
+    bool said = false;
+    Clock::time_point last{};
+    int held = 0;
+  };
+  static std::string Held(const std::string& kind, Kind* k) {
+    if (k->held == 0) return "";
+    std::string what = kind;  // "followers joined"; one: "follower joined"
+    const std::size_t space = what.find(' ');
+    if (k->held == 1 && space != std::string::npos && space > 0 && what[space - 1] == 's')
+      what.erase(space - 1, 1);
+    const std::string text = std::to_string(k->held) + " " + what;
+    k->held = 0;
     return text;
   }
   void Write(const std::string& line) {
@@ -55,9 +63,7 @@ class LimitedLog {
   }
 
   FleetLogger log_;
-  bool said_ = false;
-  Clock::time_point last_{};
-  std::map<std::string, int> held_;
+  std::map<std::string, Kind> kinds_;
 };
 
 }  // namespace mapless::fleet
