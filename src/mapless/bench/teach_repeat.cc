@@ -178,6 +178,33 @@ void BenchViews(const std::shared_ptr<const route::Route>& taught,
   (*j)["repeat_step_5_views_over_1_mean"] = mean(five_ms) / mean(one_ms);
 }
 
+// What `repeat` runs by default: the step with the obstacle watch, on one thread and with
+// RepeatOptions::threads 2 (the watch beside the feature detection, the only repeat row with a
+// second thread; the same decisions), each timed on the same frame, then stock ORB-500.
+void BenchWatchStep(const std::shared_ptr<const route::Route>& route,
+                    const std::vector<cv::Mat>& frames, nlohmann::json* j) {
+  auto stock_orb = cv::ORB::create(500);
+  std::vector<cv::KeyPoint> kp;
+  cv::Mat desc;
+  navigation::RepeatOptions o;
+  navigation::RepeatSession one(route, o);
+  o.threads = 2;
+  navigation::RepeatSession two(route, o);
+  std::vector<double> watch_ms, two_ms, orb_ms;
+  for (std::size_t i = 0; i < frames.size() && !one.finished() && !two.finished(); ++i) {
+    const Timestamp t = FromSeconds(0.1 * static_cast<double>(i));
+    watch_ms.push_back(TimesMs(1, [&](int) { one.Update(frames[i], t); })[0]);
+    two_ms.push_back(TimesMs(1, [&](int) { two.Update(frames[i], t); })[0]);
+    orb_ms.push_back(TimesMs(
+        1, [&](int) { stock_orb->detectAndCompute(frames[i], cv::noArray(), kp, desc); })[0]);
+  }
+  (*j)["repeat_step_default_with_watch_ms"] = Median(watch_ms);
+  (*j)["repeat_step_default_with_watch_over_orb_interleaved"] = Median(watch_ms) / Median(orb_ms);
+  (*j)["repeat_step_default_with_watch_2_threads_ms"] = Median(two_ms);
+  (*j)["repeat_step_default_with_watch_2_threads_over_orb_interleaved"] =
+      Median(two_ms) / Median(orb_ms);
+}
+
 }  // namespace
 
 // Teach & repeat stages (issue 3) on the frames of the table1_almost_straight teach drive; the
@@ -228,9 +255,9 @@ void BenchTeachRepeat(nlohmann::json* j) {
   // The default step (RepeatOptions{}): KLT tracking with fresh matching every
   // redetect_every_frames frames; every frame counts. Median, mean and 90th percentile: the
   // frames that detect afresh cost more than the others.
-  const auto default_step = [&](bool watch, std::vector<double>* orb_ms) {
+  const auto default_step = [&](std::vector<double>* orb_ms) {
     navigation::RepeatOptions o;
-    o.obstacle.enabled = watch;
+    o.obstacle.enabled = false;
     navigation::RepeatSession session(taught.route, o);
     std::vector<double> ms;
     for (int i = 0; i < n && !session.finished(); ++i) {
@@ -245,7 +272,7 @@ void BenchTeachRepeat(nlohmann::json* j) {
   };
   {
     std::vector<double> orb_interleaved;
-    std::vector<double> ms = default_step(false, &orb_interleaved);
+    std::vector<double> ms = default_step(&orb_interleaved);
     (*j)["opencv_orb500_interleaved_ms"] = Median(orb_interleaved);
     (*j)["repeat_step_default_over_orb_interleaved"] =
         Median(ms) / (*j)["opencv_orb500_interleaved_ms"].get<double>();
@@ -256,27 +283,8 @@ void BenchTeachRepeat(nlohmann::json* j) {
     std::sort(ms.begin(), ms.end());
     (*j)["repeat_step_default_p90_ms"] =
         ms.empty() ? 0.0 : ms[static_cast<std::size_t>(0.9 * static_cast<double>(ms.size() - 1))];
-    // What `repeat` runs by default: the step with the obstacle watch, one thread and
-    // RepeatOptions::threads 2 (the watch beside the feature detection, the only repeat row with a
-    // second thread; the same decisions), each timed on the same frame, then ORB-500.
-    navigation::RepeatOptions o;
-    navigation::RepeatSession one(taught.route, o);
-    o.threads = 2;
-    navigation::RepeatSession two(taught.route, o);
-    std::vector<double> watch_ms, two_ms, orb_watch;
-    for (int i = 0; i < n && !one.finished() && !two.finished(); ++i) {
-      const cv::Mat& frame = frames[static_cast<std::size_t>(i)];
-      watch_ms.push_back(TimesMs(1, [&](int) { one.Update(frame, FromSeconds(0.1 * i)); })[0]);
-      two_ms.push_back(TimesMs(1, [&](int) { two.Update(frame, FromSeconds(0.1 * i)); })[0]);
-      time_stock_orb(frame, &orb_watch);
-    }
-    (*j)["repeat_step_default_with_watch_ms"] = Median(watch_ms);
-    (*j)["repeat_step_default_with_watch_over_orb_interleaved"] =
-        Median(watch_ms) / Median(orb_watch);
-    (*j)["repeat_step_default_with_watch_2_threads_ms"] = Median(two_ms);
-    (*j)["repeat_step_default_with_watch_2_threads_over_orb_interleaved"] =
-        Median(two_ms) / Median(orb_watch);
   }
+  BenchWatchStep(taught.route, frames, j);
   BenchViews(taught.route, frames, j);
   const std::vector<cv::Mat> grey = GreyFrames(frames);
   BenchObstacleWatch(scenario, grey, j);
