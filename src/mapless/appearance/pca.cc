@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mapless/appearance/rank_one_eigen.h"
 #include "mapless/core/check.h"
 
 namespace mapless::appearance {
@@ -97,7 +98,7 @@ Vector IncrementalPca::Project(const Vector& image) const {
   MAPLESS_CHECK(n_ > 0 && image.size() == mean_.size(), "IncrementalPca::Project: image of "
                                                             << image.size() << " pixels, model of "
                                                             << mean_.size());
-  const Vector all = q_.transpose() * (u_.transpose() * (image - mean_));
+  const Vector all = q_.transpose() * (U().transpose() * (image - mean_));
   return all.head(dimensions());
 }
 
@@ -110,9 +111,14 @@ void IncrementalPca::Add(const Vector& image) {
     MAPLESS_CHECK(image.size() >= 1, "IncrementalPca::Add: empty image");
     mean_ = image;
     u_.resize(image.size(), 0);
+    u_cols_ = 0;
     q_.resize(0, 0);
     eigenvalues_.resize(0);
-    projections_ = Matrix::Zero(0, 1);
+    stored_rows_ = 0;
+    stored_.resize(0, 0);
+    ReserveStored(0, 1);
+    transform_.resize(0, 0);
+    offset_.resize(0);
     n_ = 1;
     return;
   }
@@ -122,16 +128,16 @@ void IncrementalPca::Add(const Vector& image) {
   const int k = static_cast<int>(q_.cols());
   const double n = n_;
   const Vector d = image - mean_;  // x_{N+1} - m
-  const Vector up = u_.transpose() * d;
+  const Vector up = U().transpose() * d;
   const Vector p = q_.transpose() * up;  // Vᵀ(x - m)
   // Residual h = (x - m) - V p, orthogonal to V; a second pass keeps it so in floating point.
   Vector h = d;
   if (k > 0) {
     const Vector qp = q_ * p;
-    h.noalias() -= u_ * qp;
-    const Vector uh = u_.transpose() * h;
+    h.noalias() -= U() * qp;
+    const Vector uh = U().transpose() * h;
     const Vector qqh = q_ * (q_.transpose() * uh);
-    h.noalias() -= u_ * qqh;
+    h.noalias() -= U() * qqh;
   }
   const double h_norm = h.norm();
   const double d_norm = d.norm();
@@ -141,24 +147,23 @@ void IncrementalPca::Add(const Vector& image) {
   const int k1 = add_dimension ? k + 1 : k;
   if (k1 == 0) {  // the same image as the mean so far: nothing to rotate
     mean_ = (mean_ * static_cast<float>(n) + image) / static_cast<float>(n + 1.0);
-    projections_ = Matrix::Zero(0, n_ + 1);
+    ReserveStored(stored_rows_, n_ + 1);
+    stored_.col(n_).head(stored_rows_).setZero();
+    transform_.resize(0, stored_rows_);
+    offset_.resize(0);
     ++n_;
     return;
   }
   Eigen::VectorXd a(k1);
   a.head(k) = p.cast<double>();
   if (add_dimension) a(k) = h_norm;
-  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(k1, k1);
-  D.diagonal().head(k) = eigenvalues_.cast<double>() * (n / (n + 1.0));
-  D += (n / ((n + 1.0) * (n + 1.0))) * a * a.transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(D);
-  // Sorted by decreasing eigenvalue.
-  Eigen::MatrixXd R(k1, k1);
-  Eigen::VectorXd lambda(k1);
-  for (int i = 0; i < k1; ++i) {
-    R.col(i) = solver.eigenvectors().col(k1 - 1 - i);
-    lambda(i) = solver.eigenvalues()(k1 - 1 - i);
-  }
+  // D is diagonal plus rank one: its eigen-system in O(k^2) (rank_one_eigen.h; a general
+  // symmetric solver took half of Add's time at k = 96). Sorted by decreasing eigenvalue.
+  Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(k1);
+  diagonal.head(k) = eigenvalues_.cast<double>() * (n / (n + 1.0));
+  const RankOneEigen solved = RankOneUpdateEigen(diagonal, n / ((n + 1.0) * (n + 1.0)), a);
+  const Eigen::MatrixXd& R = solved.vectors;
+  const Eigen::VectorXd& lambda = solved.values;
   // Dimension criteria: at most max_dimensions; drop trailing eigenvectors whose eigenvalue is
   // below min_eigenvalue_ratio of the first (or carries no variance).
   int keep = std::min(k1, options_.max_dimensions + options_.extra_dimensions);
@@ -170,9 +175,11 @@ void IncrementalPca::Add(const Vector& image) {
 
   // Eq. (2): V' = [V ĥ] R, kept factored: U' = [U ĥ], Q' = blkdiag(Q, 1) R.
   if (add_dimension) {
-    const Eigen::Index l = u_.cols();
-    u_.conservativeResize(Eigen::NoChange, l + 1);
+    const Eigen::Index l = u_cols_;
+    // U grows in place (its spare columns doubling), not by a copy of M x L floats per image.
+    if (l == u_.cols()) u_.conservativeResize(Eigen::NoChange, std::max<Eigen::Index>(8, 2 * l));
     u_.col(l) = h / static_cast<float>(h_norm);
+    ++u_cols_;
     Matrix q = Matrix::Zero(l + 1, k + 1);
     q.topLeftCorner(l, k) = q_;
     q(l, k) = 1.0F;
@@ -184,43 +191,77 @@ void IncrementalPca::Add(const Vector& image) {
 
   // Eq. (4) (Artac et al.): p_i' = Rᵀ [p_i; 0] + V'ᵀ(m - m'), with m - m' = -(x - m)/(N+1) and
   // V'ᵀ(x - m) = Rᵀ a, so no M-sized product is needed. The new image: V'ᵀ(x - m') = N/(N+1) Rᵀ a.
+  // With P = G S + c 1ᵀ (pca.h) the rotation of every stored projection is one of G and c.
   const Vector rta = r.transpose() * a.cast<float>();
-  Matrix projections(keep, n_ + 1);
-  if (add_dimension) {
-    projections.leftCols(n_) = r.topRows(k).transpose() * projections_;
+  if (add_dimension) {  // [P; 0] = [G 0; 0 1] [S; 0] + [c; 0] 1ᵀ: S gains a row of zeros
+    ReserveStored(stored_rows_ + 1, n_ + 1);
+    stored_.row(stored_rows_).head(n_).setZero();
+    Matrix g = Matrix::Zero(k + 1, stored_rows_ + 1);
+    g.topLeftCorner(k, stored_rows_) = transform_;
+    g(k, stored_rows_) = 1.0F;
+    ++stored_rows_;
+    transform_.noalias() = r.transpose() * g;
+    offset_ = r.topRows(k).transpose() * offset_;
   } else {
-    projections.leftCols(n_) = r.transpose() * projections_;
+    ReserveStored(stored_rows_, n_ + 1);
+    const Matrix g = transform_;
+    transform_.noalias() = r.transpose() * g;
+    offset_ = r.transpose() * Vector(offset_);
   }
-  projections.leftCols(n_).colwise() -= rta / static_cast<float>(n + 1.0);
-  projections.col(n_) = rta * static_cast<float>(n / (n + 1.0));
-  projections_ = std::move(projections);
+  offset_ -= rta / static_cast<float>(n + 1.0);
+  // The new image's stored column: G has orthonormal rows, so G Gᵀ (v - c) = v - c.
+  const Vector v = rta * static_cast<float>(n / (n + 1.0));
+  stored_.col(n_).head(stored_rows_).noalias() = transform_.transpose() * (v - offset_);
+  if (stored_rows_ > 2 * std::max<Eigen::Index>(keep, 4)) FoldProjections(n_ + 1);
 
   mean_ = (mean_ * static_cast<float>(n) + image) / static_cast<float>(n + 1.0);  // Eq. (1)
   ++n_;
-  if (u_.cols() > 2 * std::max<Eigen::Index>(q_.cols(), 4)) Fold();
+  if (u_cols_ > 2 * std::max<Eigen::Index>(q_.cols(), 4)) Fold();
 }
 
 void IncrementalPca::Fold() {
   // U ← U Q, Q ← I; re-orthonormalise against drift accumulated over many rotations.
-  Matrix v = u_ * q_;
+  Matrix v = U() * q_;
   Eigen::HouseholderQR<Matrix> qr(v);
   Matrix orthonormal = qr.householderQ() * Matrix::Identity(v.rows(), v.cols());
   // Keep each column's direction (QR may flip signs).
   for (Eigen::Index i = 0; i < v.cols(); ++i) {
     if (orthonormal.col(i).dot(v.col(i)) < 0.0F) orthonormal.col(i) *= -1.0F;
   }
-  u_ = std::move(orthonormal);
-  q_ = Matrix::Identity(u_.cols(), u_.cols());
+  u_cols_ = orthonormal.cols();
+  u_.leftCols(u_cols_) = orthonormal;
+  q_ = Matrix::Identity(u_cols_, u_cols_);
 }
 
 Eigenspace IncrementalPca::Model() const {
   const int k = dimensions();
   Eigenspace space;
   space.mean = mean_;
-  space.basis = u_ * q_.leftCols(k);
+  space.basis = U() * q_.leftCols(k);
   space.eigenvalues = eigenvalues_.head(k);
-  space.projections = projections_.topRows(k);
+  space.projections = transform_.topRows(k) * stored_.topLeftCorner(stored_rows_, n_);
+  space.projections.colwise() += offset_.head(k);
   return space;
+}
+
+void IncrementalPca::ReserveStored(Eigen::Index rows, Eigen::Index cols) {
+  if (rows <= stored_.rows() && cols <= stored_.cols()) return;
+  // Room for the rows of twice the kept dimensions and twice the images (amortised O(1) growth).
+  const Eigen::Index want_rows =
+      std::max<Eigen::Index>(rows, 2 * (options_.max_dimensions + options_.extra_dimensions) + 2);
+  const Eigen::Index want_cols = std::max<Eigen::Index>(cols, 2 * stored_.cols());
+  stored_.conservativeResize(std::max(want_rows, stored_.rows()),
+                             std::max(want_cols, stored_.cols()));
+}
+
+void IncrementalPca::FoldProjections(Eigen::Index images) {
+  // S ← P, G ← I, c ← 0: S is back to L rows (and G's rows orthonormal again).
+  Matrix p = transform_ * stored_.topLeftCorner(stored_rows_, images);
+  p.colwise() += offset_;
+  stored_rows_ = p.rows();
+  stored_.topLeftCorner(stored_rows_, images) = p;
+  transform_ = Matrix::Identity(stored_rows_, stored_rows_);
+  offset_ = Vector::Zero(stored_rows_);
 }
 
 }  // namespace mapless::appearance

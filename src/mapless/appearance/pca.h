@@ -58,9 +58,10 @@ struct IncrementalPcaOptions {
 };
 
 // Artac et al.'s incremental PCA. With L = K + extra kept eigenvectors, Add() costs
-// O(M L + N L²) (projections included): the basis is kept factored as V = U Q so that the rotation
-// of Eq. (2) touches only the small matrix Q; U is folded back (U ← U Q) when it has grown to
-// twice L columns.
+// O(M L + L³ + N L) amortised (projections included): the basis is kept factored as V = U Q so
+// that the rotation of Eq. (2) touches only the small matrix Q, and the projections likewise
+// (below); U is folded back (U ← U Q) when it has grown to twice L columns. The eigen-system of
+// Eq. (3) is a diagonal-plus-rank-one one (rank_one_eigen.h).
 class IncrementalPca {
  public:
   explicit IncrementalPca(IncrementalPcaOptions options = {});
@@ -81,14 +82,27 @@ class IncrementalPca {
 
  private:
   void Fold();
+  // Room in stored_ for this many rows and images.
+  void ReserveStored(Eigen::Index rows, Eigen::Index cols);
+  void FoldProjections(Eigen::Index images);
 
   IncrementalPcaOptions options_;
   int n_ = 0;
   Vector mean_;
-  Matrix u_;  // M x L, L >= K; V = U Q
+  // U, M x L (L >= K, the first u_cols_ columns of u_, the rest spare); V = U Q.
+  auto U() const { return u_.leftCols(u_cols_); }
+  Matrix u_;
+  Eigen::Index u_cols_ = 0;
   Matrix q_;  // L x K
   Vector eigenvalues_;
-  Matrix projections_;  // K x N
+  // The stored projections (L x N, Eq. 4), kept factored as the basis is (issue 44): P = G S +
+  // c 1ᵀ with G's rows orthonormal, so each image's rotation touches G (L x s) and c, not all N
+  // projections; S gains a row with each new dimension and a column with each image, and is
+  // folded back (S ← P) when it has twice L rows.
+  Matrix stored_;  // S: the first stored_rows_ rows and n_ columns are in use
+  Eigen::Index stored_rows_ = 0;
+  Matrix transform_;  // G: L x stored_rows_
+  Vector offset_;     // c: L
 };
 
 }  // namespace mapless::appearance
