@@ -103,32 +103,45 @@ void BenchOrbSettings(const std::vector<cv::Mat>& grey, nlohmann::json* j) {
       (*j)["opencv_orb_mapless_settings_320x240_ms"].get<double>();
 }
 
-// Teach: KLT tracking + keyframe test per frame (keyframe frames also detect and describe), with
-// stock ORB-500 timed on the same frame right after each step.
-void BenchTeachStep(const std::vector<cv::Mat>& frames, nlohmann::json* j) {
+// Times `one(i)`, `two(i)` and stock ORB-500 on frame i, one right after the other, for every
+// frame while `more()` holds: the three medians see the same load.
+struct Interleaved {
+  std::vector<double> one, two, orb;
+};
+Interleaved TimeInterleaved(
+    const std::vector<cv::Mat>& frames, const std::function<void(std::size_t)>& one,
+    const std::function<void(std::size_t)>& two,
+    const std::function<bool()>& more = [] { return true; }) {
   auto stock_orb = cv::ORB::create(500);
   std::vector<cv::KeyPoint> kp;
   cv::Mat desc;
+  Interleaved t;
+  for (std::size_t i = 0; i < frames.size() && more(); ++i) {
+    t.one.push_back(TimesMs(1, [&](int) { one(i); })[0]);
+    t.two.push_back(TimesMs(1, [&](int) { two(i); })[0]);
+    t.orb.push_back(TimesMs(
+        1, [&](int) { stock_orb->detectAndCompute(frames[i], cv::noArray(), kp, desc); })[0]);
+  }
+  return t;
+}
+
+// Teach: KLT tracking + keyframe test per frame (keyframe frames also detect and describe), with
+// stock ORB-500 timed on the same frame right after each step.
+void BenchTeachStep(const std::vector<cv::Mat>& frames, nlohmann::json* j) {
   // TeachOptions::threads 2 (the features tracked in two halves, the same keyframes) is timed on
   // the same frame right after the one-thread step, so both see the same load.
   navigation::TeachSession teach(navigation::TeachOptions{});
   navigation::TeachOptions two_threads;
   two_threads.threads = 2;
   navigation::TeachSession two(two_threads);
-  std::vector<double> ms;
-  std::vector<double> two_ms;
-  std::vector<double> orb_ms;
-  for (std::size_t i = 0; i < frames.size(); ++i) {
-    const Timestamp t = FromSeconds(0.1 * static_cast<double>(i));
-    ms.push_back(TimesMs(1, [&](int) { teach.Update(frames[i], t); })[0]);
-    two_ms.push_back(TimesMs(1, [&](int) { two.Update(frames[i], t); })[0]);
-    orb_ms.push_back(TimesMs(
-        1, [&](int) { stock_orb->detectAndCompute(frames[i], cv::noArray(), kp, desc); })[0]);
-  }
-  (*j)["teach_step_ms"] = Median(ms);
-  (*j)["teach_step_over_orb_interleaved"] = Median(ms) / Median(orb_ms);
-  (*j)["teach_step_2_threads_ms"] = Median(two_ms);
-  (*j)["teach_step_2_threads_over_orb_interleaved"] = Median(two_ms) / Median(orb_ms);
+  const auto at = [](std::size_t i) { return FromSeconds(0.1 * static_cast<double>(i)); };
+  const Interleaved t = TimeInterleaved(
+      frames, [&](std::size_t i) { teach.Update(frames[i], at(i)); },
+      [&](std::size_t i) { two.Update(frames[i], at(i)); });
+  (*j)["teach_step_ms"] = Median(t.one);
+  (*j)["teach_step_over_orb_interleaved"] = Median(t.one) / Median(t.orb);
+  (*j)["teach_step_2_threads_ms"] = Median(t.two);
+  (*j)["teach_step_2_threads_over_orb_interleaved"] = Median(t.two) / Median(t.orb);
 }
 
 // Experiences (issue 45): the default step on the route with 4 learned views per keyframe (5
@@ -183,26 +196,20 @@ void BenchViews(const std::shared_ptr<const route::Route>& taught,
 // second thread; the same decisions), each timed on the same frame, then stock ORB-500.
 void BenchWatchStep(const std::shared_ptr<const route::Route>& route,
                     const std::vector<cv::Mat>& frames, nlohmann::json* j) {
-  auto stock_orb = cv::ORB::create(500);
-  std::vector<cv::KeyPoint> kp;
-  cv::Mat desc;
   navigation::RepeatOptions o;
   navigation::RepeatSession one(route, o);
   o.threads = 2;
   navigation::RepeatSession two(route, o);
-  std::vector<double> watch_ms, two_ms, orb_ms;
-  for (std::size_t i = 0; i < frames.size() && !one.finished() && !two.finished(); ++i) {
-    const Timestamp t = FromSeconds(0.1 * static_cast<double>(i));
-    watch_ms.push_back(TimesMs(1, [&](int) { one.Update(frames[i], t); })[0]);
-    two_ms.push_back(TimesMs(1, [&](int) { two.Update(frames[i], t); })[0]);
-    orb_ms.push_back(TimesMs(
-        1, [&](int) { stock_orb->detectAndCompute(frames[i], cv::noArray(), kp, desc); })[0]);
-  }
-  (*j)["repeat_step_default_with_watch_ms"] = Median(watch_ms);
-  (*j)["repeat_step_default_with_watch_over_orb_interleaved"] = Median(watch_ms) / Median(orb_ms);
-  (*j)["repeat_step_default_with_watch_2_threads_ms"] = Median(two_ms);
+  const auto at = [](std::size_t i) { return FromSeconds(0.1 * static_cast<double>(i)); };
+  const Interleaved t = TimeInterleaved(
+      frames, [&](std::size_t i) { one.Update(frames[i], at(i)); },
+      [&](std::size_t i) { two.Update(frames[i], at(i)); },
+      [&] { return !one.finished() && !two.finished(); });
+  (*j)["repeat_step_default_with_watch_ms"] = Median(t.one);
+  (*j)["repeat_step_default_with_watch_over_orb_interleaved"] = Median(t.one) / Median(t.orb);
+  (*j)["repeat_step_default_with_watch_2_threads_ms"] = Median(t.two);
   (*j)["repeat_step_default_with_watch_2_threads_over_orb_interleaved"] =
-      Median(two_ms) / Median(orb_ms);
+      Median(t.two) / Median(t.orb);
 }
 
 }  // namespace
