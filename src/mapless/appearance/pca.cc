@@ -1,10 +1,9 @@
 #include "mapless/appearance/pca.h"
 
-#include <Eigen/Eigenvalues>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 
+#include "mapless/appearance/decompositions.h"
 #include "mapless/appearance/rank_one_eigen.h"
 #include "mapless/core/check.h"
 
@@ -43,11 +42,12 @@ Eigenspace BatchPcaSvd(const Matrix& images, int dimensions) {
   Eigenspace space;
   space.mean = images.rowwise().mean();
   const Matrix centred = images.colwise() - space.mean;
-  const Eigen::BDCSVD<Matrix> svd(centred, Eigen::ComputeThinU | Eigen::ComputeThinV);
-  const Vector eigenvalues =
-      svd.singularValues().array().square() / static_cast<float>(images.cols());
+  Matrix u;
+  Vector singular_values;
+  ThinSvd(centred, &u, &singular_values);
+  const Vector eigenvalues = singular_values.array().square() / static_cast<float>(images.cols());
   const int k = UsableDimensions(eigenvalues, dimensions);
-  space.basis = svd.matrixU().leftCols(k);
+  space.basis = u.leftCols(k);
   space.eigenvalues = eigenvalues.head(k);
   space.projections = space.basis.transpose() * centred;
   return space;
@@ -60,16 +60,18 @@ Eigenspace BatchPcaGram(const Matrix& images, int dimensions) {
   const Matrix centred = images.colwise() - space.mean;
   // Turk & Pentland: if (AᵀA) w = μ w then (A Aᵀ)(A w) = μ (A w); ‖A w‖ = sqrt(μ).
   const Eigen::MatrixXd gram = (centred.transpose() * centred).cast<double>();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(gram);
+  Eigen::VectorXd values;
+  Eigen::MatrixXd vectors;
+  SymmetricEigen(gram, &values, &vectors);
   const int n = static_cast<int>(gram.rows());
   Vector eigenvalues(n);
   for (int i = 0; i < n; ++i) {
-    eigenvalues(i) = static_cast<float>(solver.eigenvalues()(n - 1 - i) / images.cols());
+    eigenvalues(i) = static_cast<float>(values(n - 1 - i) / images.cols());
   }
   const int k = UsableDimensions(eigenvalues, dimensions);
   space.basis.resize(images.rows(), k);
   for (int i = 0; i < k; ++i) {
-    const Vector w = solver.eigenvectors().col(n - 1 - i).cast<float>();
+    const Vector w = vectors.col(n - 1 - i).cast<float>();
     space.basis.col(i) = (centred * w).normalized();
   }
   space.eigenvalues = eigenvalues.head(k);
@@ -222,8 +224,7 @@ void IncrementalPca::Add(const Vector& image) {
 void IncrementalPca::Fold() {
   // U ← U Q, Q ← I; re-orthonormalise against drift accumulated over many rotations.
   Matrix v = U() * q_;
-  Eigen::HouseholderQR<Matrix> qr(v);
-  Matrix orthonormal = qr.householderQ() * Matrix::Identity(v.rows(), v.cols());
+  Matrix orthonormal = ThinQ(v);
   // Keep each column's direction (QR may flip signs).
   for (Eigen::Index i = 0; i < v.cols(); ++i) {
     if (orthonormal.col(i).dot(v.col(i)) < 0.0F) orthonormal.col(i) *= -1.0F;

@@ -2,10 +2,10 @@
 
 #include <gtest/gtest.h>
 
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 
+#include "mapless/appearance/decompositions.h"
 #include "mapless/appearance/image.h"
 #include "mapless/core/check.h"
 #include "mapless/sim/scenario.h"
@@ -44,9 +44,10 @@ const Matrix& Route300() {
 // Orthogonal Procrustes: the relative residual of the best rotation (and reflection) taking the
 // columns of `a` onto those of `b`; 0 when they agree up to sign and rotation.
 double ProcrustesResidual(const Matrix& a, const Matrix& b) {
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd((b * a.transpose()).cast<double>(),
-                                              Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Eigen::MatrixXd omega = svd.matrixU() * svd.matrixV().transpose();
+  Eigen::MatrixXd u, v;
+  Eigen::VectorXd s;
+  JacobiSvd((b * a.transpose()).cast<double>(), &u, &s, &v);
+  const Eigen::MatrixXd omega = u * v.transpose();
   return (omega * a.cast<double>() - b.cast<double>()).norm() / b.cast<double>().norm();
 }
 
