@@ -55,8 +55,10 @@ struct Hit {
 // Bilinear sample of one mip level in fixed point. (s_fx, t_fx) are level-0 texel coordinates
 // times 256; level l is reached by an arithmetic shift (a floor, also for negative coordinates).
 // Returns the grey level times 65536.
-inline int BilinearFixed(const Texture::LevelView& level, int level_index, std::int64_t s_fx,
-                         std::int64_t t_fx) {
+// Both forced inline: clang does not inline them under AddressSanitizer (instrumentation makes them
+// look large), and a call per pixel was a sixth of `mapless demo`'s time in the sanitizer build.
+[[gnu::always_inline]] inline int BilinearFixed(const Texture::LevelView& level, int level_index,
+                                                std::int64_t s_fx, std::int64_t t_fx) {
   const int mask = (1 << level.log2_size) - 1;
   const std::int64_t sf = (s_fx >> level_index) - 128;  // texel centres at +0.5
   const std::int64_t tf = (t_fx >> level_index) - 128;
@@ -74,7 +76,7 @@ inline int BilinearFixed(const Texture::LevelView& level, int level_index, std::
 }
 
 // `lod_slope` is 0.5 (3 + anisotropy), fixed per render.
-inline float ShadeHit(const Prepared& p, const Hit& h, float lod_slope) {
+[[gnu::always_inline]] inline float ShadeHit(const Prepared& p, const Hit& h, float lod_slope) {
   // Level-0 texel coordinates in 24.8 fixed point (hits are nearer than far_m, so they fit).
   const auto s_fx = static_cast<std::int64_t>(h.alpha * p.s_scale * 256.0f);
   const auto t_fx = static_cast<std::int64_t>(h.beta * p.t_scale * 256.0f);
