@@ -44,6 +44,32 @@ function(mapless_library)
   endif()
 endfunction()
 
+# The compile flags of every GoogleTest binary's own code (and of mapless_test_main, whose
+# precompiled header they reuse: a precompiled header needs the same optimisation level).
+function(mapless_test_flags target)
+  mapless_target_warnings(${target})
+  mapless_glue_code(${target})
+  # In the release build a test's own code is glue too (assertions, fixtures; the work is in the
+  # libraries, at -O3): -O1 compiles it in 60% of the time (issue 39, docs/ci.md).
+  if(NOT MAPLESS_SANITIZE AND CMAKE_BUILD_TYPE STREQUAL "Release")
+    target_compile_options(${target} PRIVATE -O1)
+  endif()
+endfunction()
+
+# One precompiled header of the system headers most tests include (GoogleTest, OpenCV, Eigen,
+# nlohmann/json, the standard library), built once with mapless_test_main and reused by every test
+# binary: each of them parsed these headers again, about 3 s of CPU a binary under the sanitizers
+# and 2 s in the release build (docs/ci.md). MAPLESS_TEST_PCH=OFF turns it off.
+option(MAPLESS_TEST_PCH "Reuse one precompiled header in every GoogleTest binary" ON)
+function(mapless_test_precompiled_header)
+  if(MAPLESS_TEST_PCH)
+    target_precompile_headers(mapless_test_main PRIVATE
+      <gtest/gtest.h> <opencv2/core.hpp> <opencv2/imgproc.hpp> <Eigen/Core>
+      <nlohmann/json.hpp> <algorithm> <chrono> <cmath> <filesystem> <fstream> <functional>
+      <map> <memory> <sstream> <string> <thread> <vector>)
+  endif()
+endfunction()
+
 # mapless_test(NAME name SRCS ... DEPS ... [SANITIZE_ENV VAR=VALUE ...] [COST N]): one GoogleTest
 # binary, tests discovered by ctest. SANITIZE_ENV: extra environment for its tests in the sanitizer
 # build. COST: ctest starts tests of higher cost first (closed loops: a clean clone has no timing
@@ -57,12 +83,9 @@ function(mapless_test)
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} GTest::gtest mapless_test_main)
   target_compile_definitions(${ARG_NAME} PRIVATE
     MAPLESS_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
-  mapless_target_warnings(${ARG_NAME})
-  mapless_glue_code(${ARG_NAME})
-  # In the release build a test's own code is glue too (assertions, fixtures; the work is in the
-  # libraries, at -O3): -O1 compiles it in 60% of the time (issue 39, docs/ci.md).
-  if(NOT MAPLESS_SANITIZE AND CMAKE_BUILD_TYPE STREQUAL "Release")
-    target_compile_options(${ARG_NAME} PRIVATE -O1)
+  mapless_test_flags(${ARG_NAME})
+  if(MAPLESS_TEST_PCH)
+    target_precompile_headers(${ARG_NAME} REUSE_FROM mapless_test_main)
   endif()
   # Label `unit`: a GoogleTest case (scripts/test.sh runs these under the sanitizers, and in the
   # release build only those in tests/release_only_tests.txt).
