@@ -59,7 +59,8 @@ endfunction()
 # One precompiled header of the system headers most tests include (GoogleTest, OpenCV, Eigen,
 # nlohmann/json, the standard library), built once with mapless_test_main and reused by every test
 # binary: each of them parsed these headers again, about 3 s of CPU a binary under the sanitizers
-# and 2 s in the release build (docs/ci.md). MAPLESS_TEST_PCH=OFF turns it off.
+# and 2 s in the release build (docs/ci.md). MAPLESS_TEST_PCH=OFF turns it off (the dev preset
+# does, so that a test file that does not include what it uses fails to compile there).
 option(MAPLESS_TEST_PCH "Reuse one precompiled header in every GoogleTest binary" ON)
 function(mapless_test_precompiled_header)
   if(MAPLESS_TEST_PCH)
