@@ -101,6 +101,8 @@ void Repeat(const RepeatArgs& r) {
   if (!r.record.path.empty() && !r.source.empty() && !run::IsSim(r.source))
     throw InputError("--record: records runs on the simulator or a robot; " + r.source +
                      " is played open loop (its decisions are in --log)");
+  // The robot file first: it is read in milliseconds, a route's keyframe images take longer.
+  const int robot_threads = r.robot.empty() ? 0 : robot::LoadRobotFile(r.robot).threads;
   // --learn writes into the route: no other process may write it meanwhile.
   const auto lock = r.learn ? std::make_unique<io::DirectoryLock>(r.route) : nullptr;
   auto route = std::make_shared<route::Route>(route::LoadRoute(r.route));
@@ -115,7 +117,7 @@ void Repeat(const RepeatArgs& r) {
   options.learn = r.learn;
   if (!r.robot.empty() || !run::IsSim(r.source)) {
     if (!r.robot.empty()) {
-      options.threads = robot::LoadRobotFile(r.robot).threads;
+      options.threads = robot_threads;
       options.sloped.max_speed_mps = r.speed;
       options.standard.forward_speed_mps = r.speed;
     }
