@@ -25,12 +25,13 @@ function(mapless_glue_code target)
   endif()
 endfunction()
 
-# mapless_library(NAME name SRCS ... PUBLIC_DEPS ... PRIVATE_DEPS ... [NO_INSTALL])
+# mapless_library(NAME name SRCS ... PUBLIC_DEPS ... PRIVATE_DEPS ... [NO_INSTALL] [GLUE])
 # One static library per module folder: mapless_<name>, alias mapless::<name>. Installed (with
 # `cmake --install`) and exported as mapless::<name> in the CMake package (cmake/MaplessInstall.cmake)
-# unless NO_INSTALL: the middleware adapters stay inside the `mapless` command.
+# unless NO_INSTALL: the middleware adapters stay inside the `mapless` command. GLUE: an edge
+# library, compiled at -O0 under the sanitizers (mapless_glue_code).
 function(mapless_library)
-  cmake_parse_arguments(ARG "NO_INSTALL" "NAME" "SRCS;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "NO_INSTALL;GLUE" "NAME" "SRCS;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
   set(target mapless_${ARG_NAME})
   add_library(${target} STATIC ${ARG_SRCS})
   add_library(mapless::${ARG_NAME} ALIAS ${target})
@@ -38,6 +39,9 @@ function(mapless_library)
                                               $<INSTALL_INTERFACE:include>)
   target_link_libraries(${target} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
   mapless_target_warnings(${target})
+  if(ARG_GLUE)
+    mapless_glue_code(${target})
+  endif()
   if(NOT ARG_NO_INSTALL)
     set_target_properties(${target} PROPERTIES EXPORT_NAME ${ARG_NAME})
     set_property(GLOBAL APPEND PROPERTY MAPLESS_INSTALLED_MODULES ${ARG_NAME})
