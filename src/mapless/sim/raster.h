@@ -143,16 +143,46 @@ std::vector<Prepared> PrepareSurfaces(const std::vector<Surface>& own,
                                       const Rigid3& camera_from_world,
                                       const RenderOptions& options);
 
-// Pass 1: the nearest surface per pixel centre. Branchless over structure-of-arrays buffers so
-// that the compiler vectorises the ray-surface tests.
-void RasterNearest(const std::vector<Prepared>& prepared, const std::vector<float>& xd,
-                   const std::vector<float>& yd, int w, float near_m, float far_m, Buffers* out);
+// The kernels: the per-pixel passes, each compiled for the baseline and, on x86-64, for AVX2
+// (kernel_target.h). Both give the same bytes; Kernels() picks the one the CPU runs.
+#define MAPLESS_SIM_KERNEL_DECLARATIONS                                                     \
+  /* Pass 1: the nearest surface per pixel centre. Branchless over structure-of-arrays */   \
+  /* buffers so that the compiler vectorises the ray-surface tests (nearest.cc). */         \
+  void RasterNearest(const std::vector<Prepared>& prepared, const std::vector<float>& xd,   \
+                     const std::vector<float>& yd, int w, float near_m, float far_m,        \
+                     Buffers* out);                                                         \
+  /* Pass 1b: every pixel shaded from the surface pass 1 found there (ShadeHit's bytes), */ \
+  /* the sky where there is none (shade.cc). */                                             \
+  void ShadeImage(const std::vector<Prepared>& prepared, const Buffers& buf,                \
+                  const std::vector<float>& yd, const SkyRamp& sky, float lod_slope,        \
+                  cv::Mat* image);                                                          \
+  /* Pass 2: silhouette pixels (where the visible surface differs from a neighbour's) */    \
+  /* supersampled S x S, each surface that wins sub-rays shaded once at the centroid of */  \
+  /* its hits (supersample.cc). */                                                          \
+  void SupersampleEdges(const std::vector<Prepared>& prepared, const Buffers& buf,          \
+                        const std::vector<float>& xd, const std::vector<float>& yd,         \
+                        const CameraModel& cam, int ss, float near_m, float far_m,          \
+                        float lod_slope, const SkyRamp& sky, cv::Mat* image);
 
-// Pass 2: silhouette pixels (where the visible surface differs from a neighbour's) supersampled
-// S x S, each surface that wins sub-rays shaded once at the centroid of its hits.
-void SupersampleEdges(const std::vector<Prepared>& prepared, const Buffers& buf,
-                      const std::vector<float>& xd, const std::vector<float>& yd,
-                      const CameraModel& cam, int ss, float near_m, float far_m, float lod_slope,
-                      const SkyRamp& sky, cv::Mat* image);
+namespace baseline {
+MAPLESS_SIM_KERNEL_DECLARATIONS
+}  // namespace baseline
+namespace avx2 {
+MAPLESS_SIM_KERNEL_DECLARATIONS
+}  // namespace avx2
+#undef MAPLESS_SIM_KERNEL_DECLARATIONS
+
+// One build of the three kernels.
+struct KernelSet {
+  const char* name;  // "baseline" or "avx2"
+  decltype(&baseline::RasterNearest) raster_nearest;
+  decltype(&baseline::ShadeImage) shade_image;
+  decltype(&baseline::SupersampleEdges) supersample_edges;
+};
+
+// The AVX2 build where the CPU (and the operating system) runs AVX2, the baseline otherwise, or
+// the baseline always after UseBaselineKernels(true) (tests that compare the two).
+const KernelSet& Kernels();
+void UseBaselineKernels(bool baseline);
 
 }  // namespace mapless::sim::raster

@@ -1,5 +1,6 @@
 #include "mapless/sim/renderer.h"
 
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -17,7 +18,29 @@ float ShadeFor(const Eigen::Vector3d& normal, const Eigen::Vector3d& light) {
   return static_cast<float>(0.6 + 0.4 * std::abs(normal.normalized().dot(light)));
 }
 
+std::atomic<bool> force_baseline_kernels{false};
+
 }  // namespace
+
+namespace raster {
+
+const KernelSet& Kernels() {
+  static const KernelSet kBaseline{"baseline", baseline::RasterNearest, baseline::ShadeImage,
+                                   baseline::SupersampleEdges};
+#if defined(__x86_64__) || defined(__i386__)
+  static const KernelSet kAvx2{"avx2", avx2::RasterNearest, avx2::ShadeImage,
+                               avx2::SupersampleEdges};
+  static const bool has_avx2 = __builtin_cpu_supports("avx2");
+  if (has_avx2 && !force_baseline_kernels.load(std::memory_order_relaxed)) return kAvx2;
+#endif
+  return kBaseline;
+}
+
+void UseBaselineKernels(bool baseline) {
+  force_baseline_kernels.store(baseline, std::memory_order_relaxed);
+}
+
+}  // namespace raster
 
 void RenderOptions::Validate() const {
   MAPLESS_CHECK(edge_supersample >= 1 && edge_supersample <= 8,
@@ -167,31 +190,18 @@ cv::Mat Renderer::Render(const CameraModel& cam, const Rigid3& world_from_camera
   buf.beta.resize(npix);
   buf.nd.resize(npix);
 
-  raster::RasterNearest(prepared, xd, yd, w, near_m, far_m, &buf);
-  const std::vector<float>& depth = buf.depth;
-  const std::vector<std::int32_t>& id = buf.id;
+  const raster::KernelSet& kernels = raster::Kernels();
+  kernels.raster_nearest(prepared, xd, yd, w, near_m, far_m, &buf);
   const raster::SkyRamp sky{sky_top_, sky_horizon_, yd.front(), yd.back()};
 
   cv::Mat image(h, w, CV_8UC1);
-  for (int y = 0; y < h; ++y) {
-    std::uint8_t* out = image.ptr<std::uint8_t>(y);
-    const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
-    const float sky_row = sky(yd[static_cast<std::size_t>(y)]);
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = row + static_cast<std::size_t>(x);
-      const float v =
-          id[i] < 0 ? sky_row
-                    : raster::ShadeHit(prepared[static_cast<std::size_t>(id[i])],
-                                       raster::Hit{depth[i], buf.alpha[i], buf.beta[i], buf.nd[i]},
-                                       lod_slope);
-      out[x] = cv::saturate_cast<std::uint8_t>(v);
-    }
-  }
+  kernels.shade_image(prepared, buf, yd, sky, lod_slope, &image);
 
   // Pass 2: supersample silhouette pixels, where the visible surface differs from a neighbour.
   const int ss = options_.edge_supersample;
   if (ss > 1)
-    raster::SupersampleEdges(prepared, buf, xd, yd, cam, ss, near_m, far_m, lod_slope, sky, &image);
+    kernels.supersample_edges(prepared, buf, xd, yd, cam, ss, near_m, far_m, lod_slope, sky,
+                              &image);
   return image;
 }
 

@@ -2,12 +2,14 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <vector>
 
+#include "mapless/sim/kernel_target.h"
 #include "mapless/sim/raster.h"
 
-namespace mapless::sim::raster {
+namespace mapless::sim::raster::MAPLESS_KERNEL_NS {
 namespace {
 
 // The sub-rays of one silhouette pixel and, per sub-ray, the nearest hit so far.
@@ -24,8 +26,8 @@ struct SubRayBuffers {
 
 // Tests every sub-ray against one candidate surface (branchless, so that it vectorises).
 template <Surface::Shape kShape>
-void SubRays(const Prepared& p, std::int32_t candidate, int n, float near_m, float far_m,
-             SubRayBuffers* b) {
+MAPLESS_KERNEL void SubRays(const Prepared& p, std::int32_t candidate, int n, float near_m,
+                            float far_m, SubRayBuffers* b) {
   for (int k = 0; k < n; ++k) {
     const float xv = b->xv[k];
     const float yv = b->yv[k];
@@ -49,38 +51,57 @@ void SubRays(const Prepared& p, std::int32_t candidate, int n, float near_m, flo
   }
 }
 
+// Marks the pixels of one row whose group differs from a neighbour's (left, right, up, down),
+// branchless so that it vectorises.
+MAPLESS_KERNEL void MarkEdges(const std::int32_t* __restrict g, const std::int32_t* __restrict up,
+                              const std::int32_t* __restrict down, int w,
+                              std::uint8_t* __restrict e) {
+  if (w == 1) {
+    e[0] = static_cast<std::uint8_t>((g[0] != up[0]) | (g[0] != down[0]));
+    return;
+  }
+  e[0] = static_cast<std::uint8_t>((g[0] != g[1]) | (g[0] != up[0]) | (g[0] != down[0]));
+  for (int x = 1; x + 1 < w; ++x) {
+    e[x] = static_cast<std::uint8_t>((g[x] != g[x - 1]) | (g[x] != g[x + 1]) | (g[x] != up[x]) |
+                                     (g[x] != down[x]));
+  }
+  const int l = w - 1;
+  e[l] = static_cast<std::uint8_t>((g[l] != g[l - 1]) | (g[l] != up[l]) | (g[l] != down[l]));
+}
+
 }  // namespace
 
 // Pass 2: silhouette pixels (where the visible surface differs from a neighbour's) supersampled
 // S x S, each surface that wins sub-rays shaded once at the centroid of its hits.
-void SupersampleEdges(const std::vector<Prepared>& prepared, const Buffers& buf,
-                      const std::vector<float>& xd, const std::vector<float>& yd,
-                      const CameraModel& cam, int ss, float near_m, float far_m, float lod_slope,
-                      const SkyRamp& sky, cv::Mat* image) {
+MAPLESS_KERNEL void SupersampleEdges(const std::vector<Prepared>& prepared, const Buffers& buf,
+                                     const std::vector<float>& xd, const std::vector<float>& yd,
+                                     const CameraModel& cam, int ss, float near_m, float far_m,
+                                     float lod_slope, const SkyRamp& sky, cv::Mat* image) {
   const int w = cam.width;
   const int h = cam.height;
   const std::size_t npix = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
   const std::vector<std::int32_t>& id = buf.id;
   const float sub_x = static_cast<float>(1.0 / cam.fx);
   const float sub_y = static_cast<float>(1.0 / cam.fy);
-  // Mark both pixels of every horizontally or vertically adjacent pair that sees different
-  // surfaces (or a surface and the sky).
+  // Mark every pixel that sees another surface (or a surface and the sky) than one of its four
+  // neighbours: the pixels of every adjacent pair that differs.
   thread_local std::vector<std::int32_t> group;  // kept between renders, as Render's buffers
+  thread_local std::vector<std::int32_t> group_of;
   thread_local std::vector<std::uint8_t> edge;
+  group_of.resize(prepared.size() + 1);
+  group_of[0] = -1;  // the sky
+  for (std::size_t k = 0; k < prepared.size(); ++k) group_of[k + 1] = prepared[k].group;
   group.resize(npix);
-  for (std::size_t i = 0; i < npix; ++i) {
-    group[i] = id[i] < 0 ? -1 : prepared[static_cast<std::size_t>(id[i])].group;
-  }
-  edge.assign(npix, 0);
+  edge.resize(npix);
+  for (std::size_t i = 0; i < npix; ++i) group[i] = group_of[static_cast<std::size_t>(id[i] + 1)];
   for (int y = 0; y < h; ++y) {
     const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = row + static_cast<std::size_t>(x);
-      if (x + 1 < w && group[i] != group[i + 1]) edge[i] = edge[i + 1] = 1;
-      if (y + 1 < h && group[i] != group[i + static_cast<std::size_t>(w)]) {
-        edge[i] = edge[i + static_cast<std::size_t>(w)] = 1;
-      }
-    }
+    const std::int32_t* g = group.data() + row;
+    // The first and the last row compare with themselves where there is no row beyond.
+    const std::int32_t* up = y > 0 ? g - w : g;
+    const std::int32_t* down = y + 1 < h ? g + w : g;
+    std::uint8_t* e = edge.data() + row;
+    MarkEdges(g, up, down, w, e);
   }
   struct Accum {
     float t = 0.0f, alpha = 0.0f, beta = 0.0f, nd = 0.0f;
@@ -101,10 +122,16 @@ void SupersampleEdges(const std::vector<Prepared>& prepared, const Buffers& buf,
   SubRayBuffers sub;
   for (int y = 0; y < h; ++y) {
     std::uint8_t* out = image->ptr<std::uint8_t>(y);
+    const std::uint8_t* e = edge.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
     for (int x = 0; x < w; ++x) {
-      const std::size_t i =
-          static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-      if (!edge[i]) continue;
+      // Skip eight pixels at a time where none is on an edge (most of the image).
+      std::uint64_t eight = 0;
+      if (x + 8 <= w) std::memcpy(&eight, e + x, sizeof(eight));
+      if (x + 8 <= w && eight == 0) {
+        x += 7;
+        continue;
+      }
+      if (!e[x]) continue;
       // Surfaces seen in the 3x3 neighbourhood: the candidates for this pixel's sub-rays.
       candidates.clear();
       for (int dy = -1; dy <= 1; ++dy) {
@@ -174,4 +201,4 @@ void SupersampleEdges(const std::vector<Prepared>& prepared, const Buffers& buf,
   }
 }
 
-}  // namespace mapless::sim::raster
+}  // namespace mapless::sim::raster::MAPLESS_KERNEL_NS
