@@ -69,23 +69,13 @@ MAPLESS_KERNEL void MarkEdges(const std::int32_t* __restrict g, const std::int32
   e[l] = static_cast<std::uint8_t>((g[l] != g[l - 1]) | (g[l] != up[l]) | (g[l] != down[l]));
 }
 
-}  // namespace
-
-// Pass 2: silhouette pixels (where the visible surface differs from a neighbour's) supersampled
-// S x S, each surface that wins sub-rays shaded once at the centroid of its hits.
-MAPLESS_KERNEL void SupersampleEdges(const std::vector<Prepared>& prepared, const Buffers& buf,
-                                     const std::vector<float>& xd, const std::vector<float>& yd,
-                                     const CameraModel& cam, int ss, float near_m, float far_m,
-                                     float lod_slope, const SkyRamp& sky, cv::Mat* image) {
-  const int w = cam.width;
-  const int h = cam.height;
+// Marks every pixel that sees another surface group (or a surface and the sky) than one of its
+// four neighbours: the pixels of every adjacent pair that differs. Returns a per-thread buffer,
+// kept between renders as Render's buffers.
+MAPLESS_KERNEL const std::vector<std::uint8_t>& SilhouettePixels(
+    const std::vector<Prepared>& prepared, const std::vector<std::int32_t>& id, int w, int h) {
   const std::size_t npix = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-  const std::vector<std::int32_t>& id = buf.id;
-  const float sub_x = static_cast<float>(1.0 / cam.fx);
-  const float sub_y = static_cast<float>(1.0 / cam.fy);
-  // Mark every pixel that sees another surface (or a surface and the sky) than one of its four
-  // neighbours: the pixels of every adjacent pair that differs.
-  thread_local std::vector<std::int32_t> group;  // kept between renders, as Render's buffers
+  thread_local std::vector<std::int32_t> group;
   thread_local std::vector<std::int32_t> group_of;
   thread_local std::vector<std::uint8_t> edge;
   group_of.resize(prepared.size() + 1);
@@ -100,9 +90,25 @@ MAPLESS_KERNEL void SupersampleEdges(const std::vector<Prepared>& prepared, cons
     // The first and the last row compare with themselves where there is no row beyond.
     const std::int32_t* up = y > 0 ? g - w : g;
     const std::int32_t* down = y + 1 < h ? g + w : g;
-    std::uint8_t* e = edge.data() + row;
-    MarkEdges(g, up, down, w, e);
+    MarkEdges(g, up, down, w, edge.data() + row);
   }
+  return edge;
+}
+
+}  // namespace
+
+// Pass 2: silhouette pixels (where the visible surface differs from a neighbour's) supersampled
+// S x S, each surface that wins sub-rays shaded once at the centroid of its hits.
+MAPLESS_KERNEL void SupersampleEdges(const std::vector<Prepared>& prepared, const Buffers& buf,
+                                     const std::vector<float>& xd, const std::vector<float>& yd,
+                                     const CameraModel& cam, int ss, float near_m, float far_m,
+                                     float lod_slope, const SkyRamp& sky, cv::Mat* image) {
+  const int w = cam.width;
+  const int h = cam.height;
+  const std::vector<std::int32_t>& id = buf.id;
+  const float sub_x = static_cast<float>(1.0 / cam.fx);
+  const float sub_y = static_cast<float>(1.0 / cam.fy);
+  const std::vector<std::uint8_t>& edge = SilhouettePixels(prepared, id, w, h);
   struct Accum {
     float t = 0.0f, alpha = 0.0f, beta = 0.0f, nd = 0.0f;
     int n = 0;
