@@ -202,10 +202,17 @@ nlohmann::json BenchStages(const StageOptions& options) {
       std::to_string(BenchFrameSize().width) + "x" + std::to_string(BenchFrameSize().height);
   j["repeats"] = options.repeats;
   cv::Mat sink;
-  j["sim_render_320x240_ms"] = MedianMs(options.repeats, 3, [&](int i) {
+  // The renderer's kernels in use (AVX2 where the CPU has it), then the baseline build of them
+  // on the same views: the same images, the time a CPU without AVX2 would take relative to DIS.
+  j["sim_render_kernels"] = sim::RenderKernels();
+  auto render = [&](int i) {
     const View& v = views[static_cast<std::size_t>(i) % views.size()];
     sink = v.renderer->Render(v.camera.model, sim::WorldFromCamera(v.pose, v.camera.mount));
-  });
+  };
+  j["sim_render_320x240_ms"] = MedianMs(options.repeats, 3, render);
+  sim::UseBaselineRenderKernels(true);
+  j["sim_render_baseline_kernels_320x240_ms"] = MedianMs(options.repeats, 3, render);
+  sim::UseBaselineRenderKernels(false);
   // Reference: DIS optical flow (PRESET_FAST) on consecutive views of the same drive.
   std::vector<cv::Mat> pair_a;
   std::vector<cv::Mat> pair_b;
@@ -227,6 +234,9 @@ nlohmann::json BenchStages(const StageOptions& options) {
   });
   j["sim_render_over_dis_fast"] =
       j["sim_render_320x240_ms"].get<double>() / j["opencv_dis_fast_320x240_ms"].get<double>();
+  j["sim_render_baseline_kernels_over_dis_fast"] =
+      j["sim_render_baseline_kernels_320x240_ms"].get<double>() /
+      j["opencv_dis_fast_320x240_ms"].get<double>();
   // Issue 4: the paper's dense pyramidal LK (5x5, levels 0-4) against OpenCV's sparse
   // calcOpticalFlowPyrLK asked for every pixel with the same window and levels.
   j["dense_lk_320x240_ms"] = MedianMs(options.repeats, 2, [&](int i) {

@@ -10,7 +10,7 @@
 //
 // AVX2 does not include FMA, so the compiler cannot fuse a multiply and an add: every float
 // operation rounds as in the baseline build, lane by lane, and both builds of a kernel give the
-// same bytes (`Renderer.Avx2KernelsGiveTheBaselineBytes`).
+// same bytes (`RendererKernels.Avx2KernelsGiveTheBaselineBytes`).
 #pragma once
 
 #if defined(MAPLESS_SIM_KERNELS_AVX2)

@@ -91,17 +91,17 @@ bool SameBytes(const cv::Mat& a, const cv::Mat& b) {
 }
 
 bool CpuRunsAvx2() {
-  UseBaselineKernels(false);
-  return std::string(Kernels().name) == "avx2";
+  UseBaselineRenderKernels(false);
+  return std::string(RenderKernels()) == "avx2";
 }
 
 // The kernel builds this machine runs: the baseline always, AVX2 where the CPU has it.
 std::vector<KernelSet> RunnableKernels() {
   std::vector<KernelSet> sets;
-  UseBaselineKernels(true);
+  UseBaselineRenderKernels(true);
   sets.push_back(Kernels());
   if (CpuRunsAvx2()) sets.push_back(Kernels());
-  UseBaselineKernels(false);
+  UseBaselineRenderKernels(false);
   return sets;
 }
 
@@ -114,7 +114,7 @@ TEST(RendererKernels, ShadingGivesShadeHitsBytesPixelForPixel) {
   for (const char* name : kScenarios) {
     const Scenario scenario = LoadScenario(name);
     const Renderer renderer(scenario.world, RenderOptions{});
-    for (const Pose2& pose : PosesAlong(scenario, 5)) {
+    for (const Pose2& pose : PosesAlong(scenario, 2)) {
       const View v = PassOne(renderer, scenario.world, scenario.camera.model,
                              WorldFromCamera(pose, scenario.camera.mount));
       const cv::Mat expected = ShadeHitImage(v);
@@ -126,7 +126,7 @@ TEST(RendererKernels, ShadingGivesShadeHitsBytesPixelForPixel) {
       ++views;
     }
   }
-  EXPECT_EQ(views, 15);
+  EXPECT_EQ(views, 6);
 }
 
 // Texels of 10 um seen 1 km from the world's origin: the texture coordinates in 24.8 fixed point
@@ -161,8 +161,8 @@ TEST(RendererKernels, Avx2KernelsGiveTheBaselineBytes) {
   int views = 0;
   for (const char* name : kScenarios) {
     const Scenario scenario = LoadScenario(name);
-    // The default supersampling everywhere, none and the most on the first scenario.
-    for (const int supersample : {4, 1, 8}) {
+    // The default supersampling everywhere, the most on the first scenario.
+    for (const int supersample : {4, 8}) {
       if (supersample != 4 && name != kScenarios[0]) continue;
       RenderOptions options;
       options.edge_supersample = supersample;
@@ -179,12 +179,13 @@ TEST(RendererKernels, Avx2KernelsGiveTheBaselineBytes) {
         std::vector<Surface> extra;
         AppendObjectSurfaces(box, renderer.surfaces().front().texture, &extra,
                              LightDirection(scenario.world));
-        for (const CameraModel& cam :
-             {scenario.camera.model, CameraModel::FromFov(640, 480, DegToRad(70))}) {
+        std::vector<CameraModel> cameras = {scenario.camera.model};
+        if (views == 0) cameras.push_back(CameraModel::FromFov(640, 480, DegToRad(70)));
+        for (const CameraModel& cam : cameras) {
           const Rigid3 pose3 = WorldFromCamera(pose, scenario.camera.mount);
-          UseBaselineKernels(true);
+          UseBaselineRenderKernels(true);
           const cv::Mat baseline = renderer.Render(cam, pose3, extra);
-          UseBaselineKernels(false);
+          UseBaselineRenderKernels(false);
           const cv::Mat avx2 = renderer.Render(cam, pose3, extra);
           EXPECT_TRUE(SameBytes(avx2, baseline))
               << name << ", supersample " << supersample << ", " << cam.width << "x" << cam.height;
@@ -193,7 +194,7 @@ TEST(RendererKernels, Avx2KernelsGiveTheBaselineBytes) {
       }
     }
   }
-  EXPECT_EQ(views, (3 + 2) * 2 * 2);
+  EXPECT_EQ(views, (3 + 1) * 2 + 1);
 }
 
 }  // namespace

@@ -181,8 +181,7 @@ struct KernelSet {
 };
 
 // The AVX2 build where the CPU (and the operating system) runs AVX2, the baseline otherwise, or
-// the baseline always after UseBaselineKernels(true) (tests that compare the two).
+// the baseline always after UseBaselineRenderKernels(true) (renderer.h).
 const KernelSet& Kernels();
-void UseBaselineKernels(bool baseline);
 
 }  // namespace mapless::sim::raster

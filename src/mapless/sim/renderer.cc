@@ -36,11 +36,13 @@ const KernelSet& Kernels() {
   return kBaseline;
 }
 
-void UseBaselineKernels(bool baseline) {
+}  // namespace raster
+
+const char* RenderKernels() { return raster::Kernels().name; }
+
+void UseBaselineRenderKernels(bool baseline) {
   force_baseline_kernels.store(baseline, std::memory_order_relaxed);
 }
-
-}  // namespace raster
 
 void RenderOptions::Validate() const {
   MAPLESS_CHECK(edge_supersample >= 1 && edge_supersample <= 8,

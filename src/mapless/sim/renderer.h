@@ -52,6 +52,13 @@ Eigen::Vector3d LightDirection(const World& world);
 void AppendObjectSurfaces(const WorldObject& object, std::shared_ptr<const Texture> texture,
                           std::vector<Surface>* out, const Eigen::Vector3d& light);
 
+// The renderer's per-pixel passes run as AVX2 code where the CPU has it and as baseline code
+// otherwise (SSE2 on x86-64; the target's own elsewhere): the same bytes either way, only the time
+// differs. RenderKernels() names the one in use, "avx2" or "baseline";
+// UseBaselineRenderKernels(true) makes every later render use the baseline (benches, tests).
+const char* RenderKernels();
+void UseBaselineRenderKernels(bool baseline);
+
 class Renderer {
  public:
   // Generates every texture of the world (shared between objects with the same spec).

@@ -4,8 +4,9 @@
 // into segments that see one surface at one mip level (or one of the cases without a level pair),
 // and each segment is shaded in chunks by loops without branches or per-pixel shift counts. Only
 // the texel fetches stay scalar. A run whose fixed-point texture coordinates do not fit 32 bits
-// (never within far_m on the built-in worlds, but possible for a huge texture scale) is shaded by
-// ShadeHit itself, so the bytes are ShadeHit's in every case (`Renderer.ShadingMatchesShadeHit`).
+// (never on the built-in worlds; a ground of 10 um texels a kilometre from the origin) is shaded
+// by ShadeHit itself, so the bytes are ShadeHit's in every case
+// (`RendererKernels.ShadingGivesShadeHitsBytesPixelForPixel`). A kernel file (kernel_target.h).
 #include <algorithm>
 #include <cstdint>
 #include <vector>
@@ -115,8 +116,8 @@ MAPLESS_KERNEL bool ShadeChunk(const Prepared& p, const float* alpha, const floa
     // ShadeHit's (alpha * s_scale) * 256, in the same order.
     const float fs = alpha[i] * p.s_scale * 256.0f;
     const float ft = beta[i] * p.t_scale * 256.0f;
-    misfits += static_cast<std::int32_t>((std::abs(fs) >= 2147483648.0f) |
-                                         (std::abs(ft) >= 2147483648.0f));
+    misfits += static_cast<std::int32_t>(std::abs(fs) >= 2147483648.0f);
+    misfits += static_cast<std::int32_t>(std::abs(ft) >= 2147483648.0f);
     v.s[i] = static_cast<std::int32_t>(fs);
     v.t[i] = static_cast<std::int32_t>(ft);
     // ShadeHit's std::max(|nd|, 1e-6f) and its max(lod, 0) below are written as selects, which
