@@ -125,11 +125,13 @@ void AddFollowCommand(CLI::App* app) {
     RefuseOutputOverInputs(a->log, "--log", {a->route, run::SourceInput(a->source), a->robot});
     RefuseOutputOverInputs(a->record.path, "--record",
                            {a->route, run::SourceInput(a->source), a->robot});
-    cv::Size size;
-    const std::shared_ptr<const route::AppearanceRoute> route = RebuildRoute(a->route, &size);
+    // The robot file first: a mistake there is answered before the route's images are read
+    // and every one of them goes through the incremental PCA.
     navigation::AppearanceFollowerOptions follower;
     follower.obstacle = ObstacleWatchFor(a->robot, a->on_obstacle, follower.obstacle, false);
     SetFollowerRecovery(a->carry_on_m, &follower);
+    cv::Size size;
+    const std::shared_ptr<const route::AppearanceRoute> route = RebuildRoute(a->route, &size);
     robot::FollowMethod method([route] { return route; }, follower, size);
     if (!a->robot.empty() || !run::IsSim(a->source)) {
       SourceRunArgs args;
