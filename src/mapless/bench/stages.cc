@@ -21,34 +21,10 @@
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/flow/flow.h"
 #include "mapless/localization/markov.h"
-#include "mapless/sim/driver.h"
 
 namespace mapless::bench {
 
 // The middleware's robot-link latency rows (bench_links.cc).
-
-namespace {
-
-// Poses along a scenario's taught path (ground truth of a clean drive), for typical views.
-std::vector<Pose2> PosesAlong(const sim::Scenario& scenario, int count) {
-  std::vector<Pose2> poses;
-  sim::Simulation s(scenario.world, scenario.camera, {}, 1);
-  s.AddRobot(scenario.teach_start, scenario.robot);
-  sim::ScriptedDriver driver(scenario.teach_start, scenario.teach_path, scenario.teach_speed_mps);
-  while (!driver.done() && poses.size() < 5000) {
-    poses.push_back(s.robot(0).pose());
-    s.SetCommand(0, driver.Update(s.robot(0).pose()));
-    s.Advance(0.1);
-  }
-  std::vector<Pose2> picked;
-  for (int i = 0; i < count; ++i) {
-    picked.push_back(
-        poses[static_cast<std::size_t>(i) * poses.size() / static_cast<std::size_t>(count)]);
-  }
-  return picked;
-}
-
-}  // namespace
 
 // Issue 4: one visual-potential control step (flow + dominant plane + potential + command) on
 // the downward camera of the corridor scenario, against DIS fast alone on the same frames.
@@ -190,7 +166,7 @@ nlohmann::json BenchStages(const StageOptions& options) {
     scenario.camera.model =
         sim::CameraModel::FromFov(BenchFrameSize().width, BenchFrameSize().height, DegToRad(60.0));
     renderers.push_back(std::make_unique<sim::Renderer>(scenario.world, sim::RenderOptions{}));
-    for (const Pose2& p : PosesAlong(scenario, 12))
+    for (const Pose2& p : sim::PosesAlongTaughtPath(scenario, 12))
       views.push_back({renderers.back().get(), scenario.camera, p});
   }
   const sim::Scenario scenario = BenchScenario(names.front());

@@ -75,7 +75,7 @@ void PrintLinkRows(const nlohmann::json& j) {
 void PrintStageTable(const nlohmann::json& j) {
   // Every stage runs on one thread (cv::setNumThreads(1)) but those named "2_threads"; fps: the
   // frame rate the stage alone allows on this host (1000 / median).
-  std::printf("%-34s %10s %9s\n", "stage (one thread; 2_threads: two)", "median ms", "fps");
+  std::printf("%-40s %10s %9s\n", "stage (one thread; 2_threads: two)", "median ms", "fps");
   for (const char* key : {"sim_render_320x240_ms",
                           "sim_render_baseline_kernels_320x240_ms",
                           "opencv_dis_fast_320x240_ms",
@@ -107,7 +107,7 @@ void PrintStageTable(const nlohmann::json& j) {
                           "markov_update_10000_ms",
                           "subwindow_control_ms"}) {
     const double ms = j[key].get<double>();
-    std::printf("%-34s %10.3f %9.0f\n", key, ms, ms > 0.0 ? 1000.0 / ms : 0.0);
+    std::printf("%-40s %10.3f %9.0f\n", key, ms, ms > 0.0 ? 1000.0 / ms : 0.0);
   }
   std::printf("%-34s %10.2f  (issue 44: <= 1.0; %s kernels)\n", "sim_render / dis_fast",
               j["sim_render_over_dis_fast"].get<double>(),

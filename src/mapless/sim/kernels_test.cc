@@ -7,7 +7,6 @@
 #include <string>
 #include <vector>
 
-#include "mapless/sim/driver.h"
 #include "mapless/sim/raster.h"
 #include "mapless/sim/renderer.h"
 #include "mapless/sim/scenario.h"
@@ -15,25 +14,6 @@
 
 namespace mapless::sim::raster {
 namespace {
-
-// Poses along a scenario's taught path, `count` of them evenly spread.
-std::vector<Pose2> PosesAlong(const Scenario& scenario, int count) {
-  std::vector<Pose2> poses;
-  Simulation s(scenario.world, scenario.camera, {}, 1);
-  s.AddRobot(scenario.teach_start, scenario.robot);
-  ScriptedDriver driver(scenario.teach_start, scenario.teach_path, scenario.teach_speed_mps);
-  while (!driver.done() && poses.size() < 5000) {
-    poses.push_back(s.robot(0).pose());
-    s.SetCommand(0, driver.Update(s.robot(0).pose()));
-    s.Advance(0.1);
-  }
-  std::vector<Pose2> picked;
-  for (int i = 0; i < count; ++i) {
-    picked.push_back(
-        poses[static_cast<std::size_t>(i) * poses.size() / static_cast<std::size_t>(count)]);
-  }
-  return picked;
-}
 
 // Pass 1 of one view, as Renderer::Render runs it (baseline kernel).
 struct View {
@@ -114,7 +94,7 @@ TEST(RendererKernels, ShadingGivesShadeHitsBytesPixelForPixel) {
   for (const char* name : kScenarios) {
     const Scenario scenario = LoadScenario(name);
     const Renderer renderer(scenario.world, RenderOptions{});
-    for (const Pose2& pose : PosesAlong(scenario, 2)) {
+    for (const Pose2& pose : PosesAlongTaughtPath(scenario, 2)) {
       const View v = PassOne(renderer, scenario.world, scenario.camera.model,
                              WorldFromCamera(pose, scenario.camera.mount));
       const cv::Mat expected = ShadeHitImage(v);
@@ -167,7 +147,7 @@ TEST(RendererKernels, Avx2KernelsGiveTheBaselineBytes) {
       RenderOptions options;
       options.edge_supersample = supersample;
       const Renderer renderer(scenario.world, options);
-      for (const Pose2& pose : PosesAlong(scenario, 2)) {
+      for (const Pose2& pose : PosesAlongTaughtPath(scenario, 2)) {
         // Another robot's box in front of the camera: the extra surfaces go through the kernels.
         WorldObject box;
         box.kind = ObjectKind::kBox;

@@ -189,6 +189,24 @@ DriveOptions ParseDriveOptions(const std::string& yaml_text, const std::string& 
   return io::WithYamlErrors(name, [&] { return ParseDriveOptionsUnchecked(yaml_text, name); });
 }
 
+std::vector<Pose2> PosesAlongTaughtPath(const Scenario& scenario, int count) {
+  std::vector<Pose2> poses;
+  Simulation s(scenario.world, scenario.camera, {}, 1);
+  s.AddRobot(scenario.teach_start, scenario.robot);
+  ScriptedDriver driver(scenario.teach_start, scenario.teach_path, scenario.teach_speed_mps);
+  while (!driver.done() && poses.size() < 5000) {
+    poses.push_back(s.robot(0).pose());
+    s.SetCommand(0, driver.Update(s.robot(0).pose()));
+    s.Advance(0.1);
+  }
+  std::vector<Pose2> picked;
+  for (int i = 0; i < count && !poses.empty(); ++i) {
+    picked.push_back(
+        poses[static_cast<std::size_t>(i) * poses.size() / static_cast<std::size_t>(count)]);
+  }
+  return picked;
+}
+
 DriveSummary DriveTaughtPath(const Scenario& scenario, const DriveOptions& options,
                              const std::function<void(const DriveFrame&)>& on_frame) {
   options.Validate();

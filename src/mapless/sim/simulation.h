@@ -121,4 +121,8 @@ DriveOptions ParseDriveOptions(const std::string& yaml_text, const std::string& 
 DriveSummary DriveTaughtPath(const Scenario& scenario, const DriveOptions& options,
                              const std::function<void(const DriveFrame&)>& on_frame);
 
+// `count` poses spread evenly along a scenario's taught path (the ground truth of a drive without
+// noise, sampled every 0.1 s): typical views for benches and tests.
+std::vector<Pose2> PosesAlongTaughtPath(const Scenario& scenario, int count);
+
 }  // namespace mapless::sim
