@@ -75,26 +75,6 @@ struct Hit {
   return (top << 8) + wt * (bottom - top);
 }
 
-// `lod_slope` is 0.5 (3 + anisotropy), fixed per render.
-[[gnu::always_inline]] inline float ShadeHit(const Prepared& p, const Hit& h, float lod_slope) {
-  // Level-0 texel coordinates in 24.8 fixed point (hits are nearer than far_m, so they fit).
-  const auto s_fx = static_cast<std::int64_t>(h.alpha * p.s_scale * 256.0f);
-  const auto t_fx = static_cast<std::int64_t>(h.beta * p.t_scale * 256.0f);
-  // Footprint of the pixel on the surface in texels^2 is t^2 / (f^2 texel^2 |n.d|), and the
-  // anisotropy a moves the choice towards its long side: level = 0.5 log2(t^2 L / |n.d|^(1+a)).
-  // With t = k / (n.d) this is 0.5 log2(k^2 L) - 0.5 (3 + a) log2|n.d|: one log per pixel.
-  const float lod = p.lod_base - lod_slope * FastLog2(std::max(std::abs(h.nd), 1e-6f));
-  constexpr float kInv16 = 1.0f / 65536.0f;
-  if (lod <= 0.0f)
-    return p.shade * kInv16 * static_cast<float>(BilinearFixed(p.levels[0], 0, s_fx, t_fx));
-  if (lod >= static_cast<float>(p.max_level)) return p.shade * p.levels[p.max_level].data[0];
-  const int l0 = static_cast<int>(lod);
-  const float w = lod - static_cast<float>(l0);
-  const auto v0 = static_cast<float>(BilinearFixed(p.levels[l0], l0, s_fx, t_fx));
-  const auto v1 = static_cast<float>(BilinearFixed(p.levels[l0 + 1], l0 + 1, s_fx, t_fx));
-  return p.shade * kInv16 * (v0 + w * (v1 - v0));
-}
-
 // Branchless selects written with bit masks: GCC turns `a[i] = c ? x : a[i]` into a conditional
 // store, which blocks vectorisation; these keep the loops below straight-line.
 inline float Select(bool c, float a, float b) {
@@ -112,6 +92,39 @@ inline float Select(bool c, float a, float b) {
 inline std::int32_t Select(bool c, std::int32_t a, std::int32_t b) {
   const std::int32_t m = -static_cast<std::int32_t>(c);
   return (a & m) | (b & ~m);
+}
+
+// A surface coordinate (alpha or beta) in level-0 texels, times 256: the 24.8 fixed-point texture
+// coordinate before its conversion to an integer (ShadeHit's, and the shading kernel's).
+inline float TexelTimes256(float coordinate, float texels_per_unit) {
+  return coordinate * texels_per_unit * 256.0f;
+}
+
+// The mip level of a hit with n . d = nd. Footprint of the pixel on the surface in texels^2 is
+// t^2 / (f^2 texel^2 |n.d|), and the anisotropy a moves the choice towards its long side:
+// level = 0.5 log2(t^2 L / |n.d|^(1+a)). With t = k / (n.d) this is
+// 0.5 log2(k^2 L) - 0.5 (3 + a) log2|n.d|: one log per pixel. `lod_slope` is 0.5 (3 + a), fixed
+// per render. max(|nd|, 1e-6) is written as a select, so that loops over it vectorise.
+inline float MipLevel(const Prepared& p, float nd, float lod_slope) {
+  const float abs_nd = std::abs(nd);
+  return p.lod_base - lod_slope * FastLog2(Select(abs_nd < 1e-6f, 1e-6f, abs_nd));
+}
+
+// `lod_slope` is 0.5 (3 + anisotropy), fixed per render.
+[[gnu::always_inline]] inline float ShadeHit(const Prepared& p, const Hit& h, float lod_slope) {
+  // Level-0 texel coordinates in 24.8 fixed point (hits are nearer than far_m, so they fit).
+  const auto s_fx = static_cast<std::int64_t>(TexelTimes256(h.alpha, p.s_scale));
+  const auto t_fx = static_cast<std::int64_t>(TexelTimes256(h.beta, p.t_scale));
+  const float lod = MipLevel(p, h.nd, lod_slope);
+  constexpr float kInv16 = 1.0f / 65536.0f;
+  if (lod <= 0.0f)
+    return p.shade * kInv16 * static_cast<float>(BilinearFixed(p.levels[0], 0, s_fx, t_fx));
+  if (lod >= static_cast<float>(p.max_level)) return p.shade * p.levels[p.max_level].data[0];
+  const int l0 = static_cast<int>(lod);
+  const float w = lod - static_cast<float>(l0);
+  const auto v0 = static_cast<float>(BilinearFixed(p.levels[l0], l0, s_fx, t_fx));
+  const auto v1 = static_cast<float>(BilinearFixed(p.levels[l0 + 1], l0 + 1, s_fx, t_fx));
+  return p.shade * kInv16 * (v0 + w * (v1 - v0));
 }
 
 // Per-pixel results of pass 1, as structure of arrays.

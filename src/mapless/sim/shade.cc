@@ -113,17 +113,15 @@ MAPLESS_KERNEL bool ShadeChunk(const Prepared& p, const float* alpha, const floa
   std::int32_t misfits = 0;
   const float max_level = static_cast<float>(p.max_level);
   for (int i = 0; i < n; ++i) {
-    // ShadeHit's (alpha * s_scale) * 256, in the same order.
-    const float fs = alpha[i] * p.s_scale * 256.0f;
-    const float ft = beta[i] * p.t_scale * 256.0f;
+    // ShadeHit's fixed-point coordinates and mip level, from the same functions.
+    const float fs = TexelTimes256(alpha[i], p.s_scale);
+    const float ft = TexelTimes256(beta[i], p.t_scale);
     misfits += static_cast<std::int32_t>(std::abs(fs) >= 2147483648.0f);
     misfits += static_cast<std::int32_t>(std::abs(ft) >= 2147483648.0f);
     v.s[i] = static_cast<std::int32_t>(fs);
     v.t[i] = static_cast<std::int32_t>(ft);
-    // ShadeHit's std::max(|nd|, 1e-6f) and its max(lod, 0) below are written as selects, which
-    // GCC vectorises (it leaves the loop scalar with std::max).
-    const float abs_nd = std::abs(nd[i]);
-    const float lod = p.lod_base - lod_slope * FastLog2(Select(abs_nd < 1e-6f, 1e-6f, abs_nd));
+    const float lod = MipLevel(p, nd[i], lod_slope);
+    // max(lod, 0) as a select: GCC leaves the loop scalar with std::max.
     const auto l0 = static_cast<std::int32_t>(Select(lod > 0.0f, lod, 0.0f));
     v.w[i] = lod - static_cast<float>(l0);
     // ShadeHit's order of the cases: lod <= 0 first.
