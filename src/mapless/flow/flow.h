@@ -7,6 +7,7 @@
 
 #include <opencv2/core.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace mapless::flow {
@@ -55,6 +56,10 @@ std::vector<cv::Mat> BuildPyramid(const cv::Mat& grey, int levels);
 // the layer optical flow fields of Section 3.6, for hierarchical dominant planes.
 cv::Mat DenseLucasKanade(const cv::Mat& first, const cv::Mat& second, const DenseLkOptions& options,
                          std::vector<cv::Mat>* level_flows = nullptr);
+
+// Both images as 8-bit grey (colour converted), checked to be the same size; `who` names the
+// caller in the error.
+std::pair<cv::Mat, cv::Mat> GreyPair(const cv::Mat& first, const cv::Mat& second, const char* who);
 
 // End-point error against ground truth; pixels where `valid` is zero (or the truth is unknown,
 // |value| > 1e9 as in Middlebury files) are skipped.

@@ -3,11 +3,16 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
+#include <tuple>
+#include <vector>
 
 #include "mapless/core/check.h"
 #include "mapless/core/testing.h"
@@ -110,6 +115,105 @@ TEST(DenseLucasKanade, ReturnsEachLayersFlowInItsOwnPixels) {
   EXPECT_EQ(layers[1].size(), cv::Size(160, 120));
   const cv::Vec2f centre = layers[1].at<cv::Vec2f>(60, 80);
   EXPECT_NEAR(centre[0], 4.0, 0.5);  // 8 px at full resolution is 4 px at layer 1
+}
+
+// The dense LK as the plain composition of OpenCV calls (the code before 2026-11-29): what the
+// kept-images implementation must give bit for bit.
+cv::Mat PlainDenseLucasKanade(const cv::Mat& first, const cv::Mat& second,
+                              const DenseLkOptions& options, std::vector<cv::Mat>* layers) {
+  const std::vector<cv::Mat> pa = BuildPyramid(first, options.levels);
+  const std::vector<cv::Mat> pb = BuildPyramid(second, options.levels);
+  const cv::Size win(options.window, options.window);
+  cv::Mat flow;
+  for (int l = static_cast<int>(pa.size()) - 1; l >= 0; --l) {
+    const cv::Mat& i0 = pa[static_cast<std::size_t>(l)];
+    const cv::Mat& i1 = pb[static_cast<std::size_t>(l)];
+    if (flow.empty()) {
+      flow = cv::Mat::zeros(i0.size(), CV_32FC2);
+    } else {
+      cv::Mat up;
+      cv::resize(flow, up, i0.size(), 0, 0, cv::INTER_LINEAR);
+      flow = up * 2.0;
+    }
+    cv::Mat ix, iy, a11, a12, a22;
+    cv::Sobel(i0, ix, CV_32F, 1, 0, 3, 1.0 / 8.0, 0.0, cv::BORDER_REFLECT101);
+    cv::Sobel(i0, iy, CV_32F, 0, 1, 3, 1.0 / 8.0, 0.0, cv::BORDER_REFLECT101);
+    cv::boxFilter(ix.mul(ix), a11, CV_32F, win);
+    cv::boxFilter(ix.mul(iy), a12, CV_32F, win);
+    cv::boxFilter(iy.mul(iy), a22, CV_32F, win);
+    cv::Mat map(i0.size(), CV_32FC2);
+    for (int it = 0; it < options.iterations; ++it) {
+      for (int y = 0; y < map.rows; ++y)
+        for (int x = 0; x < map.cols; ++x)
+          map.at<cv::Vec2f>(y, x) =
+              cv::Vec2f(x + flow.at<cv::Vec2f>(y, x)[0], y + flow.at<cv::Vec2f>(y, x)[1]);
+      cv::Mat warped, b1, b2;
+      cv::remap(i1, warped, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+      const cv::Mat it_img = warped - i0;
+      cv::boxFilter(ix.mul(it_img), b1, CV_32F, win);
+      cv::boxFilter(iy.mul(it_img), b2, CV_32F, win);
+      for (int y = 0; y < flow.rows; ++y) {
+        for (int x = 0; x < flow.cols; ++x) {
+          const float s11 = a11.at<float>(y, x), s12 = a12.at<float>(y, x);
+          const float s22 = a22.at<float>(y, x), q1 = b1.at<float>(y, x);
+          const float q2 = b2.at<float>(y, x);
+          const float det = s11 * s22 - s12 * s12;
+          const float tr = 0.5f * (s11 + s22);
+          const float min_eig = tr - std::sqrt(std::max(0.f, tr * tr - det));
+          if (min_eig < static_cast<float>(options.min_eigen) || det <= 0.f) continue;
+          const float inv = 1.f / det;
+          flow.at<cv::Vec2f>(y, x)[0] += std::clamp((-s22 * q1 + s12 * q2) * inv, -1.f, 1.f);
+          flow.at<cv::Vec2f>(y, x)[1] += std::clamp((s12 * q1 - s11 * q2) * inv, -1.f, 1.f);
+        }
+      }
+    }
+    if (options.median) {
+      std::vector<cv::Mat> uv;
+      cv::split(flow, uv);
+      for (cv::Mat& c : uv) cv::medianBlur(c, c, 3);
+      cv::merge(uv, flow);
+    }
+    layers->insert(layers->begin(), flow.clone());
+  }
+  return flow;
+}
+
+// Equal bytes, not just equal values (a -0 for a +0 would count).
+bool SameBytes(const cv::Mat& a, const cv::Mat& b) {
+  if (a.size() != b.size() || a.type() != b.type()) return false;
+  for (int y = 0; y < a.rows; ++y) {
+    if (std::memcmp(a.ptr(y), b.ptr(y), a.cols * a.elemSize()) != 0) return false;
+  }
+  return true;
+}
+
+TEST(DenseLucasKanade, IsThePlainCompositionBitForBit) {
+  // Sizes whose levels leave vector tails; motions within and beyond the window and the border.
+  const std::vector<std::tuple<int, int, double, double>> cases = {
+      {320, 240, -12.0, 6.0}, {97, 61, 2.5, -1.25}, {320, 240, 0.3, 0.7}, {161, 123, 7.0, 3.0}};
+  int seed = 20;
+  for (const auto& [w, h, dx, dy] : cases) {
+    const cv::Mat a = Texture(w, h, ++seed);
+    const cv::Mat b = Translate(a, dx, dy);
+    std::vector<cv::Mat> plain_layers, layers;
+    const cv::Mat plain = PlainDenseLucasKanade(a, b, DenseLkOptions{}, &plain_layers);
+    EXPECT_TRUE(SameBytes(DenseLucasKanade(a, b, DenseLkOptions{}, &layers), plain))
+        << w << "x" << h;
+    ASSERT_EQ(layers.size(), plain_layers.size());
+    for (std::size_t l = 0; l < layers.size(); ++l)
+      EXPECT_TRUE(SameBytes(layers[l], plain_layers[l])) << w << "x" << h << " layer " << l;
+  }
+  // Options other than the defaults: one iteration, no median, a 7x7 window, a flat threshold.
+  DenseLkOptions other;
+  other.iterations = 1;
+  other.median = false;
+  other.window = 7;
+  other.min_eigen = 4.0;
+  const cv::Mat a = Texture(200, 150, 3);
+  const cv::Mat b = Translate(a, 3.0, -2.0);
+  std::vector<cv::Mat> plain_layers;
+  EXPECT_TRUE(
+      SameBytes(DenseLucasKanade(a, b, other), PlainDenseLucasKanade(a, b, other, &plain_layers)));
 }
 
 TEST(BuildPyramid, UsesThePapersKernelAndHalvesEachLevel) {

@@ -1,0 +1,306 @@
+// The paper's dense pyramidal Lucas-Kanade (Ohnishi & Imiya, Appendix A).
+//
+// Each level: the first image's gradients and its window-averaged structure tensor once, then per
+// warping iteration the second image warped by the current flow, the window-averaged mismatch and
+// the 2x2 systems solved for every pixel. The Sobel and box filters, the median and the expansion
+// are OpenCV's. The warp (with cv::remap's sampling), the products and the solve are loops of our
+// own on vectors of pixels, fused so that no image is made only to be read once. The flow is bit
+// for bit that of the plain composition of OpenCV calls
+// (`DenseLucasKanade.IsThePlainCompositionBitForBit`).
+#include <algorithm>
+#include <cmath>
+#include <opencv2/core/hal/intrin.hpp>
+#include <opencv2/imgproc.hpp>
+#include <utility>
+#include <vector>
+
+#include "mapless/flow/flow.h"
+
+namespace mapless::flow {
+namespace {
+
+// Levels 1.. of the paper's pyramid into `levels[1..]`, level 0 into `levels[0]`, reusing their
+// memory; stops before a level would be made from one smaller than 8 px. Returns the count made.
+int PyramidInto(const cv::Mat& grey, const std::vector<cv::Mat*>& levels, cv::Mat* smooth) {
+  grey.convertTo(*levels[0], CV_32F);
+  const cv::Mat kernel = (cv::Mat_<float>(1, 3) << 0.25f, 0.5f, 0.25f);
+  std::size_t count = 1;
+  for (; count < levels.size(); ++count) {
+    const cv::Mat& prev = *levels[count - 1];
+    if (prev.cols < 8 || prev.rows < 8) break;
+    cv::sepFilter2D(prev, *smooth, CV_32F, kernel, kernel, cv::Point(-1, -1), 0.0,
+                    cv::BORDER_REFLECT101);
+    cv::Mat& down = *levels[count];
+    down.create((prev.rows + 1) / 2, (prev.cols + 1) / 2, CV_32F);
+    for (int y = 0; y < down.rows; ++y) {
+      const float* src = smooth->ptr<float>(2 * y);
+      auto* dst = down.ptr<float>(y);
+      for (int x = 0; x < down.cols; ++x) dst[x] = src[2 * x];
+    }
+  }
+  return static_cast<int>(count);
+}
+
+// out1 = a * a, out2 = a * b, out3 = b * b, element-wise.
+void TensorProducts(const cv::Mat& a, const cv::Mat& b, cv::Mat* out1, cv::Mat* out2,
+                    cv::Mat* out3) {
+  out1->create(a.size(), CV_32F);
+  out2->create(a.size(), CV_32F);
+  out3->create(a.size(), CV_32F);
+  for (int y = 0; y < a.rows; ++y) {
+    const float* pa = a.ptr<float>(y);
+    const float* pb = b.ptr<float>(y);
+    auto* o1 = out1->ptr<float>(y);
+    auto* o2 = out2->ptr<float>(y);
+    auto* o3 = out3->ptr<float>(y);
+    for (int x = 0; x < a.cols; ++x) {
+      o1[x] = pa[x] * pa[x];
+      o2[x] = pa[x] * pb[x];
+      o3[x] = pb[x] * pb[x];
+    }
+  }
+}
+
+// Index x clamped to [0, size): cv::remap's BORDER_REPLICATE.
+inline int Clip(int x, int size) { return x >= 0 ? (x < size ? x : size - 1) : 0; }
+
+#if CV_SIMD
+// WarpedMismatch for the pixels of row y from 0 in whole vectors (returns where it stopped): the
+// same arithmetic lane by lane (v_round is cvRound, min/max are the saturation and the clip), the
+// four samples gathered with v_lut.
+int WarpedMismatchLanes(const cv::Mat& i1, int y, const float* f, const float* p, const float* gx,
+                        const float* gy, float* o1, float* o2) {
+  constexpr int kLanes = cv::v_float32::nlanes;
+  constexpr int kBits = 5;  // cv::INTER_BITS
+  const cv::v_float32 tab = cv::vx_setall_f32(1 << kBits);
+  const cv::v_float32 step = cv::vx_setall_f32(1.f / (1 << kBits));
+  const cv::v_float32 one = cv::vx_setall_f32(1.f);
+  const cv::v_float32 row = cv::vx_setall_f32(static_cast<float>(y));
+  const cv::v_int32 mask = cv::vx_setall_s32((1 << kBits) - 1);
+  const cv::v_int32 zero = cv::vx_setzero_s32();
+  const cv::v_int32 one_i = cv::vx_setall_s32(1);
+  const cv::v_int32 short_min = cv::vx_setall_s32(-32768);
+  const cv::v_int32 short_max = cv::vx_setall_s32(32767);
+  const cv::v_int32 last_x = cv::vx_setall_s32(i1.cols - 1);
+  const cv::v_int32 last_y = cv::vx_setall_s32(i1.rows - 1);
+  const cv::v_int32 stride = cv::vx_setall_s32(static_cast<int>(i1.step1()));
+  const float* base = i1.ptr<float>();
+  int lane[kLanes];
+  for (int k = 0; k < kLanes; ++k) lane[k] = k;
+  const cv::v_int32 iota = cv::vx_load(lane);
+  const int cols = i1.cols;
+  int x = 0;
+  for (; x + kLanes <= cols; x += kLanes) {
+    cv::v_float32 u, v;
+    cv::v_load_deinterleave(f + 2 * x, u, v);
+    const cv::v_float32 px = cv::v_cvt_f32(cv::vx_setall_s32(x) + iota);
+    const cv::v_int32 sx = cv::v_round((px + u) * tab);
+    const cv::v_int32 sy = cv::v_round((row + v) * tab);
+    const cv::v_int32 cx = cv::v_min(cv::v_max(sx >> kBits, short_min), short_max);
+    const cv::v_int32 cy = cv::v_min(cv::v_max(sy >> kBits, short_min), short_max);
+    const cv::v_float32 ax = cv::v_cvt_f32(sx & mask) * step;
+    const cv::v_float32 ay = cv::v_cvt_f32(sy & mask) * step;
+    const cv::v_int32 x0 = cv::v_min(cv::v_max(cx, zero), last_x);
+    const cv::v_int32 x1 = cv::v_min(cv::v_max(cx + one_i, zero), last_x);
+    const cv::v_int32 r0 = cv::v_min(cv::v_max(cy, zero), last_y) * stride;
+    const cv::v_int32 r1 = cv::v_min(cv::v_max(cy + one_i, zero), last_y) * stride;
+    const cv::v_float32 warped = cv::v_lut(base, r0 + x0) * ((one - ay) * (one - ax)) +
+                                 cv::v_lut(base, r0 + x1) * ((one - ay) * ax) +
+                                 cv::v_lut(base, r1 + x0) * (ay * (one - ax)) +
+                                 cv::v_lut(base, r1 + x1) * (ay * ax);
+    const cv::v_float32 it = warped - cv::vx_load(p + x);
+    cv::v_store(o1 + x, cv::vx_load(gx + x) * it);
+    cv::v_store(o2 + x, cv::vx_load(gy + x) * it);
+  }
+  return x;
+}
+#endif
+
+// The second image warped by the flow, minus the first, times the gradients: out1 = ix * it,
+// out2 = iy * it with it = I1((x, y) + flow) - I0(x, y), the mismatch before the window average.
+// I1 is sampled exactly as cv::remap samples a CV_32F image with a CV_32FC2 map, INTER_LINEAR and
+// BORDER_REPLICATE: the position rounded to 1/32 px (cv::INTER_TAB_SIZE), the four weights
+// products of multiples of 1/32 (exact in float), summed in remap's order. One pass instead of a
+// map, a remap and two products.
+void WarpedMismatch(const cv::Mat& flow, const cv::Mat& i1, const cv::Mat& i0, const cv::Mat& ix,
+                    const cv::Mat& iy, cv::Mat* out1, cv::Mat* out2) {
+  constexpr int kBits = 5;  // cv::INTER_BITS
+  constexpr int kTab = 1 << kBits;
+  constexpr float kStep = 1.f / kTab;
+  out1->create(i0.size(), CV_32F);
+  out2->create(i0.size(), CV_32F);
+  const int width = i1.cols, height = i1.rows;
+  for (int y = 0; y < i0.rows; ++y) {
+    const float* f = flow.ptr<float>(y);
+    const float* p = i0.ptr<float>(y);
+    const float* gx = ix.ptr<float>(y);
+    const float* gy = iy.ptr<float>(y);
+    auto* o1 = out1->ptr<float>(y);
+    auto* o2 = out2->ptr<float>(y);
+    const auto fy = static_cast<float>(y);
+    int x = 0;
+#if CV_SIMD
+    x = WarpedMismatchLanes(i1, y, f, p, gx, gy, o1, o2);
+#endif
+    for (; x < i0.cols; ++x) {
+      const int sx = cvRound((static_cast<float>(x) + f[2 * x]) * static_cast<float>(kTab));
+      const int sy = cvRound((fy + f[2 * x + 1]) * static_cast<float>(kTab));
+      const int cx = cv::saturate_cast<short>(sx >> kBits);
+      const int cy = cv::saturate_cast<short>(sy >> kBits);
+      const float ax = static_cast<float>(sx & (kTab - 1)) * kStep;
+      const float ay = static_cast<float>(sy & (kTab - 1)) * kStep;
+      const float* r0 = i1.ptr<float>(Clip(cy, height));
+      const float* r1 = i1.ptr<float>(Clip(cy + 1, height));
+      const int x0 = Clip(cx, width), x1 = Clip(cx + 1, width);
+      const float warped = r0[x0] * ((1.f - ay) * (1.f - ax)) + r0[x1] * ((1.f - ay) * ax) +
+                           r1[x0] * (ay * (1.f - ax)) + r1[x1] * (ay * ax);
+      const float it = warped - p[x];
+      o1[x] = gx[x] * it;
+      o2[x] = gy[x] * it;
+    }
+  }
+}
+
+// One pixel's 2x2 system [s11 s12; s12 s22] d = -[q1; q2], d added to (u, v) unless the window is
+// flat (the tensor's smaller eigenvalue below min_eigen, as OpenCV's LK rejects it) or singular.
+inline void SolvePixel(float s11, float s12, float s22, float q1, float q2, float min_eigen,
+                       float* u, float* v) {
+  const float det = s11 * s22 - s12 * s12;
+  const float tr = 0.5f * (s11 + s22);
+  const float min_eig = tr - std::sqrt(std::max(0.f, tr * tr - det));
+  if (min_eig < min_eigen || det <= 0.f) return;
+  const float inv = 1.f / det;
+  // One linearisation step is only valid for about a pixel: clamp it.
+  *u += std::clamp((-s22 * q1 + s12 * q2) * inv, -1.f, 1.f);
+  *v += std::clamp((s12 * q1 - s11 * q2) * inv, -1.f, 1.f);
+}
+
+#if CV_SIMD
+// SolvePixel on a vector of pixels with OpenCV's universal intrinsics (SSE2, AVX2 or NEON): the
+// same IEEE operations in the same order lane by lane, std::max and std::clamp as selects, so the
+// same bits. The scalar loop cannot vectorise: std::sqrt may set errno.
+inline void SolveLanes(const cv::v_float32& s11, const cv::v_float32& s12, const cv::v_float32& s22,
+                       const cv::v_float32& q1, const cv::v_float32& q2,
+                       const cv::v_float32& min_eigen, float* uv) {
+  const cv::v_float32 zero = cv::vx_setzero_f32();
+  const cv::v_float32 one = cv::vx_setall_f32(1.f);
+  const cv::v_float32 minus_one = cv::vx_setall_f32(-1.f);
+  const cv::v_float32 det = s11 * s22 - s12 * s12;
+  const cv::v_float32 tr = cv::vx_setall_f32(0.5f) * (s11 + s22);
+  const cv::v_float32 disc = tr * tr - det;
+  const cv::v_float32 min_eig = tr - cv::v_sqrt(cv::v_select(zero < disc, disc, zero));
+  const cv::v_float32 skip = (min_eig < min_eigen) | (det <= zero);
+  const cv::v_float32 inv = one / det;
+  cv::v_float32 du = (s12 * q2 - s22 * q1) * inv;
+  cv::v_float32 dv = (s12 * q1 - s11 * q2) * inv;
+  du = cv::v_select(du < minus_one, minus_one, cv::v_select(one < du, one, du));
+  dv = cv::v_select(dv < minus_one, minus_one, cv::v_select(one < dv, one, dv));
+  cv::v_float32 u, v;
+  cv::v_load_deinterleave(uv, u, v);
+  cv::v_store_interleave(uv, cv::v_select(skip, u, u + du), cv::v_select(skip, v, v + dv));
+}
+#endif
+
+void SolveAndAdd(const cv::Mat& a11, const cv::Mat& a12, const cv::Mat& a22, const cv::Mat& b1,
+                 const cv::Mat& b2, float min_eigen, cv::Mat* flow) {
+  for (int y = 0; y < flow->rows; ++y) {
+    const float* p11 = a11.ptr<float>(y);
+    const float* p12 = a12.ptr<float>(y);
+    const float* p22 = a22.ptr<float>(y);
+    const float* q1 = b1.ptr<float>(y);
+    const float* q2 = b2.ptr<float>(y);
+    auto* f = flow->ptr<float>(y);
+    int x = 0;
+#if CV_SIMD
+    const cv::v_float32 min_eigen_v = cv::vx_setall_f32(min_eigen);
+    for (; x + cv::v_float32::nlanes <= flow->cols; x += cv::v_float32::nlanes) {
+      SolveLanes(cv::vx_load(p11 + x), cv::vx_load(p12 + x), cv::vx_load(p22 + x),
+                 cv::vx_load(q1 + x), cv::vx_load(q2 + x), min_eigen_v, f + 2 * x);
+    }
+#endif
+    for (; x < flow->cols; ++x) {
+      SolvePixel(p11[x], p12[x], p22[x], q1[x], q2[x], min_eigen, &f[2 * x], &f[2 * x + 1]);
+    }
+  }
+}
+
+// One pyramid level's images.
+struct Level {
+  cv::Mat i0, i1;         // the two images at this level (CV_32F)
+  cv::Mat ix, iy;         // the first image's gradients
+  cv::Mat a11, a12, a22;  // the window-averaged structure tensor
+  cv::Mat b1, b2;         // the window-averaged mismatch vector
+  cv::Mat p1, p2, p3;     // products before the window average
+  cv::Mat flow, median;   // this level's flow (CV_32FC2) and its median
+};
+
+// Both pyramids into `levels`; returns how many levels were made.
+int BuildPyramids(const cv::Mat& a, const cv::Mat& b, std::vector<Level>* levels) {
+  std::vector<cv::Mat*> first, second;
+  for (Level& level : *levels) {
+    first.push_back(&level.i0);
+    second.push_back(&level.i1);
+  }
+  cv::Mat smooth;
+  const int count = PyramidInto(a, first, &smooth);
+  PyramidInto(b, second, &smooth);
+  return count;
+}
+
+// The level's flow refined by the options' warping iterations, then its median.
+void SolveLevel(const DenseLkOptions& options, Level* level) {
+  const cv::Size win(options.window, options.window);
+  cv::Sobel(level->i0, level->ix, CV_32F, 1, 0, 3, 1.0 / 8.0, 0.0, cv::BORDER_REFLECT101);
+  cv::Sobel(level->i0, level->iy, CV_32F, 0, 1, 3, 1.0 / 8.0, 0.0, cv::BORDER_REFLECT101);
+  TensorProducts(level->ix, level->iy, &level->p1, &level->p2, &level->p3);
+  cv::boxFilter(level->p1, level->a11, CV_32F, win);
+  cv::boxFilter(level->p2, level->a12, CV_32F, win);
+  cv::boxFilter(level->p3, level->a22, CV_32F, win);
+  for (int it = 0; it < options.iterations; ++it) {
+    WarpedMismatch(level->flow, level->i1, level->i0, level->ix, level->iy, &level->p1, &level->p2);
+    cv::boxFilter(level->p1, level->b1, CV_32F, win);
+    cv::boxFilter(level->p2, level->b2, CV_32F, win);
+    SolveAndAdd(level->a11, level->a12, level->a22, level->b1, level->b2,
+                static_cast<float>(options.min_eigen), &level->flow);
+  }
+  if (options.median) {
+    cv::medianBlur(level->flow, level->median, 3);
+    std::swap(level->flow, level->median);
+  }
+}
+
+}  // namespace
+
+std::vector<cv::Mat> BuildPyramid(const cv::Mat& grey, int levels) {
+  std::vector<cv::Mat> pyramid(static_cast<std::size_t>(std::max(levels, 1)));
+  std::vector<cv::Mat*> out;
+  for (cv::Mat& level : pyramid) out.push_back(&level);
+  cv::Mat smooth;
+  pyramid.resize(static_cast<std::size_t>(PyramidInto(grey, out, &smooth)));
+  return pyramid;
+}
+
+cv::Mat DenseLucasKanade(const cv::Mat& first, const cv::Mat& second, const DenseLkOptions& options,
+                         std::vector<cv::Mat>* level_flows) {
+  options.Validate();
+  const auto [a, b] = GreyPair(first, second, "DenseLucasKanade");
+  std::vector<Level> levels(static_cast<std::size_t>(options.levels));
+  const int count = BuildPyramids(a, b, &levels);
+  if (level_flows != nullptr) level_flows->clear();
+  for (int l = count - 1; l >= 0; --l) {
+    Level& level = levels[static_cast<std::size_t>(l)];
+    if (l == count - 1) {
+      level.flow = cv::Mat::zeros(level.i0.size(), CV_32FC2);
+    } else {
+      // Expand the coarser flow to this level: twice the size, twice the vectors.
+      cv::resize(levels[static_cast<std::size_t>(l) + 1].flow, level.flow, level.i0.size(), 0, 0,
+                 cv::INTER_LINEAR);
+      level.flow.convertTo(level.flow, -1, 2.0);
+    }
+    SolveLevel(options, &level);
+    if (level_flows != nullptr) level_flows->insert(level_flows->begin(), level.flow.clone());
+  }
+  return levels[0].flow;
+}
+
+}  // namespace mapless::flow
