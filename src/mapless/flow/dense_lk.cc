@@ -61,103 +61,124 @@ void TensorProducts(const cv::Mat& a, const cv::Mat& b, cv::Mat* out1, cv::Mat* 
   }
 }
 
+constexpr int kInterBits = 5;  // cv::INTER_BITS: remap rounds positions to 1/32 px
+constexpr int kInterTab = 1 << kInterBits;
+
 // Index x clamped to [0, size): cv::remap's BORDER_REPLICATE.
 inline int Clip(int x, int size) { return x >= 0 ? (x < size ? x : size - 1) : 0; }
 
+// The rows the warp reads and writes (one row of each image).
+struct WarpRow {
+  int y;
+  const float* flow;  // (u, v) interleaved
+  const float* i0;    // the first image
+  const float* ix;    // its gradients
+  const float* iy;
+  float* out1;  // ix * it
+  float* out2;  // iy * it
+};
+
+// Pixel x of the warp: I1 sampled exactly as cv::remap samples a CV_32F image with a CV_32FC2 map,
+// INTER_LINEAR and BORDER_REPLICATE: the position rounded to 1/32 px, saturated to 16 bits, the
+// four weights products of multiples of 1/32 (exact in float), summed in remap's order.
+inline void WarpPixel(const cv::Mat& i1, const WarpRow& r, int x) {
+  constexpr float kStep = 1.f / kInterTab;
+  const auto tab = static_cast<float>(kInterTab);
+  const int sx = cvRound((static_cast<float>(x) + r.flow[2 * x]) * tab);
+  const int sy = cvRound((static_cast<float>(r.y) + r.flow[2 * x + 1]) * tab);
+  const int cx = cv::saturate_cast<short>(sx >> kInterBits);
+  const int cy = cv::saturate_cast<short>(sy >> kInterBits);
+  const float ax = static_cast<float>(sx & (kInterTab - 1)) * kStep;
+  const float ay = static_cast<float>(sy & (kInterTab - 1)) * kStep;
+  const float* r0 = i1.ptr<float>(Clip(cy, i1.rows));
+  const float* r1 = i1.ptr<float>(Clip(cy + 1, i1.rows));
+  const int x0 = Clip(cx, i1.cols), x1 = Clip(cx + 1, i1.cols);
+  const float warped = r0[x0] * ((1.f - ay) * (1.f - ax)) + r0[x1] * ((1.f - ay) * ax) +
+                       r1[x0] * (ay * (1.f - ax)) + r1[x1] * (ay * ax);
+  const float it = warped - r.i0[x];
+  r.out1[x] = r.ix[x] * it;
+  r.out2[x] = r.iy[x] * it;
+}
+
 #if CV_SIMD
-// WarpedMismatch for the pixels of row y from 0 in whole vectors (returns where it stopped): the
-// same arithmetic lane by lane (v_round is cvRound, min/max are the saturation and the clip), the
-// four samples gathered with v_lut.
-int WarpedMismatchLanes(const cv::Mat& i1, int y, const float* f, const float* p, const float* gx,
-                        const float* gy, float* o1, float* o2) {
+// WarpPixel on the row's pixels in whole vectors (returns where it stopped). A vector whose four
+// taps all lie inside the image (remap's own fast path) is done lane by lane with the same
+// arithmetic: v_round is cvRound, no clipping or saturation is needed inside, the tap offsets are
+// exact in float (checked by the caller: the image has fewer than 2^24 elements), and each lane's
+// two taps in a row are one 64-bit load. Any other vector goes pixel by pixel through WarpPixel.
+int WarpLanes(const cv::Mat& i1, const WarpRow& r) {
   constexpr int kLanes = cv::v_float32::nlanes;
-  constexpr int kBits = 5;  // cv::INTER_BITS
-  const cv::v_float32 tab = cv::vx_setall_f32(1 << kBits);
-  const cv::v_float32 step = cv::vx_setall_f32(1.f / (1 << kBits));
+  const cv::v_float32 tab = cv::vx_setall_f32(kInterTab);
+  const cv::v_float32 step = cv::vx_setall_f32(1.f / kInterTab);
   const cv::v_float32 one = cv::vx_setall_f32(1.f);
-  const cv::v_float32 row = cv::vx_setall_f32(static_cast<float>(y));
-  const cv::v_int32 mask = cv::vx_setall_s32((1 << kBits) - 1);
-  const cv::v_int32 zero = cv::vx_setzero_s32();
-  const cv::v_int32 one_i = cv::vx_setall_s32(1);
-  const cv::v_int32 short_min = cv::vx_setall_s32(-32768);
-  const cv::v_int32 short_max = cv::vx_setall_s32(32767);
-  const cv::v_int32 last_x = cv::vx_setall_s32(i1.cols - 1);
+  const cv::v_float32 row = cv::vx_setall_f32(static_cast<float>(r.y));
+  const cv::v_float32 stride = cv::vx_setall_f32(static_cast<float>(i1.step1()));
+  const cv::v_int32 mask = cv::vx_setall_s32(kInterTab - 1);
+  const cv::v_int32 minus_one = cv::vx_setall_s32(-1);
+  const cv::v_int32 last_x = cv::vx_setall_s32(i1.cols - 1);  // cx < last_x: cx + 1 is inside
   const cv::v_int32 last_y = cv::vx_setall_s32(i1.rows - 1);
-  const cv::v_int32 stride = cv::vx_setall_s32(static_cast<int>(i1.step1()));
-  const float* base = i1.ptr<float>();
+  const float* top = i1.ptr<float>();
+  const float* bottom = top + i1.step1();
   int lane[kLanes];
   for (int k = 0; k < kLanes; ++k) lane[k] = k;
   const cv::v_int32 iota = cv::vx_load(lane);
-  const int cols = i1.cols;
+  int offset[kLanes];
+  float taps[2 * kLanes];
   int x = 0;
-  for (; x + kLanes <= cols; x += kLanes) {
+  for (; x + kLanes <= i1.cols; x += kLanes) {
     cv::v_float32 u, v;
-    cv::v_load_deinterleave(f + 2 * x, u, v);
-    const cv::v_float32 px = cv::v_cvt_f32(cv::vx_setall_s32(x) + iota);
-    const cv::v_int32 sx = cv::v_round((px + u) * tab);
+    cv::v_load_deinterleave(r.flow + 2 * x, u, v);
+    const cv::v_int32 sx = cv::v_round((cv::v_cvt_f32(cv::vx_setall_s32(x) + iota) + u) * tab);
     const cv::v_int32 sy = cv::v_round((row + v) * tab);
-    const cv::v_int32 cx = cv::v_min(cv::v_max(sx >> kBits, short_min), short_max);
-    const cv::v_int32 cy = cv::v_min(cv::v_max(sy >> kBits, short_min), short_max);
+    const cv::v_int32 cx = sx >> kInterBits;
+    const cv::v_int32 cy = sy >> kInterBits;
+    if (!cv::v_check_all((cx > minus_one) & (cx < last_x) & (cy > minus_one) & (cy < last_y))) {
+      for (int k = x; k < x + kLanes; ++k) WarpPixel(i1, r, k);
+      continue;
+    }
+    cv::v_store(offset, cv::v_round(cv::v_cvt_f32(cy) * stride + cv::v_cvt_f32(cx)));
+    cv::v_store(taps, cv::vx_lut_pairs(top, offset));
+    cv::v_store(taps + kLanes, cv::vx_lut_pairs(top, offset + kLanes / 2));
+    cv::v_float32 t0, t1, b0, b1;
+    cv::v_load_deinterleave(taps, t0, t1);
+    cv::v_store(taps, cv::vx_lut_pairs(bottom, offset));
+    cv::v_store(taps + kLanes, cv::vx_lut_pairs(bottom, offset + kLanes / 2));
+    cv::v_load_deinterleave(taps, b0, b1);
     const cv::v_float32 ax = cv::v_cvt_f32(sx & mask) * step;
     const cv::v_float32 ay = cv::v_cvt_f32(sy & mask) * step;
-    const cv::v_int32 x0 = cv::v_min(cv::v_max(cx, zero), last_x);
-    const cv::v_int32 x1 = cv::v_min(cv::v_max(cx + one_i, zero), last_x);
-    const cv::v_int32 r0 = cv::v_min(cv::v_max(cy, zero), last_y) * stride;
-    const cv::v_int32 r1 = cv::v_min(cv::v_max(cy + one_i, zero), last_y) * stride;
-    const cv::v_float32 warped = cv::v_lut(base, r0 + x0) * ((one - ay) * (one - ax)) +
-                                 cv::v_lut(base, r0 + x1) * ((one - ay) * ax) +
-                                 cv::v_lut(base, r1 + x0) * (ay * (one - ax)) +
-                                 cv::v_lut(base, r1 + x1) * (ay * ax);
-    const cv::v_float32 it = warped - cv::vx_load(p + x);
-    cv::v_store(o1 + x, cv::vx_load(gx + x) * it);
-    cv::v_store(o2 + x, cv::vx_load(gy + x) * it);
+    const cv::v_float32 warped = t0 * ((one - ay) * (one - ax)) + t1 * ((one - ay) * ax) +
+                                 b0 * (ay * (one - ax)) + b1 * (ay * ax);
+    const cv::v_float32 it = warped - cv::vx_load(r.i0 + x);
+    cv::v_store(r.out1 + x, cv::vx_load(r.ix + x) * it);
+    cv::v_store(r.out2 + x, cv::vx_load(r.iy + x) * it);
   }
   return x;
 }
 #endif
 
 // The second image warped by the flow, minus the first, times the gradients: out1 = ix * it,
-// out2 = iy * it with it = I1((x, y) + flow) - I0(x, y), the mismatch before the window average.
-// I1 is sampled exactly as cv::remap samples a CV_32F image with a CV_32FC2 map, INTER_LINEAR and
-// BORDER_REPLICATE: the position rounded to 1/32 px (cv::INTER_TAB_SIZE), the four weights
-// products of multiples of 1/32 (exact in float), summed in remap's order. One pass instead of a
-// map, a remap and two products.
+// out2 = iy * it with it = I1((x, y) + flow) - I0(x, y), the mismatch before the window average,
+// I1 sampled as cv::remap samples it (WarpPixel). One pass instead of a map, a remap and two
+// products.
 void WarpedMismatch(const cv::Mat& flow, const cv::Mat& i1, const cv::Mat& i0, const cv::Mat& ix,
                     const cv::Mat& iy, cv::Mat* out1, cv::Mat* out2) {
-  constexpr int kBits = 5;  // cv::INTER_BITS
-  constexpr int kTab = 1 << kBits;
-  constexpr float kStep = 1.f / kTab;
   out1->create(i0.size(), CV_32F);
   out2->create(i0.size(), CV_32F);
-  const int width = i1.cols, height = i1.rows;
+  // Tap offsets are computed in float in the vector path: exact below 2^24.
+  const bool lanes = static_cast<double>(i1.rows) * static_cast<double>(i1.step1()) < (1 << 24);
   for (int y = 0; y < i0.rows; ++y) {
-    const float* f = flow.ptr<float>(y);
-    const float* p = i0.ptr<float>(y);
-    const float* gx = ix.ptr<float>(y);
-    const float* gy = iy.ptr<float>(y);
-    auto* o1 = out1->ptr<float>(y);
-    auto* o2 = out2->ptr<float>(y);
-    const auto fy = static_cast<float>(y);
+    const WarpRow r{y,
+                    flow.ptr<float>(y),
+                    i0.ptr<float>(y),
+                    ix.ptr<float>(y),
+                    iy.ptr<float>(y),
+                    out1->ptr<float>(y),
+                    out2->ptr<float>(y)};
     int x = 0;
 #if CV_SIMD
-    x = WarpedMismatchLanes(i1, y, f, p, gx, gy, o1, o2);
+    if (lanes) x = WarpLanes(i1, r);
 #endif
-    for (; x < i0.cols; ++x) {
-      const int sx = cvRound((static_cast<float>(x) + f[2 * x]) * static_cast<float>(kTab));
-      const int sy = cvRound((fy + f[2 * x + 1]) * static_cast<float>(kTab));
-      const int cx = cv::saturate_cast<short>(sx >> kBits);
-      const int cy = cv::saturate_cast<short>(sy >> kBits);
-      const float ax = static_cast<float>(sx & (kTab - 1)) * kStep;
-      const float ay = static_cast<float>(sy & (kTab - 1)) * kStep;
-      const float* r0 = i1.ptr<float>(Clip(cy, height));
-      const float* r1 = i1.ptr<float>(Clip(cy + 1, height));
-      const int x0 = Clip(cx, width), x1 = Clip(cx + 1, width);
-      const float warped = r0[x0] * ((1.f - ay) * (1.f - ax)) + r0[x1] * ((1.f - ay) * ax) +
-                           r1[x0] * (ay * (1.f - ax)) + r1[x1] * (ay * ax);
-      const float it = warped - p[x];
-      o1[x] = gx[x] * it;
-      o2[x] = gy[x] * it;
-    }
+    for (; x < i0.cols; ++x) WarpPixel(i1, r, x);
   }
 }
 
