@@ -8,16 +8,41 @@
 // for bit that of the plain composition of OpenCV calls
 // (`DenseLucasKanade.IsThePlainCompositionBitForBit`).
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 #include <utility>
 #include <vector>
 
+#include "mapless/flow/dense_lk_kernels.h"
 #include "mapless/flow/flow.h"
 
 namespace mapless::flow {
 namespace {
+
+using dense_lk::kInterBits;
+using dense_lk::kInterTab;
+using dense_lk::SolvePixel;
+using dense_lk::SolveRow;
+using dense_lk::WarpPixel;
+using dense_lk::WarpRow;
+#if MAPLESS_DENSE_LK_AVX2
+using dense_lk::SolveLanesAvx2;
+using dense_lk::WarpLanesAvx2;
+#endif
+
+std::atomic<bool> force_baseline{false};
+
+// The AVX2 build of the vector loops on a CPU that has AVX2, unless a test asked for the baseline.
+bool Avx2() {
+#if MAPLESS_DENSE_LK_AVX2
+  static const bool has_avx2 = __builtin_cpu_supports("avx2");
+  return has_avx2 && !force_baseline.load(std::memory_order_relaxed);
+#else
+  return false;
+#endif
+}
 
 // Levels 1.. of the paper's pyramid into `levels[1..]`, level 0 into `levels[0]`, reusing their
 // memory; stops before a level would be made from one smaller than 8 px. Returns the count made.
@@ -59,45 +84,6 @@ void TensorProducts(const cv::Mat& a, const cv::Mat& b, cv::Mat* out1, cv::Mat* 
       o3[x] = pb[x] * pb[x];
     }
   }
-}
-
-constexpr int kInterBits = 5;  // cv::INTER_BITS: remap rounds positions to 1/32 px
-constexpr int kInterTab = 1 << kInterBits;
-
-// Index x clamped to [0, size): cv::remap's BORDER_REPLICATE.
-inline int Clip(int x, int size) { return x >= 0 ? (x < size ? x : size - 1) : 0; }
-
-// The rows the warp reads and writes (one row of each image).
-struct WarpRow {
-  int y;
-  const float* flow;  // (u, v) interleaved
-  const float* i0;    // the first image
-  const float* ix;    // its gradients
-  const float* iy;
-  float* out1;  // ix * it
-  float* out2;  // iy * it
-};
-
-// Pixel x of the warp: I1 sampled exactly as cv::remap samples a CV_32F image with a CV_32FC2 map,
-// INTER_LINEAR and BORDER_REPLICATE: the position rounded to 1/32 px, saturated to 16 bits, the
-// four weights products of multiples of 1/32 (exact in float), summed in remap's order.
-inline void WarpPixel(const cv::Mat& i1, const WarpRow& r, int x) {
-  constexpr float kStep = 1.f / kInterTab;
-  const auto tab = static_cast<float>(kInterTab);
-  const int sx = cvRound((static_cast<float>(x) + r.flow[2 * x]) * tab);
-  const int sy = cvRound((static_cast<float>(r.y) + r.flow[2 * x + 1]) * tab);
-  const int cx = cv::saturate_cast<short>(sx >> kInterBits);
-  const int cy = cv::saturate_cast<short>(sy >> kInterBits);
-  const float ax = static_cast<float>(sx & (kInterTab - 1)) * kStep;
-  const float ay = static_cast<float>(sy & (kInterTab - 1)) * kStep;
-  const float* r0 = i1.ptr<float>(Clip(cy, i1.rows));
-  const float* r1 = i1.ptr<float>(Clip(cy + 1, i1.rows));
-  const int x0 = Clip(cx, i1.cols), x1 = Clip(cx + 1, i1.cols);
-  const float warped = r0[x0] * ((1.f - ay) * (1.f - ax)) + r0[x1] * ((1.f - ay) * ax) +
-                       r1[x0] * (ay * (1.f - ax)) + r1[x1] * (ay * ax);
-  const float it = warped - r.i0[x];
-  r.out1[x] = r.ix[x] * it;
-  r.out2[x] = r.iy[x] * it;
 }
 
 #if CV_SIMD
@@ -175,34 +161,23 @@ void WarpedMismatch(const cv::Mat& flow, const cv::Mat& i1, const cv::Mat& i0, c
                     out1->ptr<float>(y),
                     out2->ptr<float>(y)};
     int x = 0;
+#if MAPLESS_DENSE_LK_AVX2
+    if (lanes && Avx2()) x = WarpLanesAvx2(i1, r);
+#endif
 #if CV_SIMD
-    if (lanes) x = WarpLanes(i1, r);
+    if (lanes && x == 0) x = WarpLanes(i1, r);
 #endif
     for (; x < i0.cols; ++x) WarpPixel(i1, r, x);
   }
 }
 
-// One pixel's 2x2 system [s11 s12; s12 s22] d = -[q1; q2], d added to (u, v) unless the window is
-// flat (the tensor's smaller eigenvalue below min_eigen, as OpenCV's LK rejects it) or singular.
-inline void SolvePixel(float s11, float s12, float s22, float q1, float q2, float min_eigen,
-                       float* u, float* v) {
-  const float det = s11 * s22 - s12 * s12;
-  const float tr = 0.5f * (s11 + s22);
-  const float min_eig = tr - std::sqrt(std::max(0.f, tr * tr - det));
-  if (min_eig < min_eigen || det <= 0.f) return;
-  const float inv = 1.f / det;
-  // One linearisation step is only valid for about a pixel: clamp it.
-  *u += std::clamp((-s22 * q1 + s12 * q2) * inv, -1.f, 1.f);
-  *v += std::clamp((s12 * q1 - s11 * q2) * inv, -1.f, 1.f);
-}
-
 #if CV_SIMD
-// SolvePixel on a vector of pixels with OpenCV's universal intrinsics (SSE2, AVX2 or NEON): the
+// SolvePixel on a vector of pixels with OpenCV's universal intrinsics (SSE2 or NEON): the
 // same IEEE operations in the same order lane by lane, std::max and std::clamp as selects, so the
 // same bits. The scalar loop cannot vectorise: std::sqrt may set errno.
-inline void SolveLanes(const cv::v_float32& s11, const cv::v_float32& s12, const cv::v_float32& s22,
-                       const cv::v_float32& q1, const cv::v_float32& q2,
-                       const cv::v_float32& min_eigen, float* uv) {
+inline void SolveVector(const cv::v_float32& s11, const cv::v_float32& s12,
+                        const cv::v_float32& s22, const cv::v_float32& q1, const cv::v_float32& q2,
+                        const cv::v_float32& min_eigen, float* uv) {
   const cv::v_float32 zero = cv::vx_setzero_f32();
   const cv::v_float32 one = cv::vx_setall_f32(1.f);
   const cv::v_float32 minus_one = cv::vx_setall_f32(-1.f);
@@ -222,25 +197,33 @@ inline void SolveLanes(const cv::v_float32& s11, const cv::v_float32& s12, const
 }
 #endif
 
+#if CV_SIMD
+int SolveLanes(const SolveRow& r, int cols) {
+  const cv::v_float32 min_eigen = cv::vx_setall_f32(r.min_eigen);
+  int x = 0;
+  for (; x + cv::v_float32::nlanes <= cols; x += cv::v_float32::nlanes) {
+    SolveVector(cv::vx_load(r.a11 + x), cv::vx_load(r.a12 + x), cv::vx_load(r.a22 + x),
+                cv::vx_load(r.b1 + x), cv::vx_load(r.b2 + x), min_eigen, r.flow + 2 * x);
+  }
+  return x;
+}
+#endif
+
 void SolveAndAdd(const cv::Mat& a11, const cv::Mat& a12, const cv::Mat& a22, const cv::Mat& b1,
                  const cv::Mat& b2, float min_eigen, cv::Mat* flow) {
   for (int y = 0; y < flow->rows; ++y) {
-    const float* p11 = a11.ptr<float>(y);
-    const float* p12 = a12.ptr<float>(y);
-    const float* p22 = a22.ptr<float>(y);
-    const float* q1 = b1.ptr<float>(y);
-    const float* q2 = b2.ptr<float>(y);
-    auto* f = flow->ptr<float>(y);
+    const SolveRow r{a11.ptr<float>(y), a12.ptr<float>(y),   a22.ptr<float>(y), b1.ptr<float>(y),
+                     b2.ptr<float>(y),  flow->ptr<float>(y), min_eigen};
     int x = 0;
+#if MAPLESS_DENSE_LK_AVX2
+    if (Avx2()) x = SolveLanesAvx2(r, flow->cols);
+#endif
 #if CV_SIMD
-    const cv::v_float32 min_eigen_v = cv::vx_setall_f32(min_eigen);
-    for (; x + cv::v_float32::nlanes <= flow->cols; x += cv::v_float32::nlanes) {
-      SolveLanes(cv::vx_load(p11 + x), cv::vx_load(p12 + x), cv::vx_load(p22 + x),
-                 cv::vx_load(q1 + x), cv::vx_load(q2 + x), min_eigen_v, f + 2 * x);
-    }
+    if (x == 0) x = SolveLanes(r, flow->cols);
 #endif
     for (; x < flow->cols; ++x) {
-      SolvePixel(p11[x], p12[x], p22[x], q1[x], q2[x], min_eigen, &f[2 * x], &f[2 * x + 1]);
+      SolvePixel(r.a11[x], r.a12[x], r.a22[x], r.b1[x], r.b2[x], min_eigen, &r.flow[2 * x],
+                 &r.flow[2 * x + 1]);
     }
   }
 }
@@ -300,6 +283,10 @@ std::vector<cv::Mat> BuildPyramid(const cv::Mat& grey, int levels) {
   pyramid.resize(static_cast<std::size_t>(PyramidInto(grey, out, &smooth)));
   return pyramid;
 }
+
+const char* DenseLkKernels() { return Avx2() ? "avx2" : "baseline"; }
+
+void UseBaselineDenseLkKernels(bool baseline) { force_baseline.store(baseline); }
 
 cv::Mat DenseLucasKanade(const cv::Mat& first, const cv::Mat& second, const DenseLkOptions& options,
                          std::vector<cv::Mat>* level_flows) {

@@ -57,6 +57,12 @@ std::vector<cv::Mat> BuildPyramid(const cv::Mat& grey, int levels);
 cv::Mat DenseLucasKanade(const cv::Mat& first, const cv::Mat& second, const DenseLkOptions& options,
                          std::vector<cv::Mat>* level_flows = nullptr);
 
+// Which build of the dense LK's vector loops runs: "avx2" on an x86-64 CPU with AVX2, else
+// "baseline" (SSE2 on x86-64, NEON on ARM). Both give the same flow, bit for bit.
+// UseBaselineDenseLkKernels(true) forces the baseline (tests, the bench).
+const char* DenseLkKernels();
+void UseBaselineDenseLkKernels(bool baseline);
+
 // Both images as 8-bit grey (colour converted), checked to be the same size; `who` names the
 // caller in the error.
 std::pair<cv::Mat, cv::Mat> GreyPair(const cv::Mat& first, const cv::Mat& second, const char* who);

@@ -11,7 +11,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
+#include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "mapless/core/check.h"
@@ -187,7 +189,15 @@ bool SameBytes(const cv::Mat& a, const cv::Mat& b) {
   return true;
 }
 
-TEST(DenseLucasKanade, IsThePlainCompositionBitForBit) {
+// Both builds of the vector loops (the AVX2 one where the CPU has it, and the baseline).
+class DenseLkKernelsTest : public ::testing::TestWithParam<bool> {
+ protected:
+  void SetUp() override { UseBaselineDenseLkKernels(GetParam()); }
+  void TearDown() override { UseBaselineDenseLkKernels(false); }
+};
+INSTANTIATE_TEST_SUITE_P(DenseLucasKanade, DenseLkKernelsTest, ::testing::Values(false, true));
+
+TEST_P(DenseLkKernelsTest, IsThePlainCompositionBitForBit) {
   // Sizes whose levels leave vector tails; motions within and beyond the window and the border.
   const std::vector<std::tuple<int, int, double, double>> cases = {
       {320, 240, -12.0, 6.0}, {97, 61, 2.5, -1.25}, {320, 240, 0.3, 0.7}, {161, 123, 7.0, 3.0}};
@@ -214,6 +224,25 @@ TEST(DenseLucasKanade, IsThePlainCompositionBitForBit) {
   std::vector<cv::Mat> plain_layers;
   EXPECT_TRUE(
       SameBytes(DenseLucasKanade(a, b, other), PlainDenseLucasKanade(a, b, other, &plain_layers)));
+}
+
+TEST(DenseLucasKanade, Avx2KernelsGiveTheBaselineFlow) {
+  if (std::string(DenseLkKernels()) != "avx2") GTEST_SKIP() << "this CPU has no AVX2";
+  // Large motions (taps beyond the border, pixel by pixel) and small ones (whole vectors).
+  for (const auto& [dx, dy] : {std::pair{-12.0, 6.0}, std::pair{0.4, -0.3}}) {
+    const cv::Mat a = Texture(203, 157, 11);
+    const cv::Mat b = Translate(a, dx, dy);
+    std::vector<cv::Mat> avx2_layers, baseline_layers;
+    const cv::Mat avx2 = DenseLucasKanade(a, b, DenseLkOptions{}, &avx2_layers);
+    UseBaselineDenseLkKernels(true);
+    EXPECT_STREQ(DenseLkKernels(), "baseline");
+    const cv::Mat baseline = DenseLucasKanade(a, b, DenseLkOptions{}, &baseline_layers);
+    UseBaselineDenseLkKernels(false);
+    EXPECT_TRUE(SameBytes(avx2, baseline));
+    ASSERT_EQ(avx2_layers.size(), baseline_layers.size());
+    for (std::size_t l = 0; l < avx2_layers.size(); ++l)
+      EXPECT_TRUE(SameBytes(avx2_layers[l], baseline_layers[l])) << "layer " << l;
+  }
 }
 
 TEST(BuildPyramid, UsesThePapersKernelAndHalvesEachLevel) {
