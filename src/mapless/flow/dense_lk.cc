@@ -28,6 +28,7 @@ using dense_lk::SolveRow;
 using dense_lk::WarpPixel;
 using dense_lk::WarpRow;
 #if MAPLESS_DENSE_LK_AVX2
+using dense_lk::BoxFilterAvx2;
 using dense_lk::SolveLanesAvx2;
 using dense_lk::WarpLanesAvx2;
 #endif
@@ -228,14 +229,28 @@ void SolveAndAdd(const cv::Mat& a11, const cv::Mat& a12, const cv::Mat& a22, con
   }
 }
 
+// cv::boxFilter(src, *dst, CV_32F, cv::Size(k, k)), by the AVX2 build of its arithmetic where
+// there is one (the same bits, BoxFilterAvx2).
+void WindowMean(const cv::Mat& src, int k, std::vector<double>* work, cv::Mat* dst) {
+#if MAPLESS_DENSE_LK_AVX2
+  if (Avx2() && (k == 3 || k == 5)) {
+    BoxFilterAvx2(src, k, work, dst);
+    return;
+  }
+#endif
+  static_cast<void>(work);
+  cv::boxFilter(src, *dst, CV_32F, cv::Size(k, k));
+}
+
 // One pyramid level's images.
 struct Level {
-  cv::Mat i0, i1;         // the two images at this level (CV_32F)
-  cv::Mat ix, iy;         // the first image's gradients
-  cv::Mat a11, a12, a22;  // the window-averaged structure tensor
-  cv::Mat b1, b2;         // the window-averaged mismatch vector
-  cv::Mat p1, p2, p3;     // products before the window average
-  cv::Mat flow, median;   // this level's flow (CV_32FC2) and its median
+  cv::Mat i0, i1;            // the two images at this level (CV_32F)
+  cv::Mat ix, iy;            // the first image's gradients
+  cv::Mat a11, a12, a22;     // the window-averaged structure tensor
+  cv::Mat b1, b2;            // the window-averaged mismatch vector
+  cv::Mat p1, p2, p3;        // products before the window average
+  cv::Mat flow, median;      // this level's flow (CV_32FC2) and its median
+  std::vector<double> sums;  // the box filter's
 };
 
 // Both pyramids into `levels`; returns how many levels were made.
@@ -253,17 +268,16 @@ int BuildPyramids(const cv::Mat& a, const cv::Mat& b, std::vector<Level>* levels
 
 // The level's flow refined by the options' warping iterations, then its median.
 void SolveLevel(const DenseLkOptions& options, Level* level) {
-  const cv::Size win(options.window, options.window);
   cv::Sobel(level->i0, level->ix, CV_32F, 1, 0, 3, 1.0 / 8.0, 0.0, cv::BORDER_REFLECT101);
   cv::Sobel(level->i0, level->iy, CV_32F, 0, 1, 3, 1.0 / 8.0, 0.0, cv::BORDER_REFLECT101);
   TensorProducts(level->ix, level->iy, &level->p1, &level->p2, &level->p3);
-  cv::boxFilter(level->p1, level->a11, CV_32F, win);
-  cv::boxFilter(level->p2, level->a12, CV_32F, win);
-  cv::boxFilter(level->p3, level->a22, CV_32F, win);
+  WindowMean(level->p1, options.window, &level->sums, &level->a11);
+  WindowMean(level->p2, options.window, &level->sums, &level->a12);
+  WindowMean(level->p3, options.window, &level->sums, &level->a22);
   for (int it = 0; it < options.iterations; ++it) {
     WarpedMismatch(level->flow, level->i1, level->i0, level->ix, level->iy, &level->p1, &level->p2);
-    cv::boxFilter(level->p1, level->b1, CV_32F, win);
-    cv::boxFilter(level->p2, level->b2, CV_32F, win);
+    WindowMean(level->p1, options.window, &level->sums, &level->b1);
+    WindowMean(level->p2, options.window, &level->sums, &level->b2);
     SolveAndAdd(level->a11, level->a12, level->a22, level->b1, level->b2,
                 static_cast<float>(options.min_eigen), &level->flow);
   }

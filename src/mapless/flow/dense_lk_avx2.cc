@@ -10,6 +10,10 @@
 
 #include <immintrin.h>
 
+#include <algorithm>
+#include <opencv2/core.hpp>
+#include <vector>
+
 #define MAPLESS_AVX2 __attribute__((target("avx2")))
 
 namespace mapless::flow::dense_lk {
@@ -128,6 +132,73 @@ MAPLESS_AVX2 int SolveLanesAvx2(const SolveRow& r, int cols) {
                      Select(skip, v, _mm256_add_ps(v, dv)));
   }
   return x;
+}
+
+namespace {
+
+// Row `y`'s k-wide window sums (with the border reflected) into `sums`, each added left to right in
+// double: OpenCV's RowSum for k 3 and 5.
+MAPLESS_AVX2 void RowWindowSums(const float* s, int width, int k, double* sums) {
+  const int r = k / 2;
+  const auto border_sum = [&](int x) {
+    double sum = s[cv::borderInterpolate(x - r, width, cv::BORDER_REFLECT_101)];
+    for (int j = 1; j < k; ++j)
+      sum +=
+          static_cast<double>(s[cv::borderInterpolate(x - r + j, width, cv::BORDER_REFLECT_101)]);
+    return sum;
+  };
+  int x = 0;
+  for (; x < std::min(r, width); ++x) sums[x] = border_sum(x);
+  for (; x + 4 <= width - r; x += 4) {
+    __m256d sum = _mm256_cvtps_pd(_mm_loadu_ps(s + x - r));
+    for (int j = 1; j < k; ++j)
+      sum = _mm256_add_pd(sum, _mm256_cvtps_pd(_mm_loadu_ps(s + x - r + j)));
+    _mm256_storeu_pd(sums + x, sum);
+  }
+  for (; x < width; ++x) sums[x] = border_sum(x);
+}
+
+}  // namespace
+
+MAPLESS_AVX2 void BoxFilterAvx2(const cv::Mat& src, int k, std::vector<double>* work,
+                                cv::Mat* dst) {
+  const int width = src.cols, height = src.rows, r = k / 2;
+  dst->create(src.size(), CV_32F);
+  const auto w = static_cast<std::size_t>(width);
+  work->assign(w * static_cast<std::size_t>(k + 1), 0.0);
+  double* column = work->data();  // the sliding column sums, then k rows of window sums
+  const auto ring = [&](int extended_row) {
+    return column + w * static_cast<std::size_t>(1 + extended_row % k);
+  };
+  // Extended row j is source row j - r, reflected at the borders.
+  const auto row_sums = [&](int j) {
+    const int y = cv::borderInterpolate(j - r, height, cv::BORDER_REFLECT_101);
+    RowWindowSums(src.ptr<float>(y), width, k, ring(j));
+  };
+  for (int j = 0; j < k - 1; ++j) {
+    row_sums(j);
+    const double* s = ring(j);
+    for (int x = 0; x < width; ++x) column[x] += s[x];
+  }
+  const double scale = 1. / (k * k);
+  const __m256d scale_v = _mm256_set1_pd(scale);
+  for (int y = 0; y < height; ++y) {
+    row_sums(y + k - 1);
+    const double* entering = ring(y + k - 1);
+    const double* leaving = ring(y);
+    auto* out = dst->ptr<float>(y);
+    int x = 0;
+    for (; x + 4 <= width; x += 4) {
+      const __m256d s = _mm256_add_pd(_mm256_loadu_pd(column + x), _mm256_loadu_pd(entering + x));
+      _mm_storeu_ps(out + x, _mm256_cvtpd_ps(_mm256_mul_pd(s, scale_v)));
+      _mm256_storeu_pd(column + x, _mm256_sub_pd(s, _mm256_loadu_pd(leaving + x)));
+    }
+    for (; x < width; ++x) {
+      const double s = column[x] + entering[x];
+      out[x] = static_cast<float>(s * scale);
+      column[x] = s - leaving[x];
+    }
+  }
 }
 
 }  // namespace mapless::flow::dense_lk

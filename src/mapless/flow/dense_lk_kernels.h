@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/core.hpp>
+#include <vector>
 
 #if (defined(__x86_64__) || defined(_M_X64)) && (defined(__GNUC__) || defined(__clang__))
 #define MAPLESS_DENSE_LK_AVX2 1
@@ -84,6 +85,14 @@ struct SolveRow {
 // the first pixel it left for the scalar tail. Only to be called on a CPU with AVX2.
 int WarpLanesAvx2(const cv::Mat& i1, const WarpRow& r);
 int SolveLanesAvx2(const SolveRow& r, int cols);
+
+// cv::boxFilter(src, *dst, CV_32F, cv::Size(k, k)) for a CV_32F `src` and k 3 or 5 (normalised,
+// anchored at the centre, BORDER_REFLECT_101), with the arithmetic of OpenCV 4.6's box filter for
+// floats, so with its bits: each row's window sum in double added left to right (RowSum, its k 3
+// and 5 case), the column sums slid down in double (ColumnSum<double, float>: add the entering
+// row, scale by 1/k^2, round to float, subtract the leaving row). OpenCV's column pass is a
+// scalar loop; here both passes run on four columns at a time. `work` holds the sums.
+void BoxFilterAvx2(const cv::Mat& src, int k, std::vector<double>* work, cv::Mat* dst);
 #endif
 
 }  // namespace mapless::flow::dense_lk

@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
+#include <random>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -18,6 +19,7 @@
 
 #include "mapless/core/check.h"
 #include "mapless/core/testing.h"
+#include "mapless/flow/dense_lk_kernels.h"
 #include "mapless/io/atomic_file.h"
 #include "mapless/io/flo.h"
 #include "mapless/io/image_file.h"
@@ -244,6 +246,29 @@ TEST(DenseLucasKanade, Avx2KernelsGiveTheBaselineFlow) {
       EXPECT_TRUE(SameBytes(avx2_layers[l], baseline_layers[l])) << "layer " << l;
   }
 }
+
+#if MAPLESS_DENSE_LK_AVX2
+TEST(DenseLucasKanade, Avx2BoxFilterIsOpenCvsBitForBit) {
+  if (std::string(DenseLkKernels()) != "avx2") GTEST_SKIP() << "this CPU has no AVX2";
+  // Values 30 decades apart in one window, so that the order of the double sums shows; sizes from
+  // one pixel (the border reflected onto itself) to more than a vector wide.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> mantissa(-1.f, 1.f), decade(-30.f, 30.f);
+  std::vector<double> work;
+  for (int trial = 0; trial < 200; ++trial) {
+    const int w = 1 + static_cast<int>(rng() % 70), h = 1 + static_cast<int>(rng() % 50);
+    const int k = trial % 2 == 0 ? 3 : 5;
+    cv::Mat src(h, w, CV_32F);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        src.at<float>(y, x) = mantissa(rng) * std::pow(10.f, trial % 3 == 0 ? 2.f : decade(rng));
+    cv::Mat expected, box;
+    cv::boxFilter(src, expected, CV_32F, cv::Size(k, k));
+    dense_lk::BoxFilterAvx2(src, k, &work, &box);
+    ASSERT_TRUE(SameBytes(box, expected)) << w << "x" << h << " k " << k << " trial " << trial;
+  }
+}
+#endif
 
 TEST(BuildPyramid, UsesThePapersKernelAndHalvesEachLevel) {
   cv::Mat impulse = cv::Mat::zeros(16, 16, CV_8U);
