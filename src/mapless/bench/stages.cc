@@ -215,10 +215,16 @@ nlohmann::json BenchStages(const StageOptions& options) {
       j["opencv_dis_fast_320x240_ms"].get<double>();
   // Issue 4: the paper's dense pyramidal LK (5x5, levels 0-4) against OpenCV's sparse
   // calcOpticalFlowPyrLK asked for every pixel with the same window and levels.
-  j["dense_lk_320x240_ms"] = MedianMs(options.repeats, 2, [&](int i) {
+  // Its vector loops in use (AVX2 where the CPU has it), then their baseline build: the same flow.
+  j["dense_lk_kernels"] = flow::DenseLkKernels();
+  const auto dense_lk = [&](int i) {
     const auto k = static_cast<std::size_t>(i) % pair_a.size();
     flow = flow::DenseLucasKanade(pair_a[k], pair_b[k], flow::DenseLkOptions{});
-  });
+  };
+  j["dense_lk_320x240_ms"] = MedianMs(options.repeats, 2, dense_lk);
+  flow::UseBaselineDenseLkKernels(true);
+  j["dense_lk_baseline_kernels_320x240_ms"] = MedianMs(options.repeats, 2, dense_lk);
+  flow::UseBaselineDenseLkKernels(false);
   {
     std::vector<cv::Point2f> every;
     for (int y = 0; y < pair_a[0].rows; ++y)
@@ -226,13 +232,16 @@ nlohmann::json BenchStages(const StageOptions& options) {
     std::vector<cv::Point2f> next;
     std::vector<uchar> status;
     std::vector<float> error;
-    j["opencv_pyrlk_every_pixel_320x240_ms"] = MedianMs(5, 1, [&](int i) {
+    j["opencv_pyrlk_every_pixel_320x240_ms"] = MedianMs(9, 1, [&](int i) {
       const auto k = static_cast<std::size_t>(i) % pair_a.size();
       cv::calcOpticalFlowPyrLK(pair_a[k], pair_b[k], every, next, status, error, cv::Size(5, 5), 4);
     });
   }
   j["pyrlk_every_pixel_over_dense_lk"] = j["opencv_pyrlk_every_pixel_320x240_ms"].get<double>() /
                                          j["dense_lk_320x240_ms"].get<double>();
+  j["pyrlk_every_pixel_over_dense_lk_baseline_kernels"] =
+      j["opencv_pyrlk_every_pixel_320x240_ms"].get<double>() /
+      j["dense_lk_baseline_kernels_320x240_ms"].get<double>();
   BenchTeachRepeat(&j);
   BenchPotential(options.repeats, &j);
   BenchEigenspace(options.repeats, &j);
