@@ -2,11 +2,12 @@
 //
 // Each level: the first image's gradients and its window-averaged structure tensor once, then per
 // warping iteration the second image warped by the current flow, the window-averaged mismatch and
-// the 2x2 systems solved for every pixel. The Sobel and box filters, the median and the expansion
-// are OpenCV's. The warp (with cv::remap's sampling), the products and the solve are loops of our
-// own on vectors of pixels, fused so that no image is made only to be read once. The flow is bit
-// for bit that of the plain composition of OpenCV calls
-// (`DenseLucasKanade.IsThePlainCompositionBitForBit`).
+// the 2x2 systems solved for every pixel. The Sobel filters and the expansion are OpenCV's, and so
+// are the box filters on a CPU without AVX2. The warp (with cv::remap's sampling), the products and
+// the solve are loops of our own on vectors of pixels, fused so that no image is made only to be
+// read once; on a CPU with AVX2 they and the box filters (with cv::boxFilter's arithmetic) run in
+// an AVX2 build (dense_lk_avx2.cc). The flow is bit for bit that of the plain composition of
+// OpenCV calls (`DenseLkKernelsTest.IsThePlainCompositionBitForBit`), with either build.
 #include <algorithm>
 #include <atomic>
 #include <cmath>

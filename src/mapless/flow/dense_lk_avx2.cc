@@ -1,6 +1,6 @@
-// The dense Lucas-Kanade's warp and solve in vectors of eight with AVX2 (dense_lk_kernels.h).
+// The dense Lucas-Kanade's warp, solve and box filter with AVX2 (dense_lk_kernels.h).
 //
-// Only these two functions carry the AVX2 target attribute; everything they call that is not
+// Only these functions carry the AVX2 target attribute; everything they call that is not
 // inlined stays baseline code, so no out-of-line copy the linker might share needs AVX2. AVX2 does
 // not include FMA: every multiply and add rounds on its own, as in the baseline loops, and the
 // flow is the same bit for bit (`DenseLucasKanade.Avx2KernelsGiveTheBaselineFlow`).
