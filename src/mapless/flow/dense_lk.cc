@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 #include <utility>
@@ -93,7 +94,7 @@ void TensorProducts(const cv::Mat& a, const cv::Mat& b, cv::Mat* out1, cv::Mat* 
 // taps all lie inside the image (remap's own fast path) is done lane by lane with the same
 // arithmetic: v_round is cvRound, no clipping or saturation is needed inside, the tap offsets are
 // exact in float (checked by the caller: the image has fewer than 2^24 elements), and each lane's
-// two taps in a row are one 64-bit load. Any other vector goes pixel by pixel through WarpPixel.
+// two taps in a row are one 8-byte copy. Any other vector goes pixel by pixel through WarpPixel.
 int WarpLanes(const cv::Mat& i1, const WarpRow& r) {
   constexpr int kLanes = cv::v_float32::nlanes;
   const cv::v_float32 tab = cv::vx_setall_f32(kInterTab);
@@ -125,12 +126,13 @@ int WarpLanes(const cv::Mat& i1, const WarpRow& r) {
       continue;
     }
     cv::v_store(offset, cv::v_round(cv::v_cvt_f32(cy) * stride + cv::v_cvt_f32(cx)));
-    cv::v_store(taps, cv::vx_lut_pairs(top, offset));
-    cv::v_store(taps + kLanes, cv::vx_lut_pairs(top, offset + kLanes / 2));
+    // Each lane's two taps in a row, as one 8-byte copy (cv::v_lut_pairs would read them as a
+    // misaligned int64).
     cv::v_float32 t0, t1, b0, b1;
+    for (int k = 0; k < kLanes; ++k) std::memcpy(taps + 2 * k, top + offset[k], 2 * sizeof(float));
     cv::v_load_deinterleave(taps, t0, t1);
-    cv::v_store(taps, cv::vx_lut_pairs(bottom, offset));
-    cv::v_store(taps + kLanes, cv::vx_lut_pairs(bottom, offset + kLanes / 2));
+    for (int k = 0; k < kLanes; ++k)
+      std::memcpy(taps + 2 * k, bottom + offset[k], 2 * sizeof(float));
     cv::v_load_deinterleave(taps, b0, b1);
     const cv::v_float32 ax = cv::v_cvt_f32(sx & mask) * step;
     const cv::v_float32 ay = cv::v_cvt_f32(sy & mask) * step;
