@@ -47,8 +47,9 @@ bool Avx2() {
 #endif
 }
 
-// Levels 1.. of the paper's pyramid into `levels[1..]`, level 0 into `levels[0]`, reusing their
-// memory; stops before a level would be made from one smaller than 8 px. Returns the count made.
+// The paper's pyramid of `grey` into *levels[0], *levels[1], ...: level 0 the image as float, each
+// next one smoothed and subsampled; stops before a level would be made from one smaller than
+// 8 px. Returns how many levels were made.
 int PyramidInto(const cv::Mat& grey, const std::vector<cv::Mat*>& levels, cv::Mat* smooth) {
   grey.convertTo(*levels[0], CV_32F);
   const cv::Mat kernel = (cv::Mat_<float>(1, 3) << 0.25f, 0.5f, 0.25f);
