@@ -27,6 +27,8 @@
 namespace mapless::flow {
 namespace {
 
+using mapless::testing::SameBytes;
+
 // A smooth random texture (blurred noise), so every method has gradients everywhere.
 cv::Mat Texture(int width, int height, int seed) {
   cv::Mat noise(height, width, CV_8U);
@@ -180,15 +182,6 @@ cv::Mat PlainDenseLucasKanade(const cv::Mat& first, const cv::Mat& second,
     layers->insert(layers->begin(), flow.clone());
   }
   return flow;
-}
-
-// Equal bytes, not just equal values (a -0 for a +0 would count).
-bool SameBytes(const cv::Mat& a, const cv::Mat& b) {
-  if (a.size() != b.size() || a.type() != b.type()) return false;
-  for (int y = 0; y < a.rows; ++y) {
-    if (std::memcmp(a.ptr(y), b.ptr(y), a.cols * a.elemSize()) != 0) return false;
-  }
-  return true;
 }
 
 // Both builds of the vector loops (the AVX2 one where the CPU has it, and the baseline).

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "mapless/core/testing.h"
 #include "mapless/sim/raster.h"
 #include "mapless/sim/renderer.h"
 #include "mapless/sim/scenario.h"
@@ -14,6 +15,8 @@
 
 namespace mapless::sim::raster {
 namespace {
+
+using mapless::testing::SameBytes;
 
 // Pass 1 of one view, as Renderer::Render runs it (baseline kernel).
 struct View {
@@ -64,10 +67,6 @@ cv::Mat ShadeHitImage(const View& v) {
     }
   }
   return image;
-}
-
-bool SameBytes(const cv::Mat& a, const cv::Mat& b) {
-  return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0.0;
 }
 
 bool CpuRunsAvx2() {
