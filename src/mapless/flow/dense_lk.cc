@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "mapless/core/cpu.h"
 #include "mapless/flow/dense_lk_kernels.h"
 #include "mapless/flow/flow.h"
 
@@ -39,12 +40,7 @@ std::atomic<bool> force_baseline{false};
 
 // The AVX2 build of the vector loops on a CPU that has AVX2, unless a test asked for the baseline.
 bool Avx2() {
-#if MAPLESS_DENSE_LK_AVX2
-  static const bool has_avx2 = __builtin_cpu_supports("avx2");
-  return has_avx2 && !force_baseline.load(std::memory_order_relaxed);
-#else
-  return false;
-#endif
+  return MAPLESS_DENSE_LK_AVX2 && CpuHasAvx2() && !force_baseline.load(std::memory_order_relaxed);
 }
 
 // The paper's pyramid of `grey` into *levels[0], *levels[1], ...: level 0 the image as float, each

@@ -7,6 +7,7 @@
 #include <map>
 
 #include "mapless/core/check.h"
+#include "mapless/core/cpu.h"
 #include "mapless/sim/raster.h"
 
 namespace mapless::sim {
@@ -30,8 +31,7 @@ const KernelSet& Kernels() {
 #if defined(__x86_64__) || defined(__i386__)
   static const KernelSet kAvx2{"avx2", avx2::RasterNearest, avx2::ShadeImage,
                                avx2::SupersampleEdges};
-  static const bool has_avx2 = __builtin_cpu_supports("avx2");
-  if (has_avx2 && !force_baseline_kernels.load(std::memory_order_relaxed)) return kAvx2;
+  if (CpuHasAvx2() && !force_baseline_kernels.load(std::memory_order_relaxed)) return kAvx2;
 #endif
   return kBaseline;
 }
