@@ -6,6 +6,7 @@
 #include <string>
 
 #include "mapless/core/check.h"
+#include "mapless/sim/sessions.h"
 
 namespace mapless::eval {
 namespace {
@@ -58,6 +59,30 @@ TEST(EigenspaceFollow, StopsBeforeABoxOnTheRouteAndGoesOnWhenItIsGone) {
   const EigenspaceRun blind = RunEigenspaceFollow(scenario, options);
   EXPECT_TRUE(blind.collided) << blind.status;
   EXPECT_EQ(blind.obstacle_stops, 0);
+}
+
+// The route of lifelong_indoor ends 0.6 m before a box: near it the low-resolution view changes
+// so fast with a lateral offset that the route images ahead stop matching, and the belief lagged
+// one to seven images behind. The follower then either drove on into the box (seed 1) or waited
+// before it until its time ran out (seed 3). With the belief kept from lagging further than the
+// distance driven allows near the end (AppearanceFollowerOptions::anchor_end_m) and the arrival
+// when the watch stops it there (arrive_blocked_within_images), it arrives.
+TEST(EigenspaceFollow, ArrivesAtARouteThatEndsBeforeABoxInsteadOfDrivingIntoIt) {
+  const sim::Scenario scenario = sim::SessionScenario(sim::LoadScenario("lifelong_indoor"), 2);
+  for (const std::uint64_t seed : {1, 3}) {
+    EigenspaceRunOptions options;
+    options.seed = seed;
+    const EigenspaceRun run = RunEigenspaceFollow(scenario, options);
+    EXPECT_TRUE(run.success) << "seed " << seed << ": " << run.status;
+    EXPECT_FALSE(run.collided) << "seed " << seed;
+    EXPECT_LE(run.final_error_m, 0.5) << "seed " << seed;
+  }
+  EigenspaceRunOptions without;
+  without.seed = 1;
+  without.follower.anchor_end_m = 0.0;
+  without.follower.arrive_blocked_within_images = -1;
+  const EigenspaceRun old = RunEigenspaceFollow(scenario, without);
+  EXPECT_TRUE(old.collided) << old.status;
 }
 
 // Issue 21, recovery: carts along both walls filled the leader's view from 5 m to 12 m and are

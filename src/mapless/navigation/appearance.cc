@@ -168,6 +168,11 @@ void AppearanceFollowerOptions::Validate() const {
                                             << behind_fraction << "; must be >= 0");
   MAPLESS_CHECK(ahead_fraction >= 0.0, "AppearanceFollowerOptions.ahead_fraction = "
                                            << ahead_fraction << "; must be >= 0");
+  MAPLESS_CHECK(anchor_probability > 0.0 && anchor_probability <= 1.0,
+                "AppearanceFollowerOptions.anchor_probability = " << anchor_probability
+                                                                  << "; must be in (0, 1]");
+  MAPLESS_CHECK(anchor_end_m >= 0.0, "AppearanceFollowerOptions.anchor_end_m = "
+                                         << anchor_end_m << "; must be >= 0");
   MAPLESS_CHECK(markov_update_images >= 0.0, "AppearanceFollowerOptions.markov_update_images = "
                                                  << markov_update_images << "; must be >= 0");
   MAPLESS_CHECK(lookahead_images >= 0, "AppearanceFollowerOptions.lookahead_images = "
@@ -278,6 +283,7 @@ FollowerStep AppearanceFollower::Initialize(const appearance::Vector& projection
     driven_m_ = 0.0;
   }
   since_localized_m_ = 0.0;
+  anchor_index_ = -1;  // the next confident belief anchors the lower limit again
   have_localization_ = false;
   carrying_.reset();
   carry_given_up_ = false;
@@ -316,7 +322,15 @@ FollowerStep AppearanceFollower::Update(const cv::Mat& image, const Pose2& odome
     }
     have_watch_odometry_ = true;
     watch_odometry_ = odometry;
-    if (obstacle.blocked) {
+    if (obstacle.blocked && BlockedAtTheEnd(route)) {
+      arrived_ = true;
+      step.state = FollowerState::kArrived;
+      step.index = last_localization_.index;
+      step.probability = last_localization_.probability;
+      step.reason = "arrived: stopped at route image " + std::to_string(step.index) + " of " +
+                    std::to_string(route.size()) + " before something beyond the route's end (" +
+                    obstacle.reason + ")";
+    } else if (obstacle.blocked) {
       step.state = FollowerState::kStopped;
       step.reason = obstacle.reason;
     } else {
@@ -326,6 +340,12 @@ FollowerStep AppearanceFollower::Update(const cv::Mat& image, const Pose2& odome
   }
   last_command_ = step.command;
   return step;
+}
+
+bool AppearanceFollower::BlockedAtTheEnd(const route::AppearanceRoute& route) const {
+  return options_.arrive_blocked_within_images >= 0 && route.complete && have_localization_ &&
+         follow_frames_ >= options_.min_follow_frames &&
+         last_localization_.index >= route.size() - 1 - options_.arrive_blocked_within_images;
 }
 
 // Where on the route the robot is: Payá et al.'s Markov localization over the route images (one
@@ -348,11 +368,14 @@ bool AppearanceFollower::Localize(const appearance::Vector& projection, double a
             driven_m_ * (1.0 + options_.ahead_fraction) + options_.ahead_margin_m;
         const double behind_m = driven_m_ * (1.0 - options_.behind_fraction) -
                                 options_.ahead_margin_m - options_.start_window_m;
-        markov_.set_index_limits(
-            options_.behind_fraction < 1.0
-                ? start_index_ + static_cast<int>(std::floor(behind_m / spacing))
-                : -1,
-            start_index_ + static_cast<int>(std::ceil(ahead_m / spacing)));
+        int lowest = start_index_ + static_cast<int>(std::floor(behind_m / spacing));
+        if (anchor_index_ >= 0) {
+          const double since_m = (driven_m_ - anchor_driven_m_) * (1.0 - options_.behind_fraction) -
+                                 options_.ahead_margin_m;
+          lowest = std::max(lowest, anchor_index_ + static_cast<int>(std::floor(since_m / spacing)));
+        }
+        markov_.set_index_limits(options_.behind_fraction < 1.0 ? lowest : -1,
+                                 start_index_ + static_cast<int>(std::ceil(ahead_m / spacing)));
       }
       markov_.set_uniform_mixing(since_localized_m_ < options_.uniform_mixing_for_m
                                      ? options_.markov.uniform_mixing
@@ -364,6 +387,17 @@ bool AppearanceFollower::Localize(const appearance::Vector& projection, double a
       pending_advance_images_ = 0.0;
       have_localization_ = true;
       last_route_size_ = route.size();
+      // Near the end of a complete route (AppearanceFollowerOptions::anchor_end_m).
+      const int end_images = static_cast<int>(std::ceil(options_.anchor_end_m / spacing));
+      if (options_.anchor_end_m > 0.0 && route.complete && !carrying_ &&
+          driven_m_ >= options_.start_window_m + options_.ahead_margin_m &&
+          last_localization_.index >= n - 1 - end_images &&
+          last_localization_.status == localization::LocalizationStatus::kTracking &&
+          last_localization_.probability >= options_.anchor_probability &&
+          last_localization_.index > anchor_index_) {
+        anchor_index_ = last_localization_.index;
+        anchor_driven_m_ = driven_m_;
+      }
     }
     const localization::Localization& loc = last_localization_;
     step->index =

@@ -131,9 +131,30 @@ struct AppearanceFollowerOptions {
   double ahead_margin_m = 0.3;
   double ahead_fraction = 0.05;  // the odometry may under-report the distance by this fraction
   double behind_fraction = 0.1;  // ... and the path be this much longer than the route (detours)
+  // Near the end of a complete route the lower limit also follows the belief (not in the paper):
+  // once the belief has been at route image j, within anchor_end_m of the end, with at least
+  // anchor_probability, it is kept from falling further behind j than the distance driven since
+  // then allows (the formula above, from j and without start_window_m). Near a wall or a box the
+  // low-resolution view changes so fast with a lateral offset that the images ahead stop
+  // matching; the belief then stayed on the last image that did while the robot drove on past the
+  // route's end (lifelong_indoor, docs/appearance_route_following.md). Past the end the limit
+  // reaches the last image and the follower arrives. Only near the end, and only after the robot
+  // has driven start_window_m + ahead_margin_m: a follower that starts off the route is
+  // confidently ahead of where it is until it has joined the route (Fig. 9 of the paper), and an
+  // anchor there kept the belief ahead for good (outdoor_70m off-route-right, 1 of 10 runs).
+  // 0: off.
+  double anchor_end_m = 2.0;
+  double anchor_probability = 0.8;
   int lookahead_images = 1;      // steer towards the route image this far ahead of the position
   int arrive_within_images = 1;  // arrived at the end of a complete route within this many
   int wait_within_images = 2;    // wait for a leader this close to the end it has taught so far
+  // Arrived also when the obstacle watch stops the follower this close to the end of a complete
+  // route (not in the paper): what stops it is beyond the end (the wall the route ends facing), as
+  // the repeat's watch, cut at the route's end, would not see. Near a wall the belief lags one or
+  // two images (the images ahead stop matching with a lateral offset), so it could not reach
+  // arrive_within_images there and the follower waited before the wall until its time ran out.
+  // Negative: off.
+  int arrive_blocked_within_images = 2;
   // Recovery (issue 21; not in the paper), for route images whose view has changed (something
   // that filled them is gone). When the route image ahead and its neighbours give no consistent
   // sub-window fit, the follower tries the route images up to recover_images beyond them, the
@@ -198,6 +219,9 @@ class AppearanceFollower {
   // Sub-window steering towards the first of `targets` that fits (step->target, step->steering).
   bool SteerTowards(const std::vector<int>& targets, const cv::Mat& low,
                     const route::AppearanceRoute& route, FollowerStep* step) const;
+  // The obstacle watch stopped the follower within arrive_blocked_within_images of the end of a
+  // complete route (by the last localization).
+  bool BlockedAtTheEnd(const route::AppearanceRoute& route) const;
   // Recovery: the route images beyond the lookahead target and its neighbours, by belief.
   bool Recover(int ahead, const cv::Mat& low, const route::AppearanceRoute& route,
                FollowerStep* step) const;
@@ -232,6 +256,8 @@ class AppearanceFollower {
   double since_localized_m_ = 0.0;
   double driven_m_ = 0.0;
   int start_index_ = -1;
+  int anchor_index_ = -1;         // the furthest confident belief (anchor_probability) ...
+  double anchor_driven_m_ = 0.0;  // ... and driven_m_ when it was reached
   std::optional<control::TaughtPathPursuit> carrying_;
   bool carry_given_up_ = false;  // until the next fit or localization
   // Heading of the follower minus the leader's at its route image, over the last frames of
