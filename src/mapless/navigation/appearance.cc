@@ -171,8 +171,8 @@ void AppearanceFollowerOptions::Validate() const {
   MAPLESS_CHECK(anchor_probability > 0.0 && anchor_probability <= 1.0,
                 "AppearanceFollowerOptions.anchor_probability = " << anchor_probability
                                                                   << "; must be in (0, 1]");
-  MAPLESS_CHECK(anchor_end_m >= 0.0, "AppearanceFollowerOptions.anchor_end_m = "
-                                         << anchor_end_m << "; must be >= 0");
+  MAPLESS_CHECK(anchor_end_m >= 0.0,
+                "AppearanceFollowerOptions.anchor_end_m = " << anchor_end_m << "; must be >= 0");
   MAPLESS_CHECK(markov_update_images >= 0.0, "AppearanceFollowerOptions.markov_update_images = "
                                                  << markov_update_images << "; must be >= 0");
   MAPLESS_CHECK(lookahead_images >= 0, "AppearanceFollowerOptions.lookahead_images = "
@@ -372,7 +372,8 @@ bool AppearanceFollower::Localize(const appearance::Vector& projection, double a
         if (anchor_index_ >= 0) {
           const double since_m = (driven_m_ - anchor_driven_m_) * (1.0 - options_.behind_fraction) -
                                  options_.ahead_margin_m;
-          lowest = std::max(lowest, anchor_index_ + static_cast<int>(std::floor(since_m / spacing)));
+          lowest =
+              std::max(lowest, anchor_index_ + static_cast<int>(std::floor(since_m / spacing)));
         }
         markov_.set_index_limits(options_.behind_fraction < 1.0 ? lowest : -1,
                                  start_index_ + static_cast<int>(std::ceil(ahead_m / spacing)));
