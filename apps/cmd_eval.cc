@@ -179,6 +179,11 @@ void AddEvalCommand(CLI::App* app) {
   l->add_option("--session-count", lifelong->suite.sessions, "Sessions repeated after the teach's")
       ->capture_default_str()
       ->check(CLI::Range(1, 100));
+  l->add_option("--method", lifelong->suite.method,
+                "funnel (teach and repeat, the views of keyframes) or eigenspace (the appearance "
+                "follower, views of route images)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"funnel", "eigenspace"}));
   l->callback([lifelong] { RunSuite(*lifelong, run::RunLifelongSuite); });
   auto fleet = std::make_shared<run::FleetEvalOptions>();
   auto fleet_json = std::make_shared<bool>(false);

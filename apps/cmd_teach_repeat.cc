@@ -232,13 +232,17 @@ static void AddRouteCommand(CLI::App* app) {
       route_cmd->add_subcommand("info", "Load a route (checking every file) and describe it");
   info->add_option("ROUTE", a->route, "Route directory")->required();
   info->add_flag("--json", a->json, "Print one JSON object");
-  info->add_flag("--views", a->views, "List each keyframe's learned views (repeat --learn)");
+  info->add_flag("--views", a->views,
+                 "List each keyframe's (repeat --learn) or route image's (follow --learn) learned "
+                 "views");
   info->callback([a] {
     const nlohmann::json j = run::RouteInfo(a->route, a->views);
     std::cout << (a->json ? j.dump() : run::RouteInfoLine(a->route, j)) << "\n";
   });
   CLI::App* prune = route_cmd->add_subcommand(
-      "prune", "Keep at most N views per keyframe, dropping the learned views used least recently");
+      "prune",
+      "Keep at most N views per keyframe (or route image of an appearance route), dropping the "
+      "learned views used least recently");
   CLI::App* merge = route_cmd->add_subcommand(
       "merge", "Add the views another copy of the route learned (repeat --learn elsewhere)");
   for (CLI::App* c : {prune, merge}) {

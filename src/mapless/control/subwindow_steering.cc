@@ -197,13 +197,19 @@ SubWindowSteering ComputeSubWindowSteering(const std::vector<WindowCorrespondenc
                                      std::max<double>(1.0, static_cast<double>(matches.size())) *
                                      std::exp(-best.rms / threshold),
                                  0.0, 1.0);
-  const double omega = std::clamp(options.turn_gain_radps_per_px * result.shift_px,
-                                  -options.max_turn_rate_radps, options.max_turn_rate_radps);
-  const double speed_fraction = std::max(
-      options.min_speed_fraction, 1.0 - std::abs(result.shift_px) / options.shift_for_stop_px);
-  result.twist.v_mps = options.max_speed_mps * speed_fraction;
-  result.twist.omega_radps = omega;
+  result.twist = SteeringTwist(result.shift_px, options);
   return result;
+}
+
+Twist2 SteeringTwist(double shift_px, const SubWindowSteeringOptions& options) {
+  const double omega = std::clamp(options.turn_gain_radps_per_px * shift_px,
+                                  -options.max_turn_rate_radps, options.max_turn_rate_radps);
+  const double speed_fraction =
+      std::max(options.min_speed_fraction, 1.0 - std::abs(shift_px) / options.shift_for_stop_px);
+  Twist2 twist;
+  twist.v_mps = options.max_speed_mps * speed_fraction;
+  twist.omega_radps = omega;
+  return twist;
 }
 
 }  // namespace mapless::control

@@ -63,6 +63,10 @@ struct SubWindowSteering {
   Twist2 twist;                // zero when !ok
 };
 
+// The command for a view shifted by `shift_px` (the low-resolution image's pixels): the turn
+// rate in proportion, the speed falling with the size of the correction.
+Twist2 SteeringTwist(double shift_px, const SubWindowSteeringOptions& options);
+
 // `window_count` = N', `step_px` = the horizontal scan step of the sub-windows.
 SubWindowSteering ComputeSubWindowSteering(const std::vector<WindowCorrespondence>& matches,
                                            int window_count, int step_px,

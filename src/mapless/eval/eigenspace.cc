@@ -10,6 +10,7 @@
 #include "mapless/eval/potential.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/localization/nearest.h"
+#include "mapless/navigation/appearance_experiences.h"
 #include "mapless/robot/loop.h"
 #include "mapless/robot/methods.h"
 #include "mapless/robot/sim_link.h"
@@ -152,6 +153,28 @@ double FollowTimeoutS(const sim::Scenario& scenario, const EigenspaceRunOptions&
   return options.timeout_factor * nominal;
 }
 
+TaughtAppearance TeachAppearanceOnSimulator(const sim::Scenario& scenario,
+                                            const EigenspaceRunOptions& options) {
+  TaughtAppearance taught;
+  navigation::AppearanceLeader leader(options.leader);
+  taught.stored.image_width = scenario.camera.model.width;
+  taught.stored.image_height = scenario.camera.model.height;
+  taught.stored.low_width = options.leader.image.width;
+  taught.stored.low_height = options.leader.image.height;
+  sim::DriveOptions drive;
+  drive.seed = options.seed;
+  sim::DriveTaughtPath(scenario, drive, [&](const sim::DriveFrame& frame) {
+    taught.leader_path.push_back(frame.truth);
+    if (leader.Update(frame.image, frame.odometry)) {
+      taught.image_truth.push_back(frame.truth);
+      taught.stored.images.push_back(
+          {leader.last_low().clone(), leader.distance_m(), frame.odometry, {}});
+    }
+  });
+  taught.stored.complete = true;
+  return taught;
+}
+
 EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario,
                                   const EigenspaceRunOptions& options,
                                   const EigenspaceObserver& observer) {
@@ -168,16 +191,25 @@ EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario,
   const double timeout_s = FollowTimeoutS(scenario, options);
   const std::uint64_t seed = options.seed;
 
+  MAPLESS_CHECK(options.taught == nullptr || !options.concurrent,
+                "eigenspace run: a stored route is followed after its teach, not concurrently");
   if (!options.concurrent) {
-    // Teach first (the scripted driver, clean), then follow in a world without the leader.
-    sim::DriveOptions drive;
-    drive.seed = seed;
-    sim::DriveTaughtPath(scenario, drive, [&](const sim::DriveFrame& frame) {
-      run.leader_path.push_back(frame.truth);
-      if (leader.Update(frame.image, frame.odometry)) image_truth.push_back(frame.truth);
-    });
-    leader.Finish();
-    channel.Publish(leader.Snapshot());
+    if (options.taught != nullptr) {
+      run.leader_path = options.taught->leader_path;
+      image_truth = options.taught->image_truth;
+      channel.Publish(
+          navigation::BuildStoredAppearanceRoute(options.taught->stored, options.leader));
+    } else {
+      // Teach first (the scripted driver, clean), then follow in a world without the leader.
+      sim::DriveOptions drive;
+      drive.seed = seed;
+      sim::DriveTaughtPath(scenario, drive, [&](const sim::DriveFrame& frame) {
+        run.leader_path.push_back(frame.truth);
+        if (leader.Update(frame.image, frame.odometry)) image_truth.push_back(frame.truth);
+      });
+      leader.Finish();
+      channel.Publish(leader.Snapshot());
+    }
     const std::shared_ptr<const route::AppearanceRoute> route = channel.Latest();
     run.route_images = route->size();
     const SimSetup setup = FollowSimSetup(scenario, options);
@@ -214,6 +246,8 @@ EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario,
         });
     const bool arrived = result.finished;
     run.collided = sim.collided(robot);
+    run.learned = method.follower().learned();
+    run.used_views = method.follower().used_views();
     Finalize(options, metrics, arrived ? std::string() : result.reason, arrived, &run);
     return run;
   }

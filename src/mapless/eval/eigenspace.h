@@ -13,10 +13,20 @@
 #include "mapless/eval/suite.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/navigation/appearance.h"
+#include "mapless/route/appearance_store.h"
 #include "mapless/sim/camera_faults.h"
 #include "mapless/sim/scenario.h"
 
 namespace mapless::eval {
+
+// A route taught on the simulator and stored as `teach --method eigenspace` stores it, with the
+// truth a run measures against: what a follower follows instead of a leader teaching first
+// (EigenspaceRunOptions::taught; eval lifelong --method eigenspace).
+struct TaughtAppearance {
+  route::StoredAppearanceRoute stored;  // its learned views grow with each follow that learns
+  std::vector<Pose2> leader_path;       // ground truth of the teach, every frame
+  std::vector<Pose2> image_truth;       // ground truth at each route image
+};
 
 struct EigenspaceRunOptions {
   std::uint64_t seed = 1;
@@ -37,7 +47,15 @@ struct EigenspaceRunOptions {
   std::vector<sim::CameraFaultWindow> camera_faults;  // the follower's camera (sim/camera_faults.h)
   navigation::AppearanceLeaderOptions leader;
   navigation::AppearanceFollowerOptions follower;
+  // Follow this stored route (its learned views included) instead of teaching one first; not
+  // with `concurrent`.
+  const TaughtAppearance* taught = nullptr;
 };
+
+// Teaches `scenario`'s route as RunEigenspaceFollow's leader does (the scripted driver, clean),
+// stored.
+TaughtAppearance TeachAppearanceOnSimulator(const sim::Scenario& scenario,
+                                            const EigenspaceRunOptions& options);
 
 // The follower's simulated robot of a run that follows a finished route (see eval::SimSetup), and
 // its timeout in simulated seconds: the same for RunEigenspaceFollow, `mapless follow` and
@@ -65,6 +83,10 @@ struct EigenspaceRun {
   double min_clearance_m = std::numeric_limits<double>::infinity();
   std::vector<Pose2> leader_path;    // ground truth
   std::vector<Pose2> follower_path;  // ground truth
+  // AppearanceFollowerOptions::learn: what the follow learned and the view each place was steered
+  // by (navigation::ApplyAppearanceVisit).
+  std::vector<navigation::LearnedAppearanceView> learned;
+  std::vector<int> used_views;
 };
 
 // Called for every follower frame (for logs and debugging).

@@ -83,5 +83,33 @@ TEST(Lifelong, ARouteRepeatedOnSessionsOfAChangingWorldLearnsViewsAndCompletesEa
   EXPECT_TRUE(run.all_succeeded());
 }
 
+// The appearance follower on the outdoor changing world's sessions (eval lifelong --method
+// eigenspace, shortened): each follow arrives and learns views of places that look different,
+// and the route grows by them; without learning it keeps its taught images.
+TEST(Lifelong, AFollowerOnSessionsOfAChangingWorldLearnsViewsAndArrives) {
+  const sim::Scenario scenario = sim::LoadScenario("lifelong_outdoor");
+  const TaughtAppearance taught =
+      TeachAppearanceOnSimulator(sim::SessionScenario(scenario, 0), EigenspaceRunOptions{});
+  const int images = static_cast<int>(taught.stored.images.size());
+  LifelongOptions options;
+  options.sessions = 3;
+  const LifelongRun run = RunLifelongFollow(scenario, taught, options);
+  ASSERT_EQ(run.sessions.size(), 3u);
+  int last = images;
+  for (const LifelongSession& s : run.sessions) {
+    std::printf("%s: %s, %d learned, %d images and views\n",
+                sim::DescribeSession(scenario, s.session).c_str(), s.status.c_str(), s.learned,
+                s.route_views);
+    EXPECT_TRUE(s.success) << s.status;
+    EXPECT_EQ(s.route_views, last + s.learned) << "session " << s.session;
+    last = s.route_views;
+  }
+  EXPECT_GT(run.route_views, images);
+  LifelongOptions single = options;
+  single.learn = false;
+  const LifelongRun alone = RunLifelongFollow(scenario, taught, single);
+  EXPECT_EQ(alone.route_views, images);
+}
+
 }  // namespace
 }  // namespace mapless::eval

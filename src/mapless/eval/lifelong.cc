@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "mapless/core/check.h"
+#include "mapless/navigation/appearance_experiences.h"
 #include "mapless/navigation/experiences.h"
 #include "mapless/sim/sessions.h"
 
@@ -81,6 +82,39 @@ LifelongRun RunLifelong(const sim::Scenario& scenario, const TaughtRoute& taught
     run.sessions.push_back(row);
   }
   run.route_views = CountViews(*route.route, &run.route_features);
+  return run;
+}
+
+LifelongRun RunLifelongFollow(const sim::Scenario& scenario, const TaughtAppearance& taught,
+                              const LifelongOptions& options) {
+  options.Validate();
+  LifelongRun run;
+  TaughtAppearance route = taught;
+  const auto count = [](const route::StoredAppearanceRoute& r) {
+    return static_cast<int>(r.images.size()) + r.views();
+  };
+  for (int s = 1; s <= options.sessions; ++s) {
+    const sim::Scenario session = sim::SessionScenario(scenario, s);
+    EigenspaceRunOptions o = options.follow;
+    o.seed = options.seed * 1000 + static_cast<std::uint64_t>(s);
+    o.follower.learn = options.learn;
+    o.taught = &route;
+    const EigenspaceRun follow = RunEigenspaceFollow(session, o);
+    LifelongSession row;
+    row.session = s;
+    row.success = follow.success;
+    row.status = follow.status;
+    row.lateral_rms_m = LateralRms(taught.leader_path, follow.follower_path);
+    row.learned = static_cast<int>(follow.learned.size());
+    // A route learns from a follow that arrived (`follow --learn` writes nothing otherwise).
+    if (options.learn && follow.success) {
+      navigation::ApplyAppearanceVisit(&route.stored, follow.used_views, follow.learned,
+                                       o.follower.experiences);
+    }
+    row.route_views = count(route.stored);
+    run.sessions.push_back(row);
+  }
+  run.route_views = count(route.stored);
   return run;
 }
 

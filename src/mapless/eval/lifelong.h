@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "mapless/eval/eigenspace.h"
 #include "mapless/eval/teach_repeat.h"
 #include "mapless/sim/scenario.h"
 
@@ -19,7 +20,8 @@ struct LifelongOptions {
   int sessions = 20;  // repeated on sessions 1..sessions
   bool learn = true;  // experiences on (the route learns), or the taught views alone
   std::uint64_t seed = 1;
-  RepeatRunOptions repeat;  // seed, learn and the speed are set per session
+  RepeatRunOptions repeat;      // seed, learn and the speed are set per session
+  EigenspaceRunOptions follow;  // RunLifelongFollow: seed, learn and the route are set per session
   void Validate() const;
 };
 
@@ -44,5 +46,14 @@ struct LifelongRun {
 // Repeats `taught` (taught on session 0 of `scenario`) on sessions 1..options.sessions of it.
 LifelongRun RunLifelong(const sim::Scenario& scenario, const TaughtRoute& taught,
                         const LifelongOptions& options);
+
+// The same for the appearance follower (`eval lifelong --method eigenspace`): `taught` (an
+// eigenspace route taught on session 0) followed on sessions 1..options.sessions, with
+// experiences (each arrived follow's learned views written into the route, as `follow --learn`
+// does) or with the taught images alone. A session succeeds as `eval eigenspace`'s runs do
+// (arrived within 0.6 m of the route's end, no collision); route_views counts the route's images
+// and views, route_features 0.
+LifelongRun RunLifelongFollow(const sim::Scenario& scenario, const TaughtAppearance& taught,
+                              const LifelongOptions& options);
 
 }  // namespace mapless::eval

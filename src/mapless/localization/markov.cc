@@ -150,20 +150,35 @@ Localization MarkovLocalizer::Predict(int route_images, double advance_images) {
 
 Localization MarkovLocalizer::Update(const Eigen::MatrixXf& projections,
                                      const Eigen::VectorXf& query, double advance_images) {
+  const int n = static_cast<int>(projections.cols());
+  if (n == 0) return {};
+  PredictFor(n, advance_images);
+  return Correct(n, NearestProjections(projections, query, options_.kernels));
+}
+
+Localization MarkovLocalizer::Update(const Eigen::MatrixXf& projections,
+                                     const std::vector<int>& column_place, int places,
+                                     const Eigen::VectorXf& query, double advance_images) {
+  if (places == 0 || projections.cols() == 0) return {};
+  PredictFor(places, advance_images);
+  return Correct(places, NearestPlaces(projections, column_place, places, query, options_.kernels));
+}
+
+void MarkovLocalizer::PredictFor(int n, double advance_images) {
   MAPLESS_CHECK(std::isfinite(advance_images),
                 "Markov localization: advance = " << advance_images << "; must be finite");
-  const int n = static_cast<int>(projections.cols());
-  Localization result;
-  if (n == 0) return result;
   if (belief_.size() == 0) ResetUniform(n);
   MAPLESS_CHECK(n >= belief_.size(), "Markov localization: the route shrank from "
                                          << belief_.size() << " to " << n << " images");
   Grow(n);
   Predict(advance_images);
   ApplyIndexLimits();
+}
 
+Localization MarkovLocalizer::Correct(int n, std::vector<Neighbour> neighbours) {
+  Localization result;
   // Eq. (6): p(z|x) = 1/k Σ γ_j exp(-((x - x_j)/σ)²), γ_j = d_1 / d_j in (0, 1].
-  result.neighbours = NearestProjections(projections, query, options_.kernels);
+  result.neighbours = std::move(neighbours);
   const double sigma = options_.kernel_sigma_images;
   const int reach = static_cast<int>(std::ceil(4.0 * sigma));
   const double nearest = result.neighbours.front().distance;

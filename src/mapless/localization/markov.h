@@ -62,6 +62,11 @@ class MarkovLocalizer {
   // (a leader still teaching): new images get the belief's floor.
   Localization Update(const Eigen::MatrixXf& projections, const Eigen::VectorXf& query,
                       double advance_images);
+  // The same over the places of a route whose places have several images (learned views,
+  // issue 45): the belief is over `places`, and the observation's k kernels sit on the k places
+  // whose nearest column is nearest the query (NearestPlaces; column_place[c] is column c's).
+  Localization Update(const Eigen::MatrixXf& projections, const std::vector<int>& column_place,
+                      int places, const Eigen::VectorXf& query, double advance_images);
 
   // Prediction alone (dead reckoning, not in the paper): the belief moves with the odometry and the
   // index limits, with no observation (the images are known not to fit, e.g. where something the
@@ -82,6 +87,8 @@ class MarkovLocalizer {
 
  private:
   void Grow(int route_images);
+  void PredictFor(int route_images, double advance_images);  // grow, predict, limits
+  Localization Correct(int route_images, std::vector<Neighbour> neighbours);  // Eq. 5-6
   void Predict(double advance_images);
   void ApplyIndexLimits();
   Localization Peak() const;  // index and probability at the belief's maximum

@@ -55,6 +55,37 @@ TEST(NearestProjection, FindsTheClosestColumn) {
   EXPECT_NEAR(nn[0].distance, 0.2F, 1e-5F);
 }
 
+// Places with several images (learned views, issue 45): a place is as near as its nearest image;
+// with one image per place in order it is NearestProjections, and Markov over places is the
+// plain update bit for bit.
+TEST(NearestPlaces, APlaceIsAsNearAsItsNearestImage) {
+  Eigen::MatrixXf p(1, 6);
+  p << 0.0F, 1.0F, 2.0F, 3.0F, 7.1F, 3.05F;  // columns 4 and 5: views of places 1 and 0
+  const std::vector<int> place{0, 1, 2, 3, 1, 0};
+  const auto nn = NearestPlaces(p, place, 4, LooksLike(7.0F), 2);
+  ASSERT_EQ(nn.size(), 2U);
+  EXPECT_EQ(nn[0].index, 1);
+  EXPECT_EQ(nn[0].column, 4);
+  EXPECT_NEAR(nn[0].distance, 0.1F, 1e-5F);
+  EXPECT_EQ(nn[1].index, 0);  // by its view at 3.05, ahead of place 3 (4.0 away)
+  EXPECT_EQ(nn[1].column, 5);
+  EXPECT_THROW(NearestPlaces(p, {0, 1}, 4, LooksLike(0.0F), 2), InputError);
+  EXPECT_THROW(NearestPlaces(p, {0, 1, 2, 3, 9, 0}, 4, LooksLike(0.0F), 2), InputError);
+
+  const Eigen::MatrixXf route = LinearRoute(30);
+  std::vector<int> identity(30);
+  for (int i = 0; i < 30; ++i) identity[static_cast<std::size_t>(i)] = i;
+  MarkovLocalizer plain;
+  MarkovLocalizer places;
+  for (int t = 0; t < 25; ++t) {
+    const Eigen::VectorXf q = LooksLike(static_cast<float>(t) + 0.3F * std::sin(t));
+    const Localization a = plain.Update(route, q, 1.0);
+    const Localization b = places.Update(route, identity, 30, q, 1.0);
+    EXPECT_EQ(a.index, b.index);
+    EXPECT_EQ((plain.belief() - places.belief()).cwiseAbs().maxCoeff(), 0.0);
+  }
+}
+
 TEST(MarkovLocalizer, TracksThroughVisualAliasingWhereNearestProjectionIsAmbiguous) {
   const int n = 120;
   const int period = 15;

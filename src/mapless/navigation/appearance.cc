@@ -79,7 +79,31 @@ void AppearanceLeader::AddStored(const cv::Mat& low, double distance_m, const Po
   last_stored_distance_m_ = distance_m;
 }
 
+void AppearanceLeader::AddStoredView(int place, const cv::Mat& low8, double offset_px) {
+  MAPLESS_CHECK(!finished_, "AppearanceLeader::AddStoredView after Finish()");
+  MAPLESS_CHECK(place >= 0 && place < images(),
+                "AppearanceLeader::AddStoredView: no route image " << place);
+  MAPLESS_CHECK(low8.type() == CV_8UC1 && low8.cols == options_.image.width &&
+                    low8.rows == options_.image.height,
+                "AppearanceLeader::AddStoredView: a view must be 8-bit "
+                    << options_.image.width << "x" << options_.image.height);
+  const cv::Mat low = appearance::LowResolution(low8, options_.image);
+  auto view = std::make_shared<route::AppearanceRouteView>();
+  view->place = place;
+  view->windows = appearance::BuildSubWindowEigenspace(low, options_.windows);
+  view->offset_px = offset_px;
+  if (options_.incremental) {
+    pca_.Add(appearance::ToVector(low));
+  } else {
+    vectors_.push_back(appearance::ToVector(low));
+  }
+  place_views_.resize(images_.size());
+  place_views_[static_cast<std::size_t>(place)].push_back(static_cast<int>(views_.size()));
+  views_.push_back(std::move(view));
+}
+
 void AppearanceLeader::Add(const cv::Mat& low8, double distance_m, const Pose2& odometry) {
+  MAPLESS_CHECK(views_.empty(), "AppearanceLeader: a route image after a learned view");
   const cv::Mat low = appearance::LowResolution(low8, options_.image);
   const appearance::Vector vector = appearance::ToVector(low);
   auto stored = std::make_shared<route::AppearanceRouteImage>();
@@ -109,6 +133,8 @@ std::shared_ptr<const route::AppearanceRoute> AppearanceLeader::Snapshot() const
   auto snapshot = std::make_shared<route::AppearanceRoute>();
   snapshot->space = options_.incremental ? pca_.Model() : batch_;
   snapshot->images = images_;
+  snapshot->views = views_;
+  snapshot->place_views = place_views_;
   snapshot->complete = finished_;
   return snapshot;
 }
@@ -186,6 +212,7 @@ void AppearanceFollowerOptions::Validate() const {
   MAPLESS_CHECK(recover_images >= 0, "AppearanceFollowerOptions.recover_images = "
                                          << recover_images << "; must be >= 0");
   carry_on.Validate();
+  experiences.Validate();
 }
 
 AppearanceFollowerOptions::AppearanceFollowerOptions() {
@@ -241,9 +268,11 @@ FollowerStep AppearanceFollower::Initialize(const appearance::Vector& projection
     to = std::clamp(init_centre_ < 0 ? w : init_centre_ + w, from, route.size() - 1);
   }
   init_localizations_.push_back(
-      from + localization::NearestProjection(
-                 route.space.projections.middleCols(from, to - from + 1), projection)
-                 .index);
+      route.has_views()
+          ? NearestPlaceIn(route, from, to)
+          : from + localization::NearestProjection(
+                       route.space.projections.middleCols(from, to - from + 1), projection)
+                       .index);
   step.index = init_localizations_.back();
   const double turned = WrapAngle(odometry.theta_rad - init_start_.theta_rad);
   const double theta = options_.init_turn_rad;
@@ -382,9 +411,16 @@ bool AppearanceFollower::Localize(const appearance::Vector& projection, double a
                                      ? options_.markov.uniform_mixing
                                      : 0.0);
       // Carrying on: the images are known not to fit here, so the belief moves by odometry alone.
-      last_localization_ =
-          carrying_ ? markov_.Predict(route.size(), pending_advance_images_)
-                    : markov_.Update(route.space.projections, projection, pending_advance_images_);
+      if (carrying_) {
+        last_localization_ = markov_.Predict(route.size(), pending_advance_images_);
+      } else if (route.has_views()) {
+        // Over places: a place is as near as its nearest view (appearance_experiences.h).
+        last_localization_ = markov_.Update(route.space.projections, route.ColumnPlaces(),
+                                            route.size(), projection, pending_advance_images_);
+      } else {
+        last_localization_ =
+            markov_.Update(route.space.projections, projection, pending_advance_images_);
+      }
       pending_advance_images_ = 0.0;
       have_localization_ = true;
       last_route_size_ = route.size();
@@ -417,7 +453,10 @@ bool AppearanceFollower::Localize(const appearance::Vector& projection, double a
     }
   } else {
     const std::vector<localization::Neighbour> nn =
-        localization::NearestProjections(route.space.projections, projection, 2);
+        route.has_views()
+            ? localization::NearestPlaces(route.space.projections, route.ColumnPlaces(),
+                                          route.size(), projection, 2)
+            : localization::NearestProjections(route.space.projections, projection, 2);
     step->index = nn.front().index;
     step->probability = nn.size() > 1 && nn[1].distance > 0.0F
                             ? 1.0 - static_cast<double>(nn[0].distance) / nn[1].distance
@@ -460,6 +499,7 @@ FollowerStep AppearanceFollower::Decide(const cv::Mat& image, const Pose2& odome
   }
   const cv::Mat low = appearance::LowResolution(image, options_.image);
   const appearance::Vector projection = route.space.Project(appearance::ToVector(low));
+  projection_ = projection;
   if (initializing_) return Initialize(projection, odometry, route);
 
   const int n = route.size();
@@ -482,8 +522,9 @@ FollowerStep AppearanceFollower::Decide(const cv::Mat& image, const Pose2& odome
   // consistent fit, try its neighbours (the localization is good to about one image), then the
   // route images beyond them (recovery), then carry on along the leader's odometry.
   const int ahead = std::min(step.index + options_.lookahead_images, n - 1);
-  if (SteerTowards({ahead, ahead - 1, ahead + 1}, low, route, &step) ||
-      Recover(ahead, low, route, &step)) {
+  const bool steered = SteerTowards({ahead, ahead - 1, ahead + 1}, low, route, &step);
+  const bool recovered = !steered && Recover(ahead, low, route, &step);
+  if (steered || recovered) {
     carrying_.reset();
     carry_given_up_ = false;
   } else if (const std::optional<Twist2> carry = CarryOn(odometry, route, &step)) {
@@ -506,6 +547,7 @@ FollowerStep AppearanceFollower::Decide(const cv::Mat& image, const Pose2& odome
   stopped_frames_ = 0;
   step.state = FollowerState::kFollowing;
   step.command = step.steering.twist;
+  MaybeLearn(image, low, route, recovered, &step);
   heading_offsets_.push_back(WrapAngle(
       odometry.theta_rad - route.images[static_cast<std::size_t>(step.index)]->odometry.theta_rad));
   while (static_cast<int>(heading_offsets_.size()) > options_.carry_on_heading_frames)

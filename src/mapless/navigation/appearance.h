@@ -26,6 +26,7 @@
 #include "mapless/core/pose.h"
 #include "mapless/localization/initial.h"
 #include "mapless/localization/markov.h"
+#include "mapless/navigation/appearance_experiences.h"
 #include "mapless/navigation/camera_check.h"
 #include "mapless/navigation/obstacle_watch.h"
 #include "mapless/route/appearance_route.h"
@@ -54,6 +55,9 @@ class AppearanceLeader {
   // Adds a route image read back from the route store (route/appearance_store.h): the model then
   // equals the leader's that stored it.
   void AddStored(const cv::Mat& low, double distance_m, const Pose2& odometry);
+  // Adds a learned view of route image `place` (route/appearance_store.h: a version-2 route),
+  // after every route image: its projection is column images() + views so far.
+  void AddStoredView(int place, const cv::Mat& low, double offset_px);
   // The route is complete (batch PCA is computed here when incremental is false).
   void Finish();
   // The current route as an immutable snapshot (null before any image, or before Finish() for
@@ -69,6 +73,8 @@ class AppearanceLeader {
   appearance::IncrementalPca pca_;
   std::vector<appearance::Vector> vectors_;  // batch mode only
   std::vector<std::shared_ptr<const route::AppearanceRouteImage>> images_;
+  std::vector<std::shared_ptr<const route::AppearanceRouteView>> views_;
+  std::vector<std::vector<int>> place_views_;
   appearance::Eigenspace batch_;
   bool finished_ = false;
   double distance_m_ = 0.0;
@@ -173,6 +179,11 @@ struct AppearanceFollowerOptions {
   int carry_on_heading_frames = 60;
   control::TaughtPathOptions carry_on;
   CameraCheckOptions camera;  // camera faults: stop until the images are usable again
+  // Experiences (issue 45; appearance_experiences.h): learn views of the places whose appearance
+  // has changed (learned(), used_views(): the caller writes them into the route). Off by default
+  // (`mapless follow --learn`); a route's learned views are used whenever it has them.
+  bool learn = false;
+  AppearanceExperienceOptions experiences;
   // Obstacle watch (not in the paper; obstacle_watch.h), as in the repeat: something on the way
   // ahead stops the follower (kStopped, the reason says so) until it is gone. On by default;
   // enabled = false: the paper's follower. The route has no features, so everything off the
@@ -190,6 +201,8 @@ struct FollowerStep {
   int index = -1;            // localization on the route (route image)
   double probability = 0.0;  // Markov: belief mass around it
   int target = -1;           // route image steered towards
+  int target_view = -1;      // ... by its taught image (0) or its learned view i - 1 (i >= 1)
+  std::string learned;       // why this frame was learned as a view of `index` (learn on)
   bool carrying_on = false;  // driving the leader's odometry (AppearanceFollowerOptions::carry_on)
   std::string reason;        // why the robot is stopped (kStopped, kWaitingForLeader)
   control::SubWindowSteering steering;
@@ -206,6 +219,11 @@ class AppearanceFollower {
   // t_ns: the frame's time (the obstacle watch compares frames at most max_age_s apart).
   FollowerStep Update(const cv::Mat& image, const Pose2& odometry,
                       const route::AppearanceRoute& route, Timestamp t_ns);
+  // Learning (AppearanceFollowerOptions::learn): the views learned so far, and the view each place
+  // was last steered by (0 the taught image, i + 1 learned view i, -1 none): what
+  // ApplyAppearanceVisit writes into the route.
+  const std::vector<LearnedAppearanceView>& learned() const { return learned_; }
+  const std::vector<int>& used_views() const { return used_views_; }
 
  private:
   FollowerStep Decide(const cv::Mat& image, const Pose2& odometry,
@@ -216,9 +234,18 @@ class AppearanceFollower {
                           const route::AppearanceRoute& route);
   // centre_index < 0: around the route start (or the whole route when start_window_m is 0).
   void StartInitialization(const Pose2& odometry, int centre_index);
-  // Sub-window steering towards the first of `targets` that fits (step->target, step->steering).
+  // Sub-window steering towards the first of `targets` that fits (step->target, step->steering):
+  // each by its route image, then, where none fits, by its learned view nearest projection_.
   bool SteerTowards(const std::vector<int>& targets, const cv::Mat& low,
                     const route::AppearanceRoute& route, FollowerStep* step) const;
+  // Localization over the route's places: the nearest place in [from, to] (initial
+  // localization), and the k nearest (nearest-projection mode).
+  int NearestPlaceIn(const route::AppearanceRoute& route, int from, int to) const;
+  // Learning (appearance_learn.cc): the place's column nearest projection_, and the view learned
+  // of step->index this frame, if it should be.
+  int NearestColumnOf(const route::AppearanceRoute& route, int place) const;
+  void MaybeLearn(const cv::Mat& image, const cv::Mat& low, const route::AppearanceRoute& route,
+                  bool recovered, FollowerStep* step);
   // The obstacle watch stopped the follower within arrive_blocked_within_images of the end of a
   // complete route (by the last localization).
   bool BlockedAtTheEnd(const route::AppearanceRoute& route) const;
@@ -263,6 +290,10 @@ class AppearanceFollower {
   // Heading of the follower minus the leader's at its route image, over the last frames of
   // following (carry_on_heading_frames).
   std::deque<double> heading_offsets_;
+  appearance::Vector projection_;  // the current frame's (Decide)
+  std::vector<LearnedAppearanceView> learned_;
+  mutable std::vector<int> used_views_;  // per place (SteerTowards marks them)
+  int last_learn_place_ = -1;            // places up to it have been looked at for learning
 };
 
 }  // namespace mapless::navigation

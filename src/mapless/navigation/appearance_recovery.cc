@@ -11,18 +11,42 @@ namespace mapless::navigation {
 bool AppearanceFollower::SteerTowards(const std::vector<int>& targets, const cv::Mat& low,
                                       const route::AppearanceRoute& route,
                                       FollowerStep* step) const {
-  for (const int target : targets) {
-    if (target < 0 || target >= route.size()) continue;
-    const route::AppearanceRouteImage& image_j = *route.images[static_cast<std::size_t>(target)];
+  // Each target by its route image first; where none fits, by the learned view of each that is
+  // nearest the current image (appearance_experiences.h).
+  std::vector<std::pair<int, int>> tries;  // (target, column)
+  for (const int target : targets)
+    if (target >= 0 && target < route.size()) tries.emplace_back(target, target);
+  if (route.has_views()) {
+    for (const int target : targets) {
+      if (target < 0 || target >= route.size()) continue;
+      const int column = NearestColumnOf(route, target);
+      if (column != target) tries.emplace_back(target, column);
+    }
+  }
+  for (const auto& [target, column] : tries) {
+    const appearance::SubWindowEigenspace& windows = route.WindowsOf(column);
     std::vector<control::WindowCorrespondence> matches;
     for (const appearance::SubWindowMatch& m :
-         appearance::MatchSubWindows(image_j.windows, low, options_.windows)) {
+         appearance::MatchSubWindows(windows, low, options_.windows)) {
       matches.push_back({m.query, m.stored});
     }
     step->target = target;
-    step->steering = control::ComputeSubWindowSteering(matches, image_j.windows.windows(),
+    step->steering = control::ComputeSubWindowSteering(matches, windows.windows(),
                                                        options_.windows.step_px, options_.steering);
-    if (step->steering.ok) return true;
+    if (!step->steering.ok) continue;
+    const std::vector<int> columns = route.ColumnsOf(target);
+    step->target_view =
+        static_cast<int>(std::find(columns.begin(), columns.end(), column) - columns.begin());
+    if (column >= route.size()) {
+      // A learned view: its shift chained to the taught image (appearance_experiences.h).
+      step->steering.shift_px += route.OffsetOf(column);
+      step->steering.shift_windows = step->steering.shift_px / options_.windows.step_px;
+      step->steering.twist = control::SteeringTwist(step->steering.shift_px, options_.steering);
+    }
+    if (used_views_.size() < static_cast<std::size_t>(route.size()))
+      used_views_.resize(static_cast<std::size_t>(route.size()), -1);
+    used_views_[static_cast<std::size_t>(target)] = step->target_view;
+    return true;
   }
   return false;
 }

@@ -94,6 +94,8 @@ class FollowMethod : public Method {
   bool needs_odometry() const override { return true; }
   cv::Size image_size() const override { return size_; }
   Decision Step(const Observation& observation) override;
+  // What the follower learned (AppearanceFollowerOptions::learn) and used, for the route.
+  const navigation::AppearanceFollower& follower() const { return follower_; }
 
  private:
   RouteSource route_;

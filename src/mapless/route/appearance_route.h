@@ -21,12 +21,37 @@ struct AppearanceRouteImage {
   Pose2 odometry;                           // the leader's odometry when it was taken
 };
 
+// A view of a route image's place learned on a later visit (issue 45; `follow --learn`,
+// navigation/appearance_experiences.h), with the sub-window shift that chains it to the route
+// image: steering by it adds offset_px to its shift.
+struct AppearanceRouteView {
+  int place = 0;  // the route image it is a view of
+  appearance::SubWindowEigenspace windows;
+  double offset_px = 0.0;
+};
+
 struct AppearanceRoute {
-  appearance::Eigenspace space;  // projections: one column per route image
+  // projections: one column per route image, then one per learned view (views[i] is column
+  // size() + i).
+  appearance::Eigenspace space;
   // Shared between snapshots: an image's sub-windows never change once added.
   std::vector<std::shared_ptr<const AppearanceRouteImage>> images;
-  bool complete = false;  // the leader has finished teaching
-  int size() const { return static_cast<int>(images.size()); }
+  std::vector<std::shared_ptr<const AppearanceRouteView>> views;
+  // The views of each place (indices into views), in the order they were added; empty without
+  // views.
+  std::vector<std::vector<int>> place_views;
+  bool complete = false;                                        // the leader has finished teaching
+  int size() const { return static_cast<int>(images.size()); }  // places
+  int columns() const { return size() + static_cast<int>(views.size()); }
+  bool has_views() const { return !views.empty(); }
+  // The place of projection column `column`, and the place of every column (for localization
+  // over places).
+  int PlaceOf(int column) const;
+  std::vector<int> ColumnPlaces() const;
+  // The columns of `place`: its route image's, then its views'.
+  std::vector<int> ColumnsOf(int place) const;
+  const appearance::SubWindowEigenspace& WindowsOf(int column) const;
+  double OffsetOf(int column) const;  // 0 for a route image
   // Mean distance between consecutive route images, metres (0 with fewer than 2 images).
   double SpacingM() const;
 };

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <set>
 
 #include "mapless/core/check.h"
 #include "mapless/io/atomic_file.h"
@@ -26,7 +27,59 @@ std::string ImageFile(int index) {
   return name;
 }
 
+// An image's manifest entry, with its learned views when it has any (version 2).
+nlohmann::json EntryJson(std::size_t index, const StoredAppearanceImage& e) {
+  nlohmann::json j = {{"index", index},
+                      {"distance_m", e.distance_m},
+                      {"x_m", e.odometry.x_m},
+                      {"y_m", e.odometry.y_m},
+                      {"theta_rad", e.odometry.theta_rad},
+                      {"file", ImageFile(static_cast<int>(index))}};
+  if (!e.views.empty()) {
+    nlohmann::json views = nlohmann::json::array();
+    for (const StoredAppearanceView& v : e.views) {
+      views.push_back({{"file", v.file},
+                       {"offset_px", v.offset_px},
+                       {"learned_at", v.learned_at},
+                       {"last_used", v.last_used}});
+    }
+    j["views"] = views;
+  }
+  return j;
+}
+
+nlohmann::json HeadJson(const StoredAppearanceRoute& header, bool with_views) {
+  nlohmann::json j;
+  j["format"] = "mapless-appearance-route";
+  j["version"] = with_views ? kAppearanceRouteViewsFormatVersion : kAppearanceRouteFormatVersion;
+  if (with_views) j["visits"] = header.visits;
+  j["image_width"] = header.image_width;
+  j["image_height"] = header.image_height;
+  j["low_width"] = header.low_width;
+  j["low_height"] = header.low_height;
+  j["complete"] = header.complete;
+  return j;
+}
+
+bool HasViews(const std::vector<StoredAppearanceImage>& images) {
+  for (const StoredAppearanceImage& e : images)
+    if (!e.views.empty()) return true;
+  return false;
+}
+
 }  // namespace
+
+int StoredAppearanceRoute::views() const {
+  int n = 0;
+  for (const StoredAppearanceImage& e : images) n += static_cast<int>(e.views.size());
+  return n;
+}
+
+std::string AppearanceViewFile(int index, int visit) {
+  char name[48];
+  std::snprintf(name, sizeof(name), "views/%06d-visit-%04d.png", index, visit);
+  return name;
+}
 
 AppearanceRouteWriter::AppearanceRouteWriter(std::string dir, int image_width, int image_height,
                                              int low_width, int low_height)
@@ -84,25 +137,52 @@ void AppearanceRouteWriter::Finish() {
 }
 
 void AppearanceRouteWriter::WriteManifest() const {
-  nlohmann::json j;
-  j["format"] = "mapless-appearance-route";
-  j["version"] = kAppearanceRouteFormatVersion;
-  j["image_width"] = header_.image_width;
-  j["image_height"] = header_.image_height;
-  j["low_width"] = header_.low_width;
-  j["low_height"] = header_.low_height;
-  j["complete"] = header_.complete;
-  for (std::size_t i = entry_text_.size(); i < entries_.size(); ++i) {
-    const StoredAppearanceImage& e = entries_[i];
-    entry_text_.push_back(EntryText({{"index", i},
-                                     {"distance_m", e.distance_m},
-                                     {"x_m", e.odometry.x_m},
-                                     {"y_m", e.odometry.y_m},
-                                     {"theta_rad", e.odometry.theta_rad},
-                                     {"file", ImageFile(static_cast<int>(i))}}));
-  }
+  // A reopened route keeps the views a follower learned into it (version 2).
+  for (std::size_t i = entry_text_.size(); i < entries_.size(); ++i)
+    entry_text_.push_back(EntryText(EntryJson(i, entries_[i])));
   io::WriteFileAtomic((fs::path(dir_) / kManifest).string(),
-                      ManifestText(j, "images", entry_text_));
+                      ManifestText(HeadJson(header_, HasViews(entries_)), "images", entry_text_));
+}
+
+void SaveAppearanceViews(const std::string& dir, StoredAppearanceRoute* route) {
+  MAPLESS_CHECK(route->visits >= 0, "SaveAppearanceViews: visits = " << route->visits);
+  std::vector<std::string> written;
+  std::set<std::string> listed;
+  for (std::size_t i = 0; i < route->images.size(); ++i) {
+    StoredAppearanceImage& image = route->images[i];
+    MAPLESS_CHECK(image.views.size() <= static_cast<std::size_t>(kMaxAppearanceViewsPerImage),
+                  "SaveAppearanceViews: image " << i << " has " << image.views.size() << " views");
+    for (StoredAppearanceView& v : image.views) {
+      if (v.file.empty()) {
+        MAPLESS_CHECK(v.low.type() == CV_8UC1 && v.low.cols == route->low_width &&
+                          v.low.rows == route->low_height,
+                      "SaveAppearanceViews: a view must be 8-bit " << route->low_width << "x"
+                                                                   << route->low_height);
+        v.file = AppearanceViewFile(static_cast<int>(i), v.learned_at);
+        const std::string path = (fs::path(dir) / v.file).string();
+        fs::create_directories(fs::path(path).parent_path());
+        io::WriteFileAtomic(path, io::EncodeImage(v.low, ".png", dir), false);
+        written.push_back(path);
+      }
+      listed.insert(v.file);
+    }
+  }
+  io::SyncFiles(written);
+  std::vector<std::string> entries;
+  for (std::size_t i = 0; i < route->images.size(); ++i)
+    entries.push_back(EntryText(EntryJson(i, route->images[i])));
+  io::WriteFileAtomic((fs::path(dir) / kManifest).string(),
+                      ManifestText(HeadJson(*route, true), "images", entries));
+  // Pruned views: their files, now listed nowhere.
+  const fs::path views = fs::path(dir) / "views";
+  if (!fs::is_directory(views)) return;
+  for (const auto& file : fs::directory_iterator(views)) {
+    const std::string name = "views/" + file.path().filename().string();
+    if (listed.count(name) == 0 && name.find("-visit-") != std::string::npos) {
+      std::error_code ignored;
+      fs::remove(file.path(), ignored);
+    }
+  }
 }
 
 std::string AppearanceImageFile(int index) { return ImageFile(index); }
@@ -134,6 +214,54 @@ StoredAppearanceImage ParseAppearanceEntry(const std::string& text, const std::s
   return image;
 }
 
+namespace {
+
+// An image entry's learned views: at most kMaxAppearanceViewsPerImage, each file the one its
+// image and visit name, visits within the route's, offsets within the image's reach.
+std::vector<StoredAppearanceView> ParseAppearanceViews(const nlohmann::json& list, int index,
+                                                       int visits, const std::string& where) {
+  MAPLESS_CHECK(list.is_array(), where << "views: not a list");
+  MAPLESS_CHECK(
+      list.size() <= static_cast<std::size_t>(kMaxAppearanceViewsPerImage),
+      where << "views: " << list.size() << " (at most " << kMaxAppearanceViewsPerImage << ")");
+  std::vector<StoredAppearanceView> views;
+  std::set<int> visits_seen;
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const nlohmann::json& v = list[k];
+    const std::string at = where + "views[" + std::to_string(k) + "].";
+    MAPLESS_CHECK(v.is_object(), at << ": not an object");
+    auto whole = [&](const char* key) {
+      MAPLESS_CHECK(v.contains(key) && v[key].is_number(),
+                    at << key << ": missing or not a number");
+      const double x = v[key].get<double>();
+      MAPLESS_CHECK(
+          std::isfinite(x) && x == std::floor(x) && x >= 1 && x <= visits,
+          at << key << " = " << v[key].dump() << "; must be a visit in [1, " << visits << "]");
+      return static_cast<int>(x);
+    };
+    StoredAppearanceView view;
+    view.learned_at = whole("learned_at");
+    view.last_used = whole("last_used");
+    MAPLESS_CHECK(view.last_used >= view.learned_at,
+                  at << "last_used: before the visit that learned it");
+    MAPLESS_CHECK(visits_seen.insert(view.learned_at).second,
+                  at << "learned_at: two views of one image learned at visit " << view.learned_at);
+    MAPLESS_CHECK(v.contains("offset_px") && v["offset_px"].is_number() &&
+                      std::isfinite(v["offset_px"].get<double>()) &&
+                      std::abs(v["offset_px"].get<double>()) <= io::kMaxImageSide,
+                  at << "offset_px: missing or not a number of pixels within the image");
+    view.offset_px = v["offset_px"].get<double>();
+    view.file = AppearanceViewFile(index, view.learned_at);
+    MAPLESS_CHECK(
+        v.contains("file") && v["file"].is_string() && v["file"].get<std::string>() == view.file,
+        at << "file: must be " << view.file);
+    views.push_back(std::move(view));
+  }
+  return views;
+}
+
+}  // namespace
+
 StoredAppearanceRoute ParseAppearanceManifest(const std::string& text, const std::string& name,
                                               std::vector<std::string>* files) {
   const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
@@ -155,10 +283,14 @@ StoredAppearanceRoute ParseAppearanceManifest(const std::string& text, const std
   };
   MAPLESS_CHECK(j.contains("format") && j["format"] == "mapless-appearance-route",
                 name << ": format: not a mapless appearance route");
-  MAPLESS_CHECK(integer("version", 0, 1000) == kAppearanceRouteFormatVersion,
-                name << ": version " << j["version"].dump() << " (this mapless reads version "
-                     << kAppearanceRouteFormatVersion << ")");
+  const int version = integer("version", 0, 1000);
+  MAPLESS_CHECK(
+      version == kAppearanceRouteFormatVersion || version == kAppearanceRouteViewsFormatVersion,
+      name << ": version " << j["version"].dump() << " (this mapless reads versions "
+           << kAppearanceRouteFormatVersion << " and " << kAppearanceRouteViewsFormatVersion
+           << ")");
   StoredAppearanceRoute route;
+  if (version == kAppearanceRouteViewsFormatVersion) route.visits = integer("visits", 0, 1'000'000);
   route.image_width = integer("image_width", 16, io::kMaxImageSide);
   route.image_height = integer("image_height", 16, io::kMaxImageSide);
   route.low_width = integer("low_width", 8, 1024);
@@ -189,6 +321,12 @@ StoredAppearanceRoute ParseAppearanceManifest(const std::string& text, const std
                       e["file"].get<std::string>() == ImageFile(static_cast<int>(i)),
                   name << ": " << where << "file: must be " << ImageFile(static_cast<int>(i)));
     if (files) files->push_back(e["file"].get<std::string>());
+    if (e.contains("views")) {
+      MAPLESS_CHECK(version == kAppearanceRouteViewsFormatVersion,
+                    name << ": " << where << "views: only a version 2 route has views");
+      image.views =
+          ParseAppearanceViews(e["views"], static_cast<int>(i), route.visits, name + ": " + where);
+    }
     route.images.push_back(image);
   }
   return route;
@@ -209,6 +347,14 @@ StoredAppearanceRoute LoadAppearanceRoute(const std::string& dir) {
                   path << ": " << low.cols << "x" << low.rows << ", the route's images are "
                        << route.low_width << "x" << route.low_height);
     route.images[i].low = low;
+    for (StoredAppearanceView& view : route.images[i].views) {
+      const std::string view_path = (fs::path(dir) / view.file).string();
+      view.low = io::ReadImage(view_path, cv::IMREAD_GRAYSCALE);
+      MAPLESS_CHECK(view.low.cols == route.low_width && view.low.rows == route.low_height,
+                    view_path << ": " << view.low.cols << "x" << view.low.rows
+                              << ", the route's images are " << route.low_width << "x"
+                              << route.low_height);
+    }
   }
   return route;
 }

@@ -101,8 +101,10 @@ TEST(RouteStore, TheManifestIsWhatTheWholeDocumentDumpsTo) {
     EXPECT_EQ(text, nlohmann::json::parse(text).dump(1) + "\n") << when;
   };
   const auto image = [](int i) {
-    return StoredAppearanceImage{cv::Mat(64, 64, CV_8UC1, cv::Scalar(3 * i)), 0.25 * i,
-                                 Pose2{0.25 * i, 0.01 * i, 0.003 * i}};
+    return StoredAppearanceImage{cv::Mat(64, 64, CV_8UC1, cv::Scalar(3 * i)),
+                                 0.25 * i,
+                                 Pose2{0.25 * i, 0.01 * i, 0.003 * i},
+                                 {}};
   };
   {
     AppearanceRouteWriter images(adir, 320, 240, 64, 64);

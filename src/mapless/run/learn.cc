@@ -31,8 +31,33 @@ std::string SaveVisit(const std::string& dir, const route::Route& route,
          std::to_string(views) + " learned views in all";
 }
 
+std::string SaveAppearanceVisit(const std::string& dir, const route::StoredAppearanceRoute& route,
+                                const std::vector<int>& used_views,
+                                std::vector<navigation::LearnedAppearanceView> learned,
+                                const navigation::AppearanceExperienceOptions& options) {
+  std::string places;
+  for (const auto& l : learned) places += (places.empty() ? "" : ", ") + std::to_string(l.place);
+  route::StoredAppearanceRoute updated = route;
+  const int added =
+      navigation::ApplyAppearanceVisit(&updated, used_views, std::move(learned), options);
+  route::SaveAppearanceViews(dir, &updated);
+  return dir + ": visit " + std::to_string(updated.visits) + ", " + std::to_string(added) +
+         " view" + (added == 1 ? "" : "s") + " learned" +
+         (places.empty() ? "" : " (route images " + places + ")") + ", " +
+         std::to_string(updated.views()) + " learned views in all";
+}
+
 std::string PruneRouteViews(const std::string& dir, int max_views) {
   const io::DirectoryLock lock(dir);
+  if (std::filesystem::exists(std::filesystem::path(dir) / "appearance.json") &&
+      !std::filesystem::exists(std::filesystem::path(dir) / "manifest.json")) {
+    // An appearance route (follow --learn): its route images' learned views.
+    route::StoredAppearanceRoute stored = route::LoadAppearanceRoute(dir);
+    const int removed = navigation::PruneAppearanceViews(&stored, max_views);
+    if (removed > 0) route::SaveAppearanceViews(dir, &stored);
+    return dir + ": " + std::to_string(removed) + " learned view" + (removed == 1 ? "" : "s") +
+           " pruned, " + std::to_string(stored.views()) + " left";
+  }
   route::Route route = route::LoadRoute(dir);
   const int removed = navigation::PruneViews(&route, max_views);
   if (removed > 0) route::SaveViews(dir, &route);
@@ -45,6 +70,10 @@ std::string PruneRouteViews(const std::string& dir, int max_views) {
 std::string MergeRouteViews(const std::string& dir, const std::string& other, int max_views) {
   MAPLESS_CHECK(!std::filesystem::exists(other) || !std::filesystem::equivalent(dir, other),
                 "route merge: " << other << " is the route itself");
+  MAPLESS_CHECK(!std::filesystem::exists(std::filesystem::path(dir) / "appearance.json"),
+                "route merge: " << dir
+                                << " is an appearance route; merging its learned views is not "
+                                   "supported (route info --views and route prune are)");
   const io::DirectoryLock lock(dir);
   const io::DirectoryLock other_lock(other);  // not while a repeat learns into it
   route::Route route = route::LoadRoute(dir);

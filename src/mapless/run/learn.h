@@ -4,7 +4,9 @@
 #include <string>
 #include <vector>
 
+#include "mapless/navigation/appearance_experiences.h"
 #include "mapless/navigation/experiences.h"
+#include "mapless/route/appearance_store.h"
 #include "mapless/route/route.h"
 
 namespace mapless::fleet {
@@ -21,6 +23,15 @@ std::string SaveVisit(const std::string& dir, const route::Route& route,
                       const std::vector<int>& used_views,
                       std::vector<navigation::LearnedView> learned,
                       const navigation::ExperienceOptions& options);
+
+// `mapless follow --learn` (issue 45): applies the follow's visit (navigation::
+// ApplyAppearanceVisit) to a copy of the stored appearance route and writes its views into `dir`
+// (route::SaveAppearanceViews; the caller holds the lock). Returns one line for the log: "route:
+// visit 3, 2 views learned (route images 4, 5), 7 learned views in all".
+std::string SaveAppearanceVisit(const std::string& dir, const route::StoredAppearanceRoute& route,
+                                const std::vector<int>& used_views,
+                                std::vector<navigation::LearnedAppearanceView> learned,
+                                const navigation::AppearanceExperienceOptions& options);
 
 // `mapless route prune ROUTE --max-views N`: locks the route directory, keeps at most N views per
 // keyframe (navigation::PruneViews) and writes what changed (route::SaveViews: the manifest, then

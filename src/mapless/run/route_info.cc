@@ -25,15 +25,16 @@ nlohmann::json ViewsOf(const route::Route& route) {
   return all;
 }
 
-std::string ViewLines(const nlohmann::json& views) {
+std::string ViewLines(const nlohmann::json& views, const char* what) {
   std::string out;
   for (std::size_t k = 0; k < views.size(); ++k) {
     if (views[k].empty()) continue;
-    out += Format("\n  keyframe %zu: taught view + %zu learned:", k, views[k].size());
+    out += Format("\n  %s %zu: taught view + %zu learned:", what, k, views[k].size());
     for (const auto& v : views[k]) {
-      out += Format(" visit %d (used at %d, %+.1f px, %zu features)", v["learned_at"].get<int>(),
-                    v["last_used"].get<int>(), v["offset_px"].get<double>(),
-                    v["features"].get<std::size_t>());
+      out += Format(" visit %d (used at %d, %+.1f px", v["learned_at"].get<int>(),
+                    v["last_used"].get<int>(), v["offset_px"].get<double>());
+      out += v.contains("features") ? Format(", %zu features)", v["features"].get<std::size_t>())
+                                    : std::string(")");
     }
   }
   return out;
@@ -54,7 +55,22 @@ nlohmann::json RouteInfo(const std::string& dir, bool list_views) {
          {"image_height", a.image_height},
          {"low_width", a.low_width},
          {"low_height", a.low_height},
-         {"length_m", a.images.empty() ? 0.0 : a.images.back().distance_m}};
+         {"length_m", a.images.empty() ? 0.0 : a.images.back().distance_m},
+         {"visits", a.visits},
+         {"learned_views", a.views()}};
+    if (list_views) {
+      nlohmann::json all = nlohmann::json::array();
+      for (const auto& image : a.images) {
+        nlohmann::json views = nlohmann::json::array();
+        for (const auto& v : image.views) {
+          views.push_back({{"learned_at", v.learned_at},
+                           {"last_used", v.last_used},
+                           {"offset_px", v.offset_px}});
+        }
+        all.push_back(views);
+      }
+      j["views"] = all;
+    }
     return j;
   }
   const route::Route route = route::LoadRoute(dir);
@@ -84,10 +100,15 @@ nlohmann::json RouteInfo(const std::string& dir, bool list_views) {
 std::string RouteInfoLine(const std::string& dir, const nlohmann::json& j) {
   const char* state = j["complete"].get<bool>() ? "complete" : "INTERRUPTED teach";
   if (j["kind"] == "appearance") {
-    return Format("%s: appearance route of %zu images (%s), %dx%d camera, %dx%d stored, %.1f m",
+    const int visits = j["visits"].get<int>();
+    const std::string learned = visits == 0 ? ""
+                                            : Format(", %d learned views over %d follows",
+                                                     j["learned_views"].get<int>(), visits);
+    return Format("%s: appearance route of %zu images (%s), %dx%d camera, %dx%d stored, %.1f m%s",
                   dir.c_str(), j["images"].get<std::size_t>(), state, j["image_width"].get<int>(),
                   j["image_height"].get<int>(), j["low_width"].get<int>(),
-                  j["low_height"].get<int>(), j["length_m"].get<double>());
+                  j["low_height"].get<int>(), j["length_m"].get<double>(), learned.c_str()) +
+           (j.contains("views") ? ViewLines(j["views"], "route image") : "");
   }
   const int visits = j["visits"].get<int>();
   const std::string learned = visits == 0 ? ""
@@ -97,7 +118,7 @@ std::string RouteInfoLine(const std::string& dir, const nlohmann::json& j) {
                 j["keyframes"].get<std::size_t>(), state, j["detector"].get<std::string>().c_str(),
                 j["image_width"].get<int>(), j["image_height"].get<int>(),
                 j["duration_s"].get<double>(), learned.c_str()) +
-         (j.contains("views") ? ViewLines(j["views"]) : "");
+         (j.contains("views") ? ViewLines(j["views"], "keyframe") : "");
 }
 
 }  // namespace mapless::run

@@ -384,14 +384,22 @@ SuiteOutput RunLifelongSuite(const SuiteOptions& options) {
     scenarios.push_back(sim::LoadScenario(name));
     (void)sim::SessionScenario(scenarios.back(), 0);  // refuses a scenario without sessions
   }
+  MAPLESS_CHECK(options.method == "funnel" || options.method == "eigenspace",
+                "--method " << options.method << ": funnel or eigenspace");
+  const bool follow = options.method == "eigenspace";
   // Each scenario taught on session 0 (clean, once), then every run in both modes.
   std::vector<eval::TaughtRoute> taught(scenarios.size());
+  std::vector<eval::TaughtAppearance> taught_images(scenarios.size());
   SuiteOptions quiet = options;
   quiet.on_start = nullptr;
   quiet.on_entry_done = nullptr;
   RunInBatches(scenarios.size(), quiet, [&](std::size_t k) {
-    taught[k] =
-        eval::TeachOnSimulator(sim::SessionScenario(scenarios[k], 0), navigation::TeachOptions{});
+    const sim::Scenario first = sim::SessionScenario(scenarios[k], 0);
+    if (follow) {
+      taught_images[k] = eval::TeachAppearanceOnSimulator(first, eval::EigenspaceRunOptions{});
+    } else {
+      taught[k] = eval::TeachOnSimulator(first, navigation::TeachOptions{});
+    }
     return std::string();
   });
   const std::size_t per_mode = static_cast<std::size_t>(options.runs);
@@ -404,7 +412,8 @@ SuiteOutput RunLifelongSuite(const SuiteOptions& options) {
     o.sessions = sessions;
     o.learn = learn;
     o.seed = options.seed + k % per_mode;
-    results[k] = eval::RunLifelong(scenarios[sc], taught[sc], o);
+    results[k] = follow ? eval::RunLifelongFollow(scenarios[sc], taught_images[sc], o)
+                        : eval::RunLifelong(scenarios[sc], taught[sc], o);
     int ok = 0;
     for (const auto& s : results[k].sessions) ok += s.success ? 1 : 0;
     return Format("%s %s run %zu: %d/%d sessions", names[sc].c_str(),
@@ -413,6 +422,7 @@ SuiteOutput RunLifelongSuite(const SuiteOptions& options) {
   SuiteOutput out;
   out.json = SuiteJson("lifelong", options.runs, options.seed);
   out.json["sessions"] = sessions;
+  out.json["method"] = options.method;
   out.table = Format("%-18s %-11s %8s  successes per session 1..%d, ratio, views, features\n",
                      "scenario", "mode", "all", sessions);
   for (std::size_t sc = 0; sc < scenarios.size(); ++sc) {

@@ -16,11 +16,12 @@ namespace mapless::run {
 
 struct SuiteOptions {
   int runs = 10;
-  std::uint64_t seed = 1;  // run i uses seed + i
-  int jobs = 1;            // entries evaluated in parallel (the results do not depend on it)
-  std::string only;        // only this scenario of the suite
-  std::string report_dir;  // "" : no report
-  int sessions = 20;       // eval lifelong: sessions repeated after the teach's
+  std::uint64_t seed = 1;         // run i uses seed + i
+  int jobs = 1;                   // entries evaluated in parallel (the results do not depend on it)
+  std::string only;               // only this scenario of the suite
+  std::string report_dir;         // "" : no report
+  int sessions = 20;              // eval lifelong: sessions repeated after the teach's
+  std::string method = "funnel";  // eval lifelong: funnel (repeat) or eigenspace (follow)
   // Called once with the number of entries, then once per entry done (from any thread).
   std::function<void(int total)> on_start;
   std::function<void(const std::string& line)> on_entry_done;
@@ -48,7 +49,8 @@ SuiteOutput RunExperiencesEval(const std::string& sessions_dir,
 // repeated on sessions 1..`options.sessions` in order, `options.runs` times, with experiences and
 // with the taught views alone: {"suite": "lifelong", "sessions", "results": [{"scenario", "learn",
 // "runs", "successes", "route_views", "route_features", "lateral_rms_ratio_max", "per_session":
-// [...]}]}.
+// [...]}]}. With options.method "eigenspace", the appearance follower on the same worlds
+// (eval::RunLifelongFollow; "method": "eigenspace", route_features 0).
 SuiteOutput RunLifelongSuite(const SuiteOptions& options);
 
 }  // namespace mapless::run

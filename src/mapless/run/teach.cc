@@ -102,7 +102,7 @@ void Teacher::Frame(const cv::Mat& image, Timestamp t_ns, const std::optional<Po
     return;
   }
   if (leader_.Update(image, *odometry)) {
-    sink_.Image({leader_.last_low(), leader_.distance_m(), *odometry});
+    sink_.Image({leader_.last_low(), leader_.distance_m(), *odometry, {}});
     ++stored_;
   }
 }
