@@ -351,7 +351,10 @@ probe "follow --connect with a key but no leader key" 2 "--curve-key and --curve
 probe "lead --take-views 1" 2 "--take-views 1" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/l5" --bind tcp://127.0.0.1:1 --take-views 1
 probe "lead --take-views on an eigenspace route" 2 "--take-views 5" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/l6" --bind tcp://127.0.0.1:1 --method eigenspace --take-views 5
 probe "lead --take-views 65" 2 "--take-views" -- "$MAPLESS" lead --source sim:table1_almost_straight --route "$NEW/l7" --bind tcp://127.0.0.1:1 --take-views 65
-probe "follow --learn without --connect" 2 "--learn requires --connect" -- "$MAPLESS" follow --route "$FX/aroute" --source sim:table1_almost_straight --learn
+# follow --learn writes views into a complete appearance route only.
+cp -r "$FX/aroute" "$FX/aroute_cut_teach" && sed -i 's/"complete": true/"complete": false/' "$FX/aroute_cut_teach/appearance.json"
+probe "follow --learn on an interrupted teach" 2 "is an interrupted teach; views are learned into complete routes" -- "$MAPLESS" follow --route "$FX/aroute_cut_teach" --source sim:table1_almost_straight --learn
+probe "follow --learn on a funnel route" 2 "no appearance route here" -- "$MAPLESS" follow --route "$FX/route" --source sim:table1_almost_straight --learn
 # Sessions of a changing world (sim:NAME@S): a world without sessions, a session out of range.
 probe "a session of a world that does not change" 2 "has no sessions: block" -- "$MAPLESS" teach --source sim:table1_almost_straight@3 --out "$NEW/t5"
 probe "session 99999" 2 "session 99999" -- "$MAPLESS" teach --source sim:lifelong_indoor@99999 --out "$NEW/t6"
