@@ -159,6 +159,9 @@ void AddEvalCommand(CLI::App* app) {
   CLI::App* e = eval->add_subcommand(
       "eigenspace", "Payá et al., Section 5: the appearance route follower on its two routes");
   AddSuiteOptions(e, eigenspace.get());
+  e->add_flag("--learn", eigenspace->suite.learn,
+              "Each entry's runs follow one route in turn, each learning views into it for the "
+              "next (follow --learn; not the concurrent entry)");
   e->callback([eigenspace] { RunSuite(*eigenspace, run::RunEigenspaceSuite); });
   auto sessions = std::make_shared<std::pair<std::string, bool>>();
   auto views = std::make_shared<eval::ExperiencesEvalOptions>();

@@ -340,7 +340,7 @@ EigenspaceRunOptions EigenspaceEntryOptions(const EigenspaceEntry& entry, std::u
 }
 
 EigenspaceEntryResult RunEigenspaceEntry(const EigenspaceEntry& entry, int runs, std::uint64_t seed,
-                                         const EigenspaceObserver& first_run) {
+                                         const EigenspaceObserver& first_run, bool learn) {
   MAPLESS_CHECK(runs >= 1, "eigenspace suite: runs = " << runs << "; must be >= 1");
   const sim::Scenario scenario = sim::LoadScenario(entry.scenario);
   EigenspaceEntryResult result;
@@ -351,10 +351,26 @@ EigenspaceEntryResult RunEigenspaceEntry(const EigenspaceEntry& entry, int runs,
   double final_sq = 0.0;
   double lateral_sq = 0.0;
   std::vector<double> finals;
+  // learn: one route for all runs (taught as the first run's leader teaches it), each run
+  // learning into it for the next (not while the leader teaches).
+  const EigenspaceRunOptions first = EigenspaceEntryOptions(entry, seed);
+  const bool one_route = learn && !first.concurrent;
+  TaughtAppearance taught;
+  if (one_route) taught = TeachAppearanceOnSimulator(scenario, first);
   for (int r = 0; r < runs; ++r) {
-    const EigenspaceRun run = RunEigenspaceFollow(
-        scenario, EigenspaceEntryOptions(entry, seed + static_cast<std::uint64_t>(r)),
-        r == 0 ? first_run : EigenspaceObserver{});
+    EigenspaceRunOptions options =
+        EigenspaceEntryOptions(entry, seed + static_cast<std::uint64_t>(r));
+    if (one_route) {
+      options.taught = &taught;
+      options.follower.learn = true;
+    }
+    const EigenspaceRun run =
+        RunEigenspaceFollow(scenario, options, r == 0 ? first_run : EigenspaceObserver{});
+    if (one_route && run.success) {
+      result.learned += static_cast<int>(run.learned.size());
+      ApplyAppearanceVisit(&taught.stored, run.used_views, run.learned,
+                           options.follower.experiences);
+    }
     if (result.reference_path.empty()) result.reference_path = run.leader_path;
     result.paths.push_back(run.follower_path);
     result.successes += run.success;

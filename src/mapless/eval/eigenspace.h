@@ -113,10 +113,15 @@ struct EigenspaceEntryResult : EntryResult {
   double nearest_within_one = 0.0;       // mean over runs, nearest projection alone
   double lateral_rms_m_max = 0.0;        // worst run
   int stops = 0;                         // total stop frames over runs
+  int learned = 0;                       // learn: views learned over the runs
 };
 
-// `first_run` (if set) observes every follower frame of the first run (for reports).
+// `first_run` (if set) observes every follower frame of the first run (for reports). `learn`
+// (`eval eigenspace --learn`, issue 45): the runs follow one route, taught as the first run's
+// leader teaches it, in turn, each arrived run's learned views written into it for the next (the
+// concurrent entry teaches each run's route as without it).
 EigenspaceEntryResult RunEigenspaceEntry(const EigenspaceEntry& entry, int runs, std::uint64_t seed,
-                                         const EigenspaceObserver& first_run = {});
+                                         const EigenspaceObserver& first_run = {},
+                                         bool learn = false);
 
 }  // namespace mapless::eval

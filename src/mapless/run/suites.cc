@@ -168,12 +168,13 @@ SuiteOutput RunEigenspaceSuite(const SuiteOptions& options) {
           1.0 / sim::LoadScenario(entries[k].scenario).camera.rate_hz);
       observer = traces[k]->Observer();
     }
-    results[k] = eval::RunEigenspaceEntry(entries[k], runs, seed, observer);
+    results[k] = eval::RunEigenspaceEntry(entries[k], runs, seed, observer, options.learn);
     return entries[k].scenario + " " + entries[k].experiment + ": " +
            std::to_string(results[k].successes) + "/" + std::to_string(results[k].runs) +
            " successes";
   });
   nlohmann::json j = SuiteJson("eigenspace", runs, seed);
+  j["learn"] = options.learn;
   std::string table;
   Appendf(&table, "%-19s %-16s %7s %4s %6s %7s %6s %6s %5s %6s %6s\n", "scenario", "experiment",
           "success", "coll", "final", "lateral", "loc1", "nn1", "stops", "at obj", "clear");
@@ -184,6 +185,7 @@ SuiteOutput RunEigenspaceSuite(const SuiteOptions& options) {
     e["localization_within_one"] = r.localization_within_one;
     e["nearest_within_one"] = r.nearest_within_one;
     e["stop_frames"] = r.stops;
+    if (options.learn) e["learned"] = r.learned;
     j["results"].push_back(e);
     const std::string clearance =
         std::isfinite(r.min_clearance_m) ? Fixed(r.min_clearance_m, 2) : "-";
@@ -198,6 +200,12 @@ SuiteOutput RunEigenspaceSuite(const SuiteOptions& options) {
       "to the\nleader's path (m); loc1, nn1: frames localized within one route image (Markov, "
       "nearest projection);\nstops: runs the obstacle watch stopped; at obj: ... while an added "
       "object stood there; clear:\nthe closest the robot came to it (m).\n";
+  if (options.learn) {
+    table +=
+        "--learn: each entry's runs followed one route in turn, learning into it; views learned:";
+    for (const auto& r : results) table += " " + std::to_string(r.learned);
+    table += "\n";
+  }
   if (!report_dir.empty()) {
     std::vector<const eval::EntryResult*> entries_out;
     std::vector<std::string> experiments;

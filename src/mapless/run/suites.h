@@ -22,6 +22,7 @@ struct SuiteOptions {
   std::string report_dir;         // "" : no report
   int sessions = 20;              // eval lifelong: sessions repeated after the teach's
   std::string method = "funnel";  // eval lifelong: funnel (repeat) or eigenspace (follow)
+  bool learn = false;  // eval eigenspace: the runs follow one route in turn, each learning into it
   // Called once with the number of entries, then once per entry done (from any thread).
   std::function<void(int total)> on_start;
   std::function<void(const std::string& line)> on_entry_done;
