@@ -7,6 +7,22 @@
 #include "mapless/core/check.h"
 
 namespace mapless::localization {
+namespace {
+
+// The k nearest of `all` (squared distances), nearest first, ties broken by the lower index; the
+// distances made Euclidean.
+void KeepNearest(std::vector<Neighbour>* all, int k) {
+  const auto nearer = [](const Neighbour& a, const Neighbour& b) {
+    return a.distance != b.distance ? a.distance < b.distance : a.index < b.index;
+  };
+  const std::size_t keep = std::min(all->size(), static_cast<std::size_t>(k));
+  std::partial_sort(all->begin(), all->begin() + static_cast<std::ptrdiff_t>(keep), all->end(),
+                    nearer);
+  all->resize(keep);
+  for (Neighbour& neighbour : *all) neighbour.distance = std::sqrt(neighbour.distance);
+}
+
+}  // namespace
 
 std::vector<Neighbour> NearestProjections(const Eigen::MatrixXf& projections,
                                           const Eigen::VectorXf& query, int k) {
@@ -18,14 +34,7 @@ std::vector<Neighbour> NearestProjections(const Eigen::MatrixXf& projections,
   std::vector<Neighbour> all(static_cast<std::size_t>(n));
   const Eigen::VectorXf squared = (projections.colwise() - query).colwise().squaredNorm();
   for (int i = 0; i < n; ++i) all[static_cast<std::size_t>(i)] = {i, squared(i), i};
-  const auto nearer = [](const Neighbour& a, const Neighbour& b) {
-    return a.distance != b.distance ? a.distance < b.distance : a.index < b.index;
-  };
-  const std::size_t keep = std::min(all.size(), static_cast<std::size_t>(k));
-  std::partial_sort(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(keep), all.end(),
-                    nearer);
-  all.resize(keep);
-  for (Neighbour& neighbour : all) neighbour.distance = std::sqrt(neighbour.distance);
+  KeepNearest(&all, k);
   return all;
 }
 
@@ -51,14 +60,7 @@ std::vector<Neighbour> NearestPlaces(const Eigen::MatrixXf& projections,
   }
   all.erase(std::remove_if(all.begin(), all.end(), [](const Neighbour& n) { return n.column < 0; }),
             all.end());
-  const auto nearer = [](const Neighbour& a, const Neighbour& b) {
-    return a.distance != b.distance ? a.distance < b.distance : a.index < b.index;
-  };
-  const std::size_t keep = std::min(all.size(), static_cast<std::size_t>(k));
-  std::partial_sort(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(keep), all.end(),
-                    nearer);
-  all.resize(keep);
-  for (Neighbour& neighbour : all) neighbour.distance = std::sqrt(neighbour.distance);
+  KeepNearest(&all, k);
   return all;
 }
 

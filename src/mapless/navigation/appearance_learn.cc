@@ -23,12 +23,10 @@ int AppearanceFollower::NearestPlaceIn(const route::AppearanceRoute& route, int 
   int best = from;
   float best_distance = std::numeric_limits<float>::infinity();
   for (int place = from; place <= to; ++place) {
-    for (const int column : route.ColumnsOf(place)) {
-      const float d = Distance(route, column, projection_);
-      if (d < best_distance) {
-        best_distance = d;
-        best = place;
-      }
+    const float d = Distance(route, NearestColumnOf(route, place), projection_);
+    if (d < best_distance) {
+      best_distance = d;
+      best = place;
     }
   }
   return best;
