@@ -33,6 +33,7 @@ struct Client {
   int requests_in_window = 0;
   std::set<std::string> told;  // the kinds of bad input already logged for it
   bool cut_off = false;        // its socket is closed; what it sent before is ignored
+  bool heard = false;          // it has sent a message
 };
 
 }  // namespace
@@ -171,8 +172,21 @@ void Server::Impl::Open(Hdl h) {
   // then never sees the channels).
   auto greet =
       std::make_shared<asio::steady_timer>(ws.get_io_service(), std::chrono::milliseconds(50));
+  // On a loaded host the client may not read its socket for longer than that, and then takes the
+  // greeting in the same read as the handshake's answer all the same (mcap-record recorded
+  // nothing in one clean-clone run of tests/live/interop.sh, 2026-12-02). So a client that has
+  // said nothing a second after its greeting gets it once more: one that missed it subscribes
+  // then; one that had it sees its channels advertised again, which the protocol allows.
+  auto again = std::make_shared<asio::steady_timer>(ws.get_io_service(),
+                                                    std::chrono::milliseconds(50 + 1000));
   greet->async_wait([this, h, greet](const std::error_code& ec) {
     if (ec || clients.find(h) == clients.end()) return;
+    SendText(h, ServerInfoJson(options.name, session_id));
+    SendText(h, AdvertiseJson(channels));
+  });
+  again->async_wait([this, h, again](const std::error_code& ec) {
+    const auto it = clients.find(h);
+    if (ec || it == clients.end() || it->second.heard || it->second.cut_off) return;
     SendText(h, ServerInfoJson(options.name, session_id));
     SendText(h, AdvertiseJson(channels));
   });
@@ -190,6 +204,7 @@ void Server::Impl::Message(Hdl h, WsServer::message_ptr msg) {
   const auto it = clients.find(h);
   if (it == clients.end()) return;
   Client& c = it->second;
+  c.heard = true;
   if (c.cut_off) return;
   if (SecondsSince(c.window_start) >= 1.0) {
     c.window_start = Clock::now();

@@ -174,6 +174,24 @@ TEST(LiveServer, SpeaksBothSubprotocolsEchoesTheOneOfferedAndAdvertisesEveryChan
   EXPECT_FALSE(other.Opened());
 }
 
+// A client that may have missed the greeting (it said nothing a second after it) gets it once more;
+// one that subscribed does not.
+TEST(LiveServer, AClientThatSaysNothingIsGreetedAgainOnceAndASubscriberIsNot) {
+  ServerOptions defaults;
+  auto server = AServer(defaults);
+  TestClient silent(server->port(), kSubprotocolSdk);
+  TestClient subscriber(server->port(), kSubprotocolSdk);
+  ASSERT_TRUE(silent.Opened());
+  ASSERT_TRUE(subscriber.Opened());
+  subscriber.SubscribeAll();
+  ASSERT_TRUE(silent.Wait([&] { return silent.Ops("advertise").size() >= 2; }, 5000ms));
+  std::this_thread::sleep_for(1500ms);  // no third greeting, and none for the subscriber
+  EXPECT_EQ(silent.Ops("serverInfo").size(), 2u);
+  EXPECT_EQ(silent.Ops("advertise").size(), 2u);
+  EXPECT_EQ(subscriber.Ops("serverInfo").size(), 1u);
+  EXPECT_EQ(subscriber.Ops("advertise").size(), 1u);
+}
+
 TEST(LiveServer, ASubscriberGetsEveryChannelWithTheRunsTimestamps) {
   ServerOptions defaults;
   auto server = AServer(defaults);
