@@ -25,8 +25,11 @@ constexpr std::size_t kMaxLatencySamples = 100000;
 // Records received and not yet applied: beyond this the follower takes no more until the copy
 // has caught up (the leader sends them again when asked), so a leader cannot fill its memory.
 constexpr std::size_t kMaxQueuedRecords = 1024;
-// Handshakes failed in a row before the follower gives up on a leader: the two disagree on CURVE
-// (a key on one side only, the wrong leader key) or the endpoint is not a mapless leader.
+// Handshakes failed in a row before the follower gives up on a leader it has never completed a
+// handshake with: the two disagree on CURVE (a key on one side only, the wrong leader key) or the
+// endpoint is not a mapless leader. Once one handshake has succeeded the keys are known to agree,
+// and failures are the way to the leader (a proxy whose leader is down or restarting): the
+// follower keeps trying and says so.
 constexpr int kMaxHandshakeFailures = 3;
 
 }  // namespace
@@ -80,10 +83,20 @@ struct FollowerClient::Impl {
 
   // The connection as ZeroMQ's monitor tells it (network thread): what the follower waits for.
   int handshake_failures = 0;
-  bool handshaking = false;  // connected, handshake not yet succeeded or failed
+  bool handshaking = false;      // connected, handshake not yet succeeded or failed
+  bool handshake_known = false;  // a handshake with this leader has succeeded
   void CountHandshakeFailure() {
     handshaking = false;
-    if (++handshake_failures < kMaxHandshakeFailures) return;
+    ++handshake_failures;
+    if (handshake_known) {
+      limited.Say("handshakes failed",
+                  "fleet: the handshake with " + options.connect + " failed " +
+                      std::to_string(handshake_failures) +
+                      " times in a row since the link was last up (the leader restarting, or a "
+                      "proxy with nothing behind it?); trying again");
+      return;
+    }
+    if (handshake_failures < kMaxHandshakeFailures) return;
     Refuse("the handshake with " + options.connect + " failed " +
            std::to_string(handshake_failures) +
            " times: the leader and this follower disagree on CURVE (--curve-key on one side only, "
@@ -119,6 +132,7 @@ struct FollowerClient::Impl {
       case ZMQ_EVENT_HANDSHAKE_SUCCEEDED:
         handshaking = false;
         handshake_failures = 0;
+        handshake_known = true;
         SetLinkState("connected to " + at);
         break;
       case ZMQ_EVENT_HANDSHAKE_FAILED_AUTH:

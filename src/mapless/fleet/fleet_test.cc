@@ -1,5 +1,11 @@
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <iterator>
@@ -393,6 +399,95 @@ TEST(FleetLink, AFollowerUnderGarbageSaysItOnceASecond) {
   EXPECT_GE(lines, 1);
   EXPECT_LE(lines, 40);  // one a second at most, and the line with the count
   EXPECT_EQ(copy.next_sequence(), 0u);
+}
+
+}  // namespace
+}  // namespace mapless::fleet
+
+namespace mapless::fleet {
+namespace {
+
+// Accepts every connection on 127.0.0.1:`port` and closes it at once: what a follower sees
+// through a TCP proxy (a relay, a tunnel) while the leader behind it is down or restarting.
+class AcceptAndClose {
+ public:
+  explicit AcceptAndClose(int port) {
+    fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    const int one = 1;
+    ::setsockopt(fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one));
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    addr.sin_port = htons(static_cast<std::uint16_t>(port));
+    bound_ = ::bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)) == 0 &&
+             ::listen(fd_, 16) == 0;
+    thread_ = std::thread([this] {
+      while (!stop_) {
+        pollfd p{fd_, POLLIN, 0};
+        if (::poll(&p, 1, 20) <= 0) continue;
+        const int c = ::accept4(fd_, nullptr, nullptr, SOCK_CLOEXEC);
+        if (c < 0) continue;
+        ::close(c);
+        ++accepted_;
+      }
+    });
+  }
+  ~AcceptAndClose() {
+    stop_ = true;
+    thread_.join();
+    ::close(fd_);
+  }
+  bool bound() const { return bound_; }
+  int accepted() const { return accepted_; }
+
+ private:
+  int fd_ = -1;
+  bool bound_ = false;
+  std::atomic<bool> stop_{false};
+  std::atomic<int> accepted_{0};
+  std::thread thread_;
+};
+
+// CI, 2026-12-02 (fleet.eigenspace_faults): follower 3 reached the leader through a relay; the
+// leader was killed and restarted, the relay took the follower's connections and closed them
+// while nothing listened behind it, and the follower took three such closes for a CURVE mismatch
+// and gave the leader up for good. A follower whose handshake with this leader has succeeded
+// knows their keys agree: it keeps trying, saying so, and takes the rest of the route.
+TEST(FleetLink, AFollowerBehindAProxyWaitsOutALeaderRestart) {
+  const std::vector<Record> records = ImageRecords(30, true);
+  RouteCopy leader(FreshDir("restart_leader"));
+  leader.Apply({records.begin(), records.begin() + 10});
+  ServerOptions server_options;
+  server_options.bind = "tcp://127.0.0.1:*";
+  auto server = std::make_unique<LeaderServer>(leader, server_options, nullptr);
+  const std::string endpoint = server->endpoint();
+  const int port = std::stoi(endpoint.substr(endpoint.rfind(':') + 1));
+  RouteCopy follower(FreshDir("restart_follower"));
+  ClientOptions client_options;
+  client_options.connect = endpoint;
+  std::mutex lines_mutex;
+  std::vector<std::string> lines;
+  FollowerClient client(follower, client_options, [&](const std::string& line) {
+    std::lock_guard<std::mutex> lock(lines_mutex);
+    lines.push_back(line);
+  });
+  ASSERT_TRUE(WaitFor([&] { return follower.next_sequence() == 10; }, 10.0));
+  server.reset();
+  {
+    AcceptAndClose proxy(port);
+    ASSERT_TRUE(proxy.bound());
+    ASSERT_TRUE(WaitFor([&] { return proxy.accepted() >= 5; }, 20.0)) << proxy.accepted();
+  }
+  EXPECT_EQ(client.Refusal(), "");
+  leader.Apply({records.begin() + 10, records.end()});
+  server_options.bind = endpoint;
+  server = std::make_unique<LeaderServer>(leader, server_options, nullptr);
+  ASSERT_TRUE(WaitFor([&] { return follower.complete(); }, 20.0)) << client.Refusal();
+  EXPECT_EQ(Files(follower.dir()), Files(leader.dir()));
+  std::lock_guard<std::mutex> lock(lines_mutex);
+  bool said = false;
+  for (const std::string& l : lines) said |= l.find("trying again") != std::string::npos;
+  EXPECT_TRUE(said) << "the failed handshakes were not said";
 }
 
 }  // namespace

@@ -144,6 +144,7 @@ void Relay::Run() {
       fds.push_back({b, POLLIN, 0});
     }
     ::poll(fds.data(), fds.size(), 20);
+    const std::size_t polled = pairs_.size();  // a pair accepted below waits for the next poll
     if (fds[0].revents & POLLIN) {
       const int in = ::accept4(listener_, nullptr, nullptr, SOCK_CLOEXEC);
       if (in >= 0) {
@@ -156,7 +157,7 @@ void Relay::Run() {
       }
     }
     std::vector<std::size_t> dead;
-    for (std::size_t i = 0; i < pairs_.size(); ++i) {
+    for (std::size_t i = 0; i < polled; ++i) {
       for (int side = 0; side < 2; ++side) {
         const pollfd& p = fds[1 + 2 * i + static_cast<std::size_t>(side)];
         if (!(p.revents & (POLLIN | POLLHUP | POLLERR))) continue;
