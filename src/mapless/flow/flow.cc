@@ -68,19 +68,35 @@ void FlowOptions::Validate() const {
   lk.Validate();
 }
 
-cv::Mat ComputeFlow(const cv::Mat& first, const cv::Mat& second, const FlowOptions& options) {
-  options.Validate();
+FlowEstimator::FlowEstimator(FlowOptions options) : options_(std::move(options)) {
+  options_.Validate();
+}
+
+FlowEstimator& FlowEstimator::operator=(const FlowEstimator& other) {
+  if (this != &other) {
+    options_ = other.options_;
+    dis_.reset();
+  }
+  return *this;
+}
+
+cv::Mat FlowEstimator::Compute(const cv::Mat& first, const cv::Mat& second) {
   const auto [a, b] = GreyPair(first, second, "ComputeFlow");
+  // Empty, so that DIS starts afresh: given a flow of the images' size it would take it as its
+  // initial estimate.
   cv::Mat flow;
-  switch (options.method) {
+  switch (options_.method) {
     case FlowMethod::kDisFast:
     case FlowMethod::kDisMedium: {
-      const auto dis = cv::DISOpticalFlow::create(options.method == FlowMethod::kDisFast
-                                                      ? cv::DISOpticalFlow::PRESET_FAST
-                                                      : cv::DISOpticalFlow::PRESET_MEDIUM);
-      if (options.dis_max_flow_width_px > 0) {
+      if (dis_.empty()) {
+        dis_ = cv::DISOpticalFlow::create(options_.method == FlowMethod::kDisFast
+                                              ? cv::DISOpticalFlow::PRESET_FAST
+                                              : cv::DISOpticalFlow::PRESET_MEDIUM);
+      }
+      auto* dis = static_cast<cv::DISOpticalFlow*>(dis_.get());
+      if (options_.dis_max_flow_width_px > 0) {
         int scale = 0;
-        while ((a.cols >> scale) > options.dis_max_flow_width_px) ++scale;
+        while ((a.cols >> scale) > options_.dis_max_flow_width_px) ++scale;
         dis->setFinestScale(scale);
       }
       dis->calc(a, b, flow);
@@ -90,10 +106,14 @@ cv::Mat ComputeFlow(const cv::Mat& first, const cv::Mat& second, const FlowOptio
       cv::calcOpticalFlowFarneback(a, b, flow, 0.5, 4, 15, 3, 5, 1.1, 0);
       break;
     case FlowMethod::kDenseLk:
-      flow = DenseLucasKanade(a, b, options.lk);
+      flow = DenseLucasKanade(a, b, options_.lk);
       break;
   }
   return flow;
+}
+
+cv::Mat ComputeFlow(const cv::Mat& first, const cv::Mat& second, const FlowOptions& options) {
+  return FlowEstimator(options).Compute(first, second);
 }
 
 FlowError EndPointError(const cv::Mat& flow, const cv::Mat& truth, const cv::Mat& valid) {

@@ -101,6 +101,35 @@ TEST(ComputeFlow, DisFlowWidthPicksTheFinestLevel) {
   EXPECT_THROW(ComputeFlow(a, b, capped), std::exception);
 }
 
+// Issue 44: the navigator keeps one FlowEstimator, so DIS's buffers and refinement objects live
+// from pair to pair. Its flow is ComputeFlow's (a DIS made afresh) on every pair of a stream whose
+// sizes and motions change, for each DIS setting the navigator can take; a copy starts afresh.
+TEST(FlowEstimator, GivesComputeFlowsFlowBitForBit) {
+  FlowOptions capped;
+  capped.method = FlowMethod::kDisMedium;
+  capped.dis_max_flow_width_px = 160;
+  FlowOptions fast;
+  fast.method = FlowMethod::kDisFast;
+  FlowOptions medium = capped;
+  medium.dis_max_flow_width_px = 0;
+  const std::vector<std::tuple<int, int, double, double>> pairs = {
+      {320, 240, 2.2, 1.1},  {320, 240, -6.5, 0.4}, {640, 480, 4.4, 2.2},
+      {320, 240, 0.3, -3.1}, {160, 120, 1.5, 1.5},  {320, 240, 2.2, 1.1}};
+  for (const FlowOptions& options : {capped, fast, medium}) {
+    FlowEstimator estimator(options);
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      const auto [w, h, dx, dy] = pairs[k];
+      const cv::Mat a = Texture(w, h, static_cast<int>(k) + 11);
+      const cv::Mat b = Translate(a, dx, dy);
+      const cv::Mat expected = ComputeFlow(a, b, options);
+      EXPECT_TRUE(SameBytes(estimator.Compute(a, b), expected))
+          << FlowMethodName(options.method) << " pair " << k;
+      FlowEstimator copy = estimator;
+      EXPECT_TRUE(SameBytes(copy.Compute(a, b), expected));
+    }
+  }
+}
+
 TEST(DenseLucasKanade, RecoversALargeMotionThroughThePyramid) {
   const cv::Mat a = Texture(320, 240, 5);
   const cv::Mat b = Translate(a, -12.0, 6.0);  // far beyond a 5x5 window at level 0

@@ -35,9 +35,10 @@ cv::Mat CalibratePlanarModel(const std::vector<cv::Mat>& frames, const flow::Flo
                 "planar-flow calibration needs at least two frames, got " << frames.size());
   cv::Mat sum = cv::Mat::zeros(3, 3, CV_64F);
   int count = 0;
+  flow::FlowEstimator estimator(flow);
   for (std::size_t i = 1; i < frames.size(); ++i) {
-    const ground::DominantPlane p = ground::DetectDominantPlane(
-        flow::ComputeFlow(Grey(frames[i - 1]), Grey(frames[i]), flow), plane);
+    const ground::DominantPlane p =
+        ground::DetectDominantPlane(estimator.Compute(Grey(frames[i - 1]), Grey(frames[i])), plane);
     if (!p.found || std::abs(p.model.at<double>(2, 2)) < 1e-12) continue;
     sum += p.model / p.model.at<double>(2, 2);
     ++count;
@@ -122,6 +123,7 @@ PotentialNavigator::PotentialNavigator(PlanarFlowCalibration calibration,
                                        PotentialNavOptions options)
     : calibration_(std::move(calibration)),
       options_(std::move(options)),
+      flow_(options_.flow),
       noise_(options_.noise_seed) {
   calibration_.Validate();
   options_.Validate();
@@ -344,7 +346,7 @@ bool PotentialNavigator::WaitForMotion(const cv::Mat& grey, const Pose2& odometr
 bool PotentialNavigator::FindGround(const cv::Mat& grey, const Pose2& odometry,
                                     ground::DominantPlane* found, cv::Mat* flow_out,
                                     PotentialStep* step) {
-  cv::Mat flow = flow::ComputeFlow(previous_, grey, options_.flow);
+  cv::Mat flow = flow_.Compute(previous_, grey);
   const Pose2 motion = previous_odometry_.Inverse() * odometry;  // this frame's, by odometry
   previous_ = grey;
   previous_odometry_ = odometry;

@@ -184,6 +184,7 @@ class PotentialNavigator {
 
   PlanarFlowCalibration calibration_;
   PotentialNavOptions options_;
+  flow::FlowEstimator flow_;    // options_.flow, its buffers kept from frame to frame
   cv::Size work_size_;          // the potential's grid
   cv::Mat translational_flow_;  // unit-mean-magnitude fields on that grid
   cv::Mat rotational_flow_;

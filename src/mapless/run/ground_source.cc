@@ -16,6 +16,7 @@ GroundSourceResult GroundOverSource(io::FrameSource& source, const std::string& 
   std::deque<io::Frame> window;  // the last `step` + 1 frames
   GroundSourceResult result;
   double fraction_sum = 0.0;
+  flow::FlowEstimator estimator(options.flow);
   io::Frame frame;
   while ((options.max_frames == 0 || result.frames < options.max_frames) && source.Next(&frame)) {
     if (each_frame) each_frame();
@@ -24,7 +25,7 @@ GroundSourceResult GroundOverSource(io::FrameSource& source, const std::string& 
     window.push_back(frame);
     if (static_cast<int>(window.size()) <= options.step) continue;
     const io::Frame& a = window.front();
-    const cv::Mat field = flow::ComputeFlow(a.image, window.back().image, options.flow);
+    const cv::Mat field = estimator.Compute(a.image, window.back().image);
     const ground::DominantPlane plane = ground::DetectDominantPlane(field, options.plane);
     nlohmann::json j;
     j["frame"] = result.frames;
