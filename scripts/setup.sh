@@ -9,8 +9,9 @@
 #                                    the demo does without)
 #        scripts/setup.sh --test     --ros and what the test command (README command 2) uses
 #                                    besides: Chromium (the report opened headless), clang (the
-#                                    sanitizer build), clang-format (the style check), dpkg-dev
-#                                    (the .deb's dependencies)
+#                                    sanitizer build, with its runtimes), clang-format (the style
+#                                    check), dpkg-dev and file (the .deb's dependencies), and
+#                                    Node.js with npm where there is none (the interop tests)
 set -euo pipefail
 WITH_ROS=0
 WITH_TEST=0
@@ -51,9 +52,16 @@ if [ "$WITH_TEST" = "1" ]; then
   PACKAGES+=(
     chromium               # the HTML report opened headless (no console error, a screenshot)
     clang                  # the sanitizer build (docs/ci.md: 0.6x GCC's compile time under ASan)
+    libclang-rt-14-dev     # ... its ASan and UBSan runtimes (only a Recommends of clang)
     clang-format           # the style check (scripts/check_format.sh)
-    dpkg-dev               # dpkg-shlibdeps: the Depends of the .deb (cpack)
+    dpkg-dev file          # dpkg-shlibdeps and file: the Depends of the .deb (cpack)
   )
+  # The interoperability tests' reference clients (npm packages pinned in the tests' folders):
+  # Debian's Node.js where the machine has none (18 in Debian 12; the live page's check needs 20
+  # and is skipped, saying so, on 18). A Node.js installed otherwise (NodeSource's, nvm) is kept.
+  if ! command -v node >/dev/null 2>&1; then
+    PACKAGES+=(nodejs npm ca-certificates)
+  fi
   if [ "$WITH_ROS" = "1" ]; then
     # A real ROS 2 middleware on the other end (tests/ros2/fastdds): eProsima Fast DDS, the default
     # of ROS 2 Humble and Jazzy, and its type generator (Java).

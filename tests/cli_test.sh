@@ -280,7 +280,7 @@ section_crash() {
   if kill -9 "$pid" 2>/dev/null; then
     wait "$pid" 2>/dev/null
     expect_exit "killed teach: route loads" 0 "$MAPLESS" route info "$TMP/killed" --json
-    grep -q '"complete":false' "$TMP/out" && grep -q '"keyframes":[1-9]' "$TMP/out"; check "killed teach keeps its completed keyframes ($(cat "$TMP/out"))" $?
+    grep -q '"complete":false' "$TMP/out" && grep -q '"keyframes":[1-9]' "$TMP/out"; st=$?; check "killed teach keeps its completed keyframes ($(cat "$TMP/out"))" $st
   else
     wait "$pid"; check "teach was still running when killed (machine too fast?)" 1
   fi

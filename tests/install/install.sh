@@ -49,7 +49,7 @@ if [ "$WHAT" = all ] || [ "$WHAT" = deb ]; then
   [ $ok -ne 0 ] && sed 's/^/     | /' "$TMP/cpack.log" | tail -30
   check "cpack -G DEB exits 0" $ok
   deb=$(ls "$TMP"/deb/mapless_*.deb 2>/dev/null | head -1)
-  [ -n "$deb" ]; check "a .deb was written ($(basename "${deb:-none}"))" $?
+  [ -n "$deb" ]; st=$?; check "a .deb was written ($(basename "${deb:-none}"))" $st
   if [ -n "$deb" ]; then
     depends=$(dpkg-deb -f "$deb" Depends)
     echo "     Depends: $depends"
@@ -65,7 +65,7 @@ if [ "$WHAT" = all ] || [ "$WHAT" = deb ]; then
     "$TMP/root/usr/bin/mapless" --version >"$TMP/version" 2>&1
     check "the packaged mapless --version exits 0" $?
     head -1 "$TMP/version" | grep -q "^mapless [0-9]" && grep -q "^robot links: " "$TMP/version"
-    check "it names its version and its robot links ($(tr '\n' ' ' <"$TMP/version"))" $?
+    st=$?; check "it names its version and its robot links ($(tr '\n' ' ' <"$TMP/version"))" $st
     "$TMP/root/usr/bin/mapless" sim list >"$TMP/list" 2>&1 && grep -qx "narrow_room_sharp_turn" "$TMP/list"
     check "the packaged mapless sim list names the built-in scenarios" $?
     [ -f "$TMP/root/usr/lib/cmake/mapless/maplessConfig.cmake" ] || \

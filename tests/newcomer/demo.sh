@@ -11,7 +11,7 @@ failed=0
 check() { if [ "$2" -eq 0 ]; then echo "ok   $1"; else echo "FAIL $1"; failed=$((failed + 1)); fi; }
 
 "$BIN" --version >"$OUT.version" 2>&1
-grep -q "^robot links: none" "$OUT.version"; check "this build has no robot link, as a newcomer's ($(tail -1 "$OUT.version" | cut -c1-40))" $?
+grep -q "^robot links: none" "$OUT.version"; st=$?; check "this build has no robot link, as a newcomer's ($(tail -1 "$OUT.version" | cut -c1-40))" $st
 rm -rf "$OUT"
 "$BIN" demo --out "$OUT" >"$OUT.log" 2>&1
 code=$?

@@ -375,7 +375,7 @@ code=$?
 [ "$code" -eq 130 ]; check "Ctrl-C ends a teach with exit 130 (got $code)" $?
 [ "$(grep -c '^mapless: interrupted (SIGINT): stopped cleanly' "$TMP/first.err")" -eq 1 ]; check "Ctrl-C: one line says so" $?
 "$MAPLESS" route info "$NEW/locked" --json >"$TMP/out" 2>"$TMP/err"
-grep -q '"complete":false' "$TMP/out"; check "Ctrl-C: the route loads, marked incomplete ($(cat "$TMP/out" "$TMP/err"))" $?
+grep -q '"complete":false' "$TMP/out"; st=$?; check "Ctrl-C: the route loads, marked incomplete ($(cat "$TMP/out" "$TMP/err"))" $st
 
 echo '{"old": "log"}' >"$NEW/old.jsonl"
 "$MAPLESS" repeat --route "$FX/route" --source sim:table1_almost_straight --log "$NEW/old.jsonl" >/dev/null 2>"$TMP/rep.err" &

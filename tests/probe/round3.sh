@@ -178,7 +178,7 @@ kill -INT "$r3curve" "$r3plain"; wait "$r3curve" "$r3plain" 2>/dev/null
 r3wait=$!
 wait_until 60 "$r3wait" grep -q "still waiting" "$TMP/r3wait.err"
 kill -INT "$r3wait"; wait "$r3wait" 2>/dev/null
-grep -q "still waiting for the leader's route: no connection to tcp://127.0.0.1:1" "$TMP/r3wait.err"; check "a follower with no leader says what it waits for ($(head -c 200 "$TMP/r3wait.err"))" $?
+grep -q "still waiting for the leader's route: no connection to tcp://127.0.0.1:1" "$TMP/r3wait.err"; st=$?; check "a follower with no leader says what it waits for ($(head -c 200 "$TMP/r3wait.err"))" $st
 
 # ---------------------------------------------------------------------------------------------
 echo "# round 3: a crash"

@@ -64,10 +64,10 @@ IMAGES=$(ls "$OUT/images/images" 2>/dev/null | wc -l)
 check "teach --robot --method eigenspace too: exit $R2, a complete route of $IMAGES images" $?
 "$BIN" route info "$OUT/route" --json >"$OUT/info.json" 2>"$OUT/info.err"
 grep -q '"complete": *true' "$OUT/info.json"
-check "the taught route is complete: $(grep -o '"keyframes": *[0-9]*' "$OUT/info.json")" $?
+st=$?; check "the taught route is complete: $(grep -o '"keyframes": *[0-9]*' "$OUT/info.json")" $st
 awk -v d="$(grep -o '"duration_s": *[0-9.e+-]*' "$OUT/info.json" | sed 's/.*: *//')" \
   'BEGIN { exit !(d != "" && d + 0 > 5 && d + 0 < 60) }'
-check "its duration is the driving time: $(grep -o '"duration_s": *[0-9.]*' "$OUT/info.json")" $?
+st=$?; check "its duration is the driving time: $(grep -o '"duration_s": *[0-9.]*' "$OUT/info.json")" $st
 [ "$(grep -o '"keyframes": *[0-9]*' "$OUT/info.json" | sed 's/.*: *//')" -ge 3 ]
 check "teleop drove the robot: keyframes along the way, not one where it stood" $?
 kill -9 "$SERVE" 2>/dev/null; wait "$SERVE" 2>/dev/null
@@ -88,7 +88,7 @@ R=$?
 [ "$R" = 1 ]; check "a repeat blocked for good exits 1 (exit $R)" $?
 grep -q "blocked for [0-9.]* s (.*): clear the way and start again, or raise safety.max_blocked_s in the robot file" \
   "$OUT/blocked.log"
-check "it says why and what to do: $(grep -o 'blocked for [0-9.]* s' "$OUT/blocked.log" | tail -1)" $?
+st=$?; check "it says why and what to do: $(grep -o 'blocked for [0-9.]* s' "$OUT/blocked.log" | tail -1)" $st
 kill -9 "$SERVE" 2>/dev/null; wait "$SERVE" 2>/dev/null
 
 [ "$FAILS" = 0 ] || { tail -5 "$OUT"/*.log; exit 1; }
