@@ -89,11 +89,15 @@ struct FollowerClient::Impl {
     handshaking = false;
     ++handshake_failures;
     if (handshake_known) {
-      limited.Say("handshakes failed",
-                  "fleet: the handshake with " + options.connect + " failed " +
-                      std::to_string(handshake_failures) +
-                      " times in a row since the link was last up (the leader restarting, or a "
-                      "proxy with nothing behind it?); trying again");
+      // Said at the 1st, 10th, 100th ... failure in a row: a leader down for an hour is not an
+      // hour of lines (the link state, said every 5 s, has the rest).
+      const int n = handshake_failures;
+      if (n == 1 || n == 10 || n == 100 || n == 1000 || n % 10000 == 0) {
+        Log("fleet: the handshake with " + options.connect + " failed " + std::to_string(n) +
+            (n == 1 ? " time" : " times") +
+            " in a row since the link was last up (the leader restarting, a proxy with nothing "
+            "behind it, or a leader with other CURVE keys?); trying again");
+      }
       return;
     }
     if (handshake_failures < kMaxHandshakeFailures) return;
