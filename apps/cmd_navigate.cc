@@ -12,6 +12,7 @@
 #include "mapless/io/limits.h"
 #include "mapless/recording/recording_link.h"
 #include "mapless/robot/methods.h"
+#include "mapless/robot/robot_file.h"
 #include "mapless/run/decision_log.h"
 #include "recording_args.h"
 #include "robot_run.h"
@@ -71,6 +72,7 @@ void NavigateOnRobot(const NavigateArgs& a, bool by_index) {
   if (a.homing && !destination) throw InputError("--homing needs a destination");
   navigation::PotentialNavOptions nav;
   nav.homing = a.homing;
+  nav.flow.threads = robot::LoadRobotFile(a.robot).threads;  // the same flow on any number
   robot::PotentialMethod method(calibration, nav, destination);
   RefuseOutputOverInputs(a.record.path, "--record", {a.robot, a.calibration});
   SourceRunArgs args;

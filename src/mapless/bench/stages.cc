@@ -52,9 +52,10 @@ void BenchPotential(int repeats, nlohmann::json* j) {
     dis->calc(frames[k], frames[k + 1], flow);
   });
   // The measure: the step with DIS fast; and the navigator's default (DIS medium).
-  auto time_step = [&](flow::FlowMethod method) {
+  auto time_step = [&](flow::FlowMethod method, int threads = 1) {
     navigation::PotentialNavOptions o = nav;
     o.flow.method = method;
+    o.flow.threads = threads;
     if (method == flow::FlowMethod::kDisFast) o.flow.dis_max_flow_width_px = 0;  // the preset's
     navigation::PotentialNavigator navigator(calibration, o);
     Pose2 odometry;
@@ -71,6 +72,11 @@ void BenchPotential(int repeats, nlohmann::json* j) {
   (*j)["dominant_plane_step_dis_medium_ms"] = time_step(flow::FlowMethod::kDisMedium);
   (*j)["navigator_default_over_dis_fast"] =
       (*j)["dominant_plane_step_dis_medium_ms"].get<double>() /
+      (*j)["opencv_dis_fast_ground_320x240_ms"].get<double>();
+  // As `navigate --robot` runs it with a robot file's `threads: 2` (the same flow).
+  (*j)["dominant_plane_step_dis_medium_2_threads_ms"] = time_step(flow::FlowMethod::kDisMedium, 2);
+  (*j)["navigator_default_2_threads_over_dis_fast"] =
+      (*j)["dominant_plane_step_dis_medium_2_threads_ms"].get<double>() /
       (*j)["opencv_dis_fast_ground_320x240_ms"].get<double>();
   (*j)["dominant_plane_step_over_dis_fast"] =
       (*j)["dominant_plane_step_ms"].get<double>() /

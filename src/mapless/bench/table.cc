@@ -104,6 +104,7 @@ void PrintStageTable(const nlohmann::json& j) {
                           "opencv_dis_fast_ground_320x240_ms",
                           "dominant_plane_step_ms",
                           "dominant_plane_step_dis_medium_ms",
+                          "dominant_plane_step_dis_medium_2_threads_ms",
                           "ipca_add_1000_ms",
                           "markov_update_10000_ms",
                           "subwindow_control_ms"}) {
@@ -160,6 +161,9 @@ void PrintStageTable(const nlohmann::json& j) {
               j["dominant_plane_step_over_dis_fast"].get<double>());
   std::printf("%-34s %10.2f  (issue 44: <= 2.0; the navigator's default, DIS medium)\n",
               "navigator_default / dis_fast", j["navigator_default_over_dis_fast"].get<double>());
+  std::printf("%-34s %10.2f  (issue 44: <= 2.0; the flow on two threads, a robot file's default)\n",
+              "navigator_default 2 thr / dis_fast",
+              j["navigator_default_2_threads_over_dis_fast"].get<double>());
   for (const char* key : {"ipca_add_1000", "markov_update_10000", "subwindow_control"}) {
     std::printf("%-34s %10.2f  (issue 5: <= 1.5)\n", (std::string(key) + " / dis_fast").c_str(),
                 j[std::string(key) + "_over_dis_fast"].get<double>());

@@ -65,6 +65,8 @@ void DenseLkOptions::Validate() const {
 void FlowOptions::Validate() const {
   MAPLESS_CHECK(dis_max_flow_width_px >= 0, "FlowOptions.dis_max_flow_width_px = "
                                                 << dis_max_flow_width_px << "; must be >= 0");
+  MAPLESS_CHECK(threads >= 1 && threads <= 8,
+                "FlowOptions.threads = " << threads << "; must be in [1, 8]");
   lk.Validate();
 }
 
@@ -99,7 +101,10 @@ cv::Mat FlowEstimator::Compute(const cv::Mat& first, const cv::Mat& second) {
         while ((a.cols >> scale) > options_.dis_max_flow_width_px) ++scale;
         dis->setFinestScale(scale);
       }
+      const int before = cv::getNumThreads();
+      if (options_.threads != before) cv::setNumThreads(options_.threads);
       dis->calc(a, b, flow);
+      if (options_.threads != before) cv::setNumThreads(before);
       break;
     }
     case FlowMethod::kFarneback:

@@ -45,6 +45,11 @@ struct FlowOptions {
   // medium: half). Nearly all of DIS's time is spent on that level, so a larger camera then costs
   // about what a smaller one does. 0: the preset's.
   int dis_max_flow_width_px = 0;
+  // DIS only: OpenCV's threads for the call (cv::setNumThreads around it, the process's count
+  // restored after; so one flow at a time per process with threads > 1). The flow is the same on
+  // any number: DIS's patch search runs in 8 fixed stripes, its densification is per pixel and its
+  // refinement red-black (FlowEstimator.TwoThreadsGiveTheSameFlow). 1 to 8.
+  int threads = 1;
   DenseLkOptions lk;
   void Validate() const;
 };

@@ -130,6 +130,28 @@ TEST(FlowEstimator, GivesComputeFlowsFlowBitForBit) {
   }
 }
 
+// Issue 44: the navigator's flow on two threads where the robot has them: the same flow, and the
+// process's thread count as it was.
+TEST(FlowEstimator, TwoThreadsGiveTheSameFlow) {
+  FlowOptions one;
+  one.method = FlowMethod::kDisMedium;
+  one.dis_max_flow_width_px = 160;
+  FlowOptions two = one;
+  two.threads = 2;
+  FlowEstimator single(one);
+  FlowEstimator dual(two);
+  const int before = cv::getNumThreads();
+  for (int k = 0; k < 6; ++k) {
+    const cv::Size size = k % 3 == 2 ? cv::Size(640, 480) : cv::Size(320 + 8 * k, 240 - 4 * k);
+    const cv::Mat a = Texture(size.width, size.height, k + 21);
+    const cv::Mat b = Translate(a, 1.5 * k - 3.0, 0.7 * k);
+    EXPECT_TRUE(SameBytes(dual.Compute(a, b), single.Compute(a, b))) << "pair " << k;
+    EXPECT_EQ(cv::getNumThreads(), before);
+  }
+  two.threads = 9;
+  EXPECT_THROW(FlowEstimator{two}, InputError);
+}
+
 TEST(DenseLucasKanade, RecoversALargeMotionThroughThePyramid) {
   const cv::Mat a = Texture(320, 240, 5);
   const cv::Mat b = Translate(a, -12.0, 6.0);  // far beyond a 5x5 window at level 0

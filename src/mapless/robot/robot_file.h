@@ -57,7 +57,8 @@ struct RobotFile {
   bool use_sim_time = false;             // ROS `use_sim_time`: the clock comes from /clock
   double connect_timeout_s = 10.0;       // waiting for the master / the first subscriber
   // Threads the method may use on the robot's computer: 2 runs `repeat`'s obstacle watch beside
-  // the frame's feature detection (RepeatOptions::threads; same decisions, shorter latency).
+  // the frame's feature detection (RepeatOptions::threads), `teach`'s tracking in two halves and
+  // `navigate`'s optical flow on two (FlowOptions::threads); same decisions, shorter latency.
   int threads = 2;
   // The full name of a topic: absolute topics stay, relative ones get the namespace.
   std::string Resolve(const std::string& topic) const;
