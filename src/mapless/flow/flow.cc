@@ -11,6 +11,24 @@
 namespace mapless::flow {
 namespace {
 
+// OpenCV's thread count for a scope, the process's restored at its end (also when the call throws).
+class OpenCvThreads {
+ public:
+  explicit OpenCvThreads(int threads) : before_(cv::getNumThreads()) {
+    if (threads != before_) cv::setNumThreads(threads);
+    changed_ = threads != before_;
+  }
+  ~OpenCvThreads() {
+    if (changed_) cv::setNumThreads(before_);
+  }
+  OpenCvThreads(const OpenCvThreads&) = delete;
+  OpenCvThreads& operator=(const OpenCvThreads&) = delete;
+
+ private:
+  int before_;
+  bool changed_ = false;
+};
+
 cv::Mat ToGrey(const cv::Mat& image) {
   MAPLESS_CHECK(!image.empty(), "ComputeFlow: empty image");
   cv::Mat grey = image;
@@ -95,16 +113,13 @@ cv::Mat FlowEstimator::Compute(const cv::Mat& first, const cv::Mat& second) {
                                               ? cv::DISOpticalFlow::PRESET_FAST
                                               : cv::DISOpticalFlow::PRESET_MEDIUM);
       }
-      auto* dis = static_cast<cv::DISOpticalFlow*>(dis_.get());
       if (options_.dis_max_flow_width_px > 0) {
         int scale = 0;
         while ((a.cols >> scale) > options_.dis_max_flow_width_px) ++scale;
-        dis->setFinestScale(scale);
+        dis_->setFinestScale(scale);
       }
-      const int before = cv::getNumThreads();
-      if (options_.threads != before) cv::setNumThreads(options_.threads);
-      dis->calc(a, b, flow);
-      if (options_.threads != before) cv::setNumThreads(before);
+      const OpenCvThreads threads(options_.threads);
+      dis_->calc(a, b, flow);
       break;
     }
     case FlowMethod::kFarneback:

@@ -11,7 +11,7 @@
 #include <vector>
 
 namespace cv {
-class DenseOpticalFlow;
+class DISOpticalFlow;
 }  // namespace cv
 
 namespace mapless::flow {
@@ -66,12 +66,11 @@ class FlowEstimator {
   explicit FlowEstimator(FlowOptions options);
   FlowEstimator(const FlowEstimator& other) : FlowEstimator(other.options_) {}
   FlowEstimator& operator=(const FlowEstimator& other);
-  const FlowOptions& options() const { return options_; }
   cv::Mat Compute(const cv::Mat& first, const cv::Mat& second);
 
  private:
   FlowOptions options_;
-  cv::Ptr<cv::DenseOpticalFlow> dis_;  // DIS methods: kept between calls
+  cv::Ptr<cv::DISOpticalFlow> dis_;  // DIS methods: kept between calls
 };
 
 // The paper's pyramid: level 0 is the image (CV_32F), level l+1 is level l smoothed with the 3x3
