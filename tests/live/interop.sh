@@ -19,8 +19,9 @@
 set -uo pipefail
 MAPLESS=$1; WORK=$2
 HERE=$(cd "$(dirname "$0")" && pwd)
-command -v node >/dev/null 2>&1 && command -v npm >/dev/null 2>&1 ||
-  { echo "interop.sh: SKIPPED: node and npm are needed for @foxglove/ws-protocol"; exit 77; }
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+  echo "interop.sh: SKIPPED: node and npm are needed for @foxglove/ws-protocol"; exit 77
+fi
 # shellcheck source=../support/npm_folder.sh
 source "$HERE/../support/npm_folder.sh"
 npm_folder "$HERE/interop" "$WORK"
@@ -29,7 +30,8 @@ rm -rf "$R"; mkdir -p "$R"
 S=sim:table1_almost_straight
 FAILS=0
 pids=()
-trap 'for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done' EXIT
+cleanup() { local p; for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; }
+trap cleanup EXIT
 
 "$MAPLESS" teach --source $S --out "$R/route" --live 127.0.0.1:0 >"$R/teach.log" 2>&1 ||
   { echo "FAIL teach:"; tail -5 "$R/teach.log"; exit 1; }
@@ -52,15 +54,16 @@ port_of() {  # the port the command said it serves on
 PORT=$(port_of "$R/repeat.log") || exit 1
 URL=ws://127.0.0.1:$PORT
 echo "-- three clients on $URL"
-node "$WORK/js/watch.mjs" "$URL" foxglove.sdk.v1 120 >"$R/sdk.json" 2>"$R/sdk.err" & pids+=($!); sdk=$!
-node "$WORK/js/watch.mjs" "$URL" foxglove.websocket.v1 120 >"$R/v1.json" 2>"$R/v1.err" & pids+=($!); v1=$!
+declare -A watchers
+node "$WORK/js/watch.mjs" "$URL" foxglove.sdk.v1 120 >"$R/sdk.json" 2>"$R/sdk.err" & pids+=($!); watchers[sdk]=$!
+node "$WORK/js/watch.mjs" "$URL" foxglove.websocket.v1 120 >"$R/v1.json" 2>"$R/v1.err" & pids+=($!); watchers[v1]=$!
 timeout 120 node "$WORK/js/node_modules/@foxglove/ws-protocol-examples/dist/cjs/ws-protocol-examples/src/index.js" \
   mcap-record "$URL" -o "$R/live.mcap" >"$R/record.log" 2>&1 & pids+=($!); rec=$!
 
 if wait "$repeat"; then echo "ok   the repeat completed while watched"; else
   echo "FAIL the repeat:"; tail -5 "$R/repeat.log"; FAILS=$((FAILS + 1)); fi
 for name in sdk v1; do
-  pid=${!name}
+  pid=${watchers[$name]}
   if wait "$pid"; then echo "ok   $name: $(cut -c1-400 "$R/$name.json")"; else
     echo "FAIL $name: $(cat "$R/$name.json") $(tail -3 "$R/$name.err")"; FAILS=$((FAILS + 1)); fi
 done
