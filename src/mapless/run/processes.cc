@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <filesystem>
 
@@ -116,21 +117,45 @@ int Relay::Dial() {
     ::close(fd);
     return -1;
   }
+  ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) | O_NONBLOCK);
   return fd;
 }
 
 void Relay::CloseAll() {
-  for (auto& [a, b] : pairs_) {
-    ::close(a);
-    ::close(b);
+  for (const Pair& p : pairs_) {
+    ::close(p.fd[0]);
+    ::close(p.fd[1]);
   }
   pairs_.clear();
   if (listener_ >= 0) ::close(listener_);
   listener_ = -1;
 }
 
-void Relay::Run() {
+// One side of a pair after poll: writes what the other side sent while this one can take it, and
+// reads only when what it sent before has gone on. False: the pair is finished.
+bool Relay::Forward(Pair& pair, int side, short revents) {
+  const auto flush = [&](int from) {
+    std::string& out = pair.pending[from];
+    while (!out.empty()) {
+      const ssize_t w = ::send(pair.fd[1 - from], out.data(), out.size(), MSG_NOSIGNAL);
+      if (w < 0) return errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR;
+      out.erase(0, static_cast<std::size_t>(w));
+    }
+    return true;
+  };
+  // An error, or a hang-up with nothing left to read (a reset): nothing more can pass.
+  if ((revents & POLLERR) || ((revents & POLLHUP) && !(revents & POLLIN))) return false;
+  if ((revents & POLLOUT) && !flush(1 - side)) return false;
+  if (!(revents & POLLIN) || !pair.pending[side].empty()) return true;
   char buffer[1 << 16];
+  const ssize_t n = ::read(pair.fd[side], buffer, sizeof(buffer));
+  if (n < 0) return errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR;
+  if (n == 0) return false;  // closed: everything it sent has been passed on
+  pair.pending[side].assign(buffer, static_cast<std::size_t>(n));
+  return flush(side);
+}
+
+void Relay::Run() {
   while (!stop_) {
     if (down_) {
       if (listener_ >= 0 || !pairs_.empty()) CloseAll();
@@ -139,45 +164,39 @@ void Relay::Run() {
     }
     if (listener_ < 0) Listen();
     std::vector<pollfd> fds = {{listener_, POLLIN, 0}};
-    for (const auto& [a, b] : pairs_) {
-      fds.push_back({a, POLLIN, 0});
-      fds.push_back({b, POLLIN, 0});
+    for (const Pair& p : pairs_) {
+      for (int side = 0; side < 2; ++side) {
+        const short in = p.pending[side].empty() ? POLLIN : 0;
+        const short out = p.pending[1 - side].empty() ? 0 : POLLOUT;
+        fds.push_back({p.fd[side], static_cast<short>(in | out), 0});
+      }
     }
     ::poll(fds.data(), fds.size(), 20);
     const std::size_t polled = pairs_.size();  // a pair accepted below waits for the next poll
     if (fds[0].revents & POLLIN) {
-      const int in = ::accept4(listener_, nullptr, nullptr, SOCK_CLOEXEC);
+      const int in = ::accept4(listener_, nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK);
       if (in >= 0) {
         const int out = Dial();
         if (out < 0) {
           ::close(in);
         } else {
-          pairs_.emplace_back(in, out);
+          pairs_.push_back(Pair{{in, out}, {}});
         }
       }
     }
     std::vector<std::size_t> dead;
     for (std::size_t i = 0; i < polled; ++i) {
       for (int side = 0; side < 2; ++side) {
-        const pollfd& p = fds[1 + 2 * i + static_cast<std::size_t>(side)];
-        if (!(p.revents & (POLLIN | POLLHUP | POLLERR))) continue;
-        const int from = side == 0 ? pairs_[i].first : pairs_[i].second;
-        const int to = side == 0 ? pairs_[i].second : pairs_[i].first;
-        const ssize_t n = ::read(from, buffer, sizeof(buffer));
-        bool ok = n > 0;
-        for (ssize_t done = 0; ok && done < n;) {
-          const ssize_t w = ::write(to, buffer + done, static_cast<std::size_t>(n - done));
-          ok = w > 0;
-          done += w > 0 ? w : 0;
+        const short revents = fds[1 + 2 * i + static_cast<std::size_t>(side)].revents;
+        if (revents != 0 && !Forward(pairs_[i], side, revents)) {
+          dead.push_back(i);
+          break;
         }
-        if (!ok) dead.push_back(i);
       }
     }
-    std::sort(dead.begin(), dead.end());
-    dead.erase(std::unique(dead.begin(), dead.end()), dead.end());
     for (auto it = dead.rbegin(); it != dead.rend(); ++it) {
-      ::close(pairs_[*it].first);
-      ::close(pairs_[*it].second);
+      ::close(pairs_[*it].fd[0]);
+      ::close(pairs_[*it].fd[1]);
       pairs_.erase(pairs_.begin() + static_cast<std::ptrdiff_t>(*it));
     }
   }

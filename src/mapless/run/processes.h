@@ -44,7 +44,9 @@ class Child {
 };
 
 // Forwards 127.0.0.1:listen_port to 127.0.0.1:target_port; Down() closes every connection and
-// stops listening (connections are refused) until Up().
+// stops listening (connections are refused) until Up(). Non-blocking, with at most 64 KB held per
+// direction: a peer that stops reading holds up only its own connection's other side, never the
+// others, Down() or the destructor.
 class Relay {
  public:
   Relay(int listen_port, int target_port);
@@ -60,7 +62,12 @@ class Relay {
   int listen_port_;
   int target_port_;
   int listener_ = -1;
-  std::vector<std::pair<int, int>> pairs_;
+  struct Pair {
+    int fd[2];               // the accepted connection, the one dialled to the target
+    std::string pending[2];  // read from fd[i], not yet written to fd[1 - i]
+  };
+  bool Forward(Pair& pair, int side, short revents);
+  std::vector<Pair> pairs_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> down_{false};
   std::thread thread_;
