@@ -32,6 +32,7 @@ navigation::ObstacleWatchOptions ObstacleWatchFor(const std::string& robot_path,
     const robot::RobotFile file = robot::LoadRobotFile(robot_path);
     o = file.obstacle;
     if (!file.obstacle_baseline_given) o.baseline_m = defaults.baseline_m;
+    if (!file.obstacle_max_unchecked_given) o.max_unchecked_m = defaults.max_unchecked_m;
     from = robot_path + ": obstacles.on_obstacle";
   }
   if (!on_obstacle.empty()) {

@@ -112,6 +112,10 @@ AppearanceFollowerOptions::AppearanceFollowerOptions() {
   // the follower saw a 0.5 m box only 1 m ahead and ran into it (obstacle_box_office, 2 of 2
   // runs); with 0.12 and 0.16 it stopped 0.7-0.8 m before it (docs/appearance_route_following.md).
   obstacle.baseline_m = 0.12;
+  // Stop when the ground ahead went unchecked for 0.5 m (obstacle_watch.h): on lifelong_indoor,
+  // followed on session 19 with the route of session 0, the lost follower crept 0.75 m towards a
+  // tiled wall with too few points tracked in the region to check it, and touched it.
+  obstacle.max_unchecked_m = 0.5;
 }
 
 AppearanceFollower::AppearanceFollower(AppearanceFollowerOptions options)

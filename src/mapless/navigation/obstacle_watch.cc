@@ -118,6 +118,8 @@ void ObstacleWatchOptions::Validate() const {
                                                                << "; must be in (0, 1)");
   MAPLESS_CHECK(confirm_frames >= 1,
                 "ObstacleWatchOptions.confirm_frames = " << confirm_frames << "; must be >= 1");
+  MAPLESS_CHECK(max_unchecked_m >= 0.0,
+                "ObstacleWatchOptions.max_unchecked_m = " << max_unchecked_m << "; must be >= 0");
   MAPLESS_CHECK(free_difference > 0.0,
                 "ObstacleWatchOptions.free_difference = " << free_difference << "; must be > 0");
 }
@@ -167,6 +169,10 @@ ObstacleCheck ObstacleWatch::Update(const cv::Mat& grey, Timestamp t_ns, double 
     cv::buildOpticalFlowPyramid(grey, pyramid, cv::Size(options_.window_px, options_.window_px),
                                 options_.levels, true);
     check = Look(grey, pyramid, t_ns, known_px);
+    unchecked_m_ = check.observed ? 0.0 : unchecked_m_ + std::max(0.0, forward_m);
+    check.unchecked_m = unchecked_m_;
+    if (!blocked_ && options_.max_unchecked_m > 0.0 && unchecked_m_ > options_.max_unchecked_m)
+      StopUnchecked(grey, &check);
     if (!blocked_) {
       Frame frame{{}, t_ns, forward_m_, turned_rad_};
       for (std::size_t l = 0; l < pyramid.size(); l += 2) frame.pyramid.push_back(pyramid[l]);
@@ -186,6 +192,7 @@ ObstacleCheck ObstacleWatch::Update(const cv::Mat& grey, Timestamp t_ns, double 
 
 void ObstacleWatch::Resume() {
   blocked_ = false;
+  unchecked_m_ = 0.0;
   votes_ = 0;
   free_votes_ = 0;
   history_.clear();
@@ -318,9 +325,31 @@ void ObstacleWatch::Vote(const cv::Mat& grey, const cv::Rect& region, int obstac
     why << "obstacle ahead: " << static_cast<int>(std::lround(100.0 * check->blocked_fraction))
         << "% of the ground ahead does not move like the ground: stopped";
     check->reason = why.str();
+    std::ostringstream waiting;
+    waiting << "obstacle ahead (" << static_cast<int>(std::lround(100.0 * blocked_at_fraction_))
+            << "% of the ground ahead): stopped, waiting for the way to be free";
+    blocked_why_ = waiting.str();
     settle_ = 0;
     free_votes_ = 0;
   }
+}
+
+void ObstacleWatch::StopUnchecked(const cv::Mat& grey, ObstacleCheck* check) {
+  const cv::Rect region = Region(grey.size());
+  blocked_ = true;
+  blocked_at_fraction_ = 0.0;
+  blocked_image_ = grey.clone();
+  blocked_mask_ = cv::Mat(region.size(), CV_8UC1, cv::Scalar(255));  // the view changing frees it
+  check->blocked = true;
+  std::ostringstream why;
+  why.precision(2);
+  why << std::fixed << "the ground ahead was not checked over the last " << unchecked_m_ << " m ("
+      << check->region_points << " points tracked there, " << options_.min_region_points
+      << " needed, or the robot turned): stopped";
+  check->reason = why.str();
+  blocked_why_ = "the ground ahead could not be checked: stopped, waiting for the view to change";
+  settle_ = 0;
+  free_votes_ = 0;
 }
 
 ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, const std::vector<cv::Mat>& pyramid,
@@ -436,7 +465,7 @@ ObstacleCheck ObstacleWatch::WatchBlocked(const cv::Mat& grey) {
     // The robot is still coming to a halt: its view is the reference.
     ++settle_;
     blocked_image_ = grey.clone();
-    check.reason = "obstacle ahead: stopped";
+    check.reason = blocked_why_;
     return check;
   }
   cv::GaussianBlur(blocked_image_(region), b, cv::Size(5, 5), 0);
@@ -446,14 +475,12 @@ ObstacleCheck ObstacleWatch::WatchBlocked(const cv::Mat& grey) {
   if (free_votes_ >= options_.confirm_frames) {
     blocked_ = false;
     votes_ = 0;
+    unchecked_m_ = 0.0;
     check.blocked = false;
     check.cleared = true;
     return check;
   }
-  std::ostringstream why;
-  why << "obstacle ahead (" << static_cast<int>(std::lround(100.0 * blocked_at_fraction_))
-      << "% of the ground ahead): stopped, waiting for the way to be free";
-  check.reason = why.str();
+  check.reason = blocked_why_;
   return check;
 }
 

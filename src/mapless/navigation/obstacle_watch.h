@@ -111,6 +111,14 @@ struct ObstacleWatchOptions {
   double min_blocked_fraction = 0.15;  // of the region's points: more than this is an obstacle
   int confirm_frames = 2;              // successive checks that must agree (see above)
   double free_difference = 12.0;       // mean |grey change| where the obstacle was (grey levels)
+  // Forward motion allowed without a check that observed the region (since the last one, or the
+  // start); beyond it the watch stops the robot as for an obstacle (0: no limit, the repeat's
+  // default). A robot that weaves turns too much between frames a baseline apart, and a wall or
+  // box coming close leaves too few tracked points in the region (a tiled wall's points fail the
+  // round trip): either way nothing is checked, and a follower once crept into a wall so
+  // (docs/appearance_route_following.md). While the checks go on, each sees the ground 0.92-2.1 m
+  // ahead (the simulator's camera), so 0.5 m between two keeps the ground in front covered.
+  double max_unchecked_m = 0.0;
   void Validate() const;
 };
 
@@ -124,6 +132,7 @@ struct ObstacleCheck {
   double blocked_fraction = 0.0;  // obstacle points among them
   bool blocked = false;           // the watch holds the robot (an obstacle confirmed, not gone)
   bool cleared = false;           // this frame the obstacle was seen to be gone
+  double unchecked_m = 0.0;       // forward motion since the last observed check
   std::string reason;             // why blocked (empty when free)
   std::vector<cv::Point2f> obstacle_px;  // the obstacle points (debug pictures)
   // With avoid: every point below fit_top off the ground's plane (the region's obstacle points
@@ -170,6 +179,8 @@ class ObstacleWatch {
   // The check observed the region: the votes, and the robot blocked when they say so.
   void Vote(const cv::Mat& grey, const cv::Rect& region, int obstacle_points, ObstacleCheck* check);
   ObstacleCheck WatchBlocked(const cv::Mat& grey);
+  // The ground ahead not checked for max_unchecked_m: stop as for an obstacle over the region.
+  void StopUnchecked(const cv::Mat& grey, ObstacleCheck* check);
 
   ObstacleWatchOptions options_;
   std::deque<Frame> history_;
@@ -181,8 +192,10 @@ class ObstacleWatch {
   cv::Mat blocked_image_;  // the frame when the robot had stopped
   cv::Mat blocked_mask_;   // where the obstacle was in it (the region's size)
   double blocked_at_fraction_ = 0.0;
-  int settle_ = 0;      // frames since the stop (the first few are the reference view)
-  int free_votes_ = 0;  // successive frames with the region changed
+  int settle_ = 0;            // frames since the stop (the first few are the reference view)
+  int free_votes_ = 0;        // successive frames with the region changed
+  double unchecked_m_ = 0.0;  // forward motion since the last observed check
+  std::string blocked_why_;   // what holds the robot (WatchBlocked's reason)
 };
 
 }  // namespace mapless::navigation

@@ -117,7 +117,8 @@ void ParseTopics(const io::YamlMap& t, RobotFile* r) {
 // The section `obstacles`: the obstacle watch (navigation/obstacle_watch.h).
 void ParseObstacles(const io::YamlMap& o, RobotFile* r) {
   o.CheckKnownKeys({"on_obstacle", "region_top", "region_far_m", "region_width",
-                    "region_half_width_m", "horizon", "baseline_m", "min_blocked_fraction"});
+                    "region_half_width_m", "horizon", "baseline_m", "min_blocked_fraction",
+                    "max_unchecked_m"});
   const std::string on = o.GetString("on_obstacle", "stop");
   if (on != "stop" && on != "avoid" && on != "off")
     o.Fail("on_obstacle", "'" + on + "' is not stop, avoid or off");
@@ -143,6 +144,8 @@ void ParseObstacles(const io::YamlMap& o, RobotFile* r) {
   r->obstacle_baseline_given = o.Has("baseline_m");
   r->obstacle.min_blocked_fraction =
       fraction("min_blocked_fraction", r->obstacle.min_blocked_fraction, 0.01, 0.99);
+  r->obstacle.max_unchecked_m = fraction("max_unchecked_m", r->obstacle.max_unchecked_m, 0.0, 10.0);
+  r->obstacle_max_unchecked_given = o.Has("max_unchecked_m");
 }
 
 }  // namespace

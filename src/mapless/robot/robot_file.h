@@ -54,8 +54,9 @@ struct RobotFile {
   // the image region the robot drives through next, for this robot's camera.
   navigation::ObstacleWatchOptions obstacle;
   bool obstacle_baseline_given = false;  // obstacles.baseline_m is in the file (else each method's)
-  bool use_sim_time = false;             // ROS `use_sim_time`: the clock comes from /clock
-  double connect_timeout_s = 10.0;       // waiting for the master / the first subscriber
+  bool obstacle_max_unchecked_given = false;  // obstacles.max_unchecked_m likewise
+  bool use_sim_time = false;                  // ROS `use_sim_time`: the clock comes from /clock
+  double connect_timeout_s = 10.0;            // waiting for the master / the first subscriber
   // Threads the method may use on the robot's computer: 2 runs `repeat`'s obstacle watch beside
   // the frame's feature detection (RepeatOptions::threads), `teach`'s tracking in two halves and
   // `navigate`'s optical flow on two (FlowOptions::threads); same decisions, shorter latency.

@@ -83,6 +83,11 @@ TEST(RobotFile, ObstacleWatchSettings) {
   const RobotFile b = ParseRobotFile("obstacles: {baseline_m: 0.2}\n", "robot.yaml");
   EXPECT_TRUE(b.obstacle_baseline_given);
   EXPECT_DOUBLE_EQ(b.obstacle.baseline_m, 0.2);
+  EXPECT_FALSE(b.obstacle_max_unchecked_given);
+  const RobotFile u = ParseRobotFile("obstacles: {max_unchecked_m: 0.4}\n", "robot.yaml");
+  EXPECT_TRUE(u.obstacle_max_unchecked_given);
+  EXPECT_DOUBLE_EQ(u.obstacle.max_unchecked_m, 0.4);
+  EXPECT_THROW(ParseRobotFile("obstacles: {max_unchecked_m: -1}\n", "robot.yaml"), InputError);
   EXPECT_FALSE(ParseRobotFile("obstacles: {on_obstacle: off}\n", "robot.yaml").obstacle.enabled);
   EXPECT_FALSE(ParseRobotFile("{}\n", "robot.yaml").obstacle.avoid);
   const RobotFile a =
