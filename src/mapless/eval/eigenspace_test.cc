@@ -85,11 +85,11 @@ TEST(EigenspaceFollow, ArrivesAtARouteThatEndsBeforeABoxInsteadOfDrivingIntoIt) 
   EXPECT_TRUE(old.collided) << old.status;
 }
 
-// "Unchecked ground" in docs/appearance_route_following.md: on lifelong_indoor's session 19 the route
-// taught on session 0 no longer fits, the follower is lost and creeps towards a tiled wall; too few
-// points are tracked in the watch's region to check the ground there, and it touched the wall.
-// Stopped when the ground ahead went unchecked for max_unchecked_m, it does not reach the wall
-// (and says why); without the limit it still does.
+// "Unchecked ground" in docs/appearance_route_following.md: on lifelong_indoor's session 19 the
+// route taught on session 0 no longer fits, the follower is lost and creeps towards a tiled wall;
+// too few points are tracked in the watch's region to check the ground there, and it touched the
+// wall. Stopped when the ground ahead went unchecked for max_unchecked_m, it does not reach the
+// wall (and says why); without the limit it still does.
 TEST(EigenspaceFollow, StopsWhenTheGroundAheadGoesUncheckedInsteadOfTouchingAWall) {
   const sim::Scenario world = sim::LoadScenario("lifelong_indoor");
   EigenspaceRunOptions options;
