@@ -81,6 +81,11 @@ TEST(EigenspaceFollow, ArrivesAtARouteThatEndsBeforeABoxInsteadOfDrivingIntoIt) 
   without.seed = 1;
   without.follower.anchor_end_m = 0.0;
   without.follower.arrive_blocked_within_images = -1;
+  // With the limit on unchecked ground alone it stops before the box, but does not arrive.
+  const EigenspaceRun stopped = RunEigenspaceFollow(scenario, without);
+  EXPECT_FALSE(stopped.collided) << stopped.status;
+  EXPECT_FALSE(stopped.success) << stopped.status;
+  without.follower.obstacle.max_unchecked_m = 0.0;
   const EigenspaceRun old = RunEigenspaceFollow(scenario, without);
   EXPECT_TRUE(old.collided) << old.status;
 }
