@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 #include <sstream>
+#include <utility>
 
 #include "mapless/core/check.h"
 #include "mapless/core/rng.h"
@@ -311,43 +312,41 @@ void ObstacleWatch::Vote(const cv::Mat& grey, const cv::Rect& region, int obstac
   const bool at_once = check->blocked_fraction > options_.single_check_fraction &&
                        obstacle_points >= options_.min_obstacle_points;
   if (votes_ >= options_.confirm_frames || at_once) {
-    blocked_ = true;
-    blocked_at_fraction_ = check->blocked_fraction;
-    blocked_image_ = grey.clone();
-    blocked_mask_ = cv::Mat::zeros(region.size(), CV_8UC1);
+    cv::Mat mask = cv::Mat::zeros(region.size(), CV_8UC1);
     for (const cv::Point2f& p : check->obstacle_px) {
-      cv::circle(blocked_mask_,
+      cv::circle(mask,
                  cv::Point(static_cast<int>(p.x) - region.x, static_cast<int>(p.y) - region.y),
                  options_.grid_px, cv::Scalar(255), cv::FILLED);
     }
-    check->blocked = true;
-    std::ostringstream why;
-    why << "obstacle ahead: " << static_cast<int>(std::lround(100.0 * check->blocked_fraction))
+    const int percent = static_cast<int>(std::lround(100.0 * check->blocked_fraction));
+    std::ostringstream why, waiting;
+    why << "obstacle ahead: " << percent
         << "% of the ground ahead does not move like the ground: stopped";
-    check->reason = why.str();
-    std::ostringstream waiting;
-    waiting << "obstacle ahead (" << static_cast<int>(std::lround(100.0 * blocked_at_fraction_))
+    waiting << "obstacle ahead (" << percent
             << "% of the ground ahead): stopped, waiting for the way to be free";
-    blocked_why_ = waiting.str();
-    settle_ = 0;
-    free_votes_ = 0;
+    Hold(grey, mask, why.str(), waiting.str(), check);
   }
 }
 
 void ObstacleWatch::StopUnchecked(const cv::Mat& grey, ObstacleCheck* check) {
-  const cv::Rect region = Region(grey.size());
-  blocked_ = true;
-  blocked_at_fraction_ = 0.0;
-  blocked_image_ = grey.clone();
-  blocked_mask_ = cv::Mat(region.size(), CV_8UC1, cv::Scalar(255));  // the view changing frees it
-  check->blocked = true;
   std::ostringstream why;
   why.precision(2);
   why << std::fixed << "the ground ahead was not checked over the last " << unchecked_m_ << " m ("
       << check->region_points << " points tracked there, " << options_.min_region_points
       << " needed, or the robot turned): stopped";
-  check->reason = why.str();
-  blocked_why_ = "the ground ahead could not be checked: stopped, waiting for the view to change";
+  // The whole region: the view changing there frees it.
+  Hold(grey, cv::Mat(Region(grey.size()).size(), CV_8UC1, cv::Scalar(255)), why.str(),
+       "the ground ahead could not be checked: stopped, waiting for the view to change", check);
+}
+
+void ObstacleWatch::Hold(const cv::Mat& grey, cv::Mat mask, std::string why, std::string waiting,
+                         ObstacleCheck* check) {
+  blocked_ = true;
+  blocked_image_ = grey.clone();
+  blocked_mask_ = std::move(mask);
+  blocked_why_ = std::move(waiting);
+  check->blocked = true;
+  check->reason = std::move(why);
   settle_ = 0;
   free_votes_ = 0;
 }

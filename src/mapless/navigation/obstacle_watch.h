@@ -181,6 +181,10 @@ class ObstacleWatch {
   ObstacleCheck WatchBlocked(const cv::Mat& grey);
   // The ground ahead not checked for max_unchecked_m: stop as for an obstacle over the region.
   void StopUnchecked(const cv::Mat& grey, ObstacleCheck* check);
+  // Stops the robot: `why` for this frame, `waiting` while it stays stopped; it goes on when the
+  // view in `mask` (over the region) changes.
+  void Hold(const cv::Mat& grey, cv::Mat mask, std::string why, std::string waiting,
+            ObstacleCheck* check);
 
   ObstacleWatchOptions options_;
   std::deque<Frame> history_;
@@ -189,9 +193,8 @@ class ObstacleWatch {
   double route_left_m_ = std::numeric_limits<double>::infinity();  // this frame's (Update)
   int votes_ = 0;
   bool blocked_ = false;
-  cv::Mat blocked_image_;  // the frame when the robot had stopped
-  cv::Mat blocked_mask_;   // where the obstacle was in it (the region's size)
-  double blocked_at_fraction_ = 0.0;
+  cv::Mat blocked_image_;     // the frame when the robot had stopped
+  cv::Mat blocked_mask_;      // where the obstacle was in it (the region's size)
   int settle_ = 0;            // frames since the stop (the first few are the reference view)
   int free_votes_ = 0;        // successive frames with the region changed
   double unchecked_m_ = 0.0;  // forward motion since the last observed check
