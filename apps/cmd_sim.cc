@@ -14,6 +14,7 @@
 #include "mapless/io/journal.h"
 #include "mapless/io/output_dir.h"
 #include "mapless/io/tum.h"
+#include "mapless/sim/generator.h"
 #include "mapless/sim/world.h"
 #include "mapless/viz/topdown.h"
 #include "robot_run.h"
@@ -74,6 +75,44 @@ sim::DriveSummary DriveToDirectory(const sim::Scenario& scenario, const sim::Dri
   return summary;
 }
 
+namespace {
+
+// `mapless sim generate`: a world drawn from a seed, written as a scenario file.
+void AddGenerateCommand(CLI::App* simcmd) {
+  struct GenerateArgs {
+    sim::GenerateOptions options;
+    std::string out;
+    bool overwrite = false;
+  };
+  auto a = std::make_shared<GenerateArgs>();
+  CLI::App* cmd = simcmd->add_subcommand(
+      "generate", "Write a world drawn from a seed as a scenario file (docs/simulator.md)");
+  cmd->add_option("--seed", a->options.seed, "The world's seed")
+      ->capture_default_str()
+      ->check(SeedCheck());
+  std::string kinds;
+  for (const std::string& k : sim::GeneratorKinds()) kinds += (kinds.empty() ? "" : ", ") + k;
+  cmd->add_option("--kind", a->options.kind, "One of " + kinds + " (default: drawn from the seed)")
+      ->check(CLI::IsMember(sim::GeneratorKinds()));
+  cmd->add_option("--obstacle-share", a->options.obstacle_share,
+                  "Share of seeds whose world gets an object on the path after the teach")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--out", a->out, "The scenario file to write (.yaml)")->required();
+  cmd->add_flag("--overwrite", a->overwrite, "Replace --out when it exists");
+  cmd->callback([a] {
+    RefuseOutputOverInputs(a->out, "--out", {});
+    if (!a->overwrite && std::filesystem::exists(a->out))
+      throw InputError("--out " + a->out + ": exists (--overwrite replaces it)");
+    const std::string text = sim::GenerateScenarioYaml(a->options);
+    const sim::Scenario scenario = sim::ParseScenario(text, a->out, "");  // checks what it wrote
+    io::WriteFileAtomic(a->out, text);
+    spdlog::info("wrote {}: {}", a->out, scenario.description);
+  });
+}
+
+}  // namespace
+
 void AddSimCommands(CLI::App* app) {
   CLI::App* simcmd =
       app->add_subcommand("sim", "The built-in simulator: scenarios, renders, drives");
@@ -118,12 +157,17 @@ void AddSimCommands(CLI::App* app) {
     const sim::World world = render_args->repeat_variant
                                  ? sim::ApplyVariant(scenario.world, scenario.repeat_variant)
                                  : scenario.world;
-    sim::Simulation s(world, scenario.camera, sim::SimulationOptions{}, render_args->seed);
+    sim::CameraSpec camera = scenario.camera;
+    if (render_args->repeat_variant && scenario.repeat_effects)
+      camera.effects = *scenario.repeat_effects;
+    sim::Simulation s(world, camera, sim::SimulationOptions{}, render_args->seed);
     s.AddRobot(pose, scenario.robot);
     io::WriteImageAtomic(render_args->out, s.Render(0));
     spdlog::info("wrote {} ({}x{})", render_args->out, scenario.camera.model.width,
                  scenario.camera.model.height);
   });
+
+  AddGenerateCommand(simcmd);
 
   struct DriveArgs {
     std::string scenario;

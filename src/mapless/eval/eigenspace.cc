@@ -141,6 +141,7 @@ SimSetup FollowSimSetup(const sim::Scenario& scenario, const EigenspaceRunOption
   // What has changed since the teach (objects added or removed), as for a repeat.
   setup.world = sim::ApplyVariant(scenario.world, scenario.repeat_variant);
   setup.camera = scenario.camera;
+  if (scenario.repeat_effects) setup.camera.effects = *scenario.repeat_effects;
   setup.robot = FollowerRobot(scenario, options);
   setup.start = StartPose(scenario, options);
   setup.seed = options.seed + 7919;

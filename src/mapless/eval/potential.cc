@@ -80,6 +80,7 @@ SimSetup PotentialSimSetup(const sim::Scenario& scenario, const PotentialRunOpti
   Rng rng(options.seed);
   SimSetup setup;
   setup.camera = scenario.camera;
+  if (scenario.repeat_effects) setup.camera.effects = *scenario.repeat_effects;
   setup.camera.effects.invert_fraction =
       std::max(setup.camera.effects.invert_fraction, options.invert_fraction);
   setup.camera.effects.noise_sigma =
@@ -88,7 +89,8 @@ SimSetup PotentialSimSetup(const sim::Scenario& scenario, const PotentialRunOpti
   setup.robot.motion_noise_v_frac = options.motion_noise_frac;
   setup.robot.motion_noise_omega_frac = options.motion_noise_frac;
   setup.start = scenario.teach_start * Pose2{0.0, options.start_lateral_m, 0.0};
-  setup.world = scenario.world;
+  // What has changed since the world was described (objects put down), as for a repeat.
+  setup.world = sim::ApplyVariant(scenario.world, scenario.repeat_variant);
   setup.seed = rng.NextU64();
   return setup;
 }

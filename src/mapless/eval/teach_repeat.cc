@@ -75,6 +75,7 @@ SimSetup RepeatSimSetup(const sim::Scenario& scenario, const RepeatRunOptions& o
   Rng rng(options.seed);
   SimSetup setup;
   setup.camera = scenario.camera;
+  if (scenario.repeat_effects) setup.camera.effects = *scenario.repeat_effects;
   setup.camera.effects.noise_sigma =
       std::max(setup.camera.effects.noise_sigma, options.image_noise_sigma);
   setup.robot = scenario.robot;

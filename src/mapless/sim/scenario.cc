@@ -25,6 +25,17 @@ using yaml::PoseDeg;
 using yaml::RequirePositive;
 using yaml::Vec2;
 
+ImageEffects ParseEffects(const YamlMap& e) {
+  e.CheckKnownKeys({"noise_sigma", "invert_fraction", "gain", "bias", "blur_sigma_px"});
+  ImageEffects effects;
+  effects.noise_sigma = e.GetDouble("noise_sigma", 0.0);
+  effects.invert_fraction = e.GetDouble("invert_fraction", 0.0);
+  effects.gain = e.GetDouble("gain", 1.0);
+  effects.bias = e.GetDouble("bias", 0.0);
+  effects.blur_sigma_px = e.GetDouble("blur_sigma_px", 0.0);
+  return effects;
+}
+
 CameraSpec ParseCamera(const YamlMap& m) {
   m.CheckKnownKeys({"width", "height", "hfov_deg", "height_m", "pitch_deg", "forward_m",
                     "lateral_m", "rate_hz", "effects"});
@@ -41,15 +52,7 @@ CameraSpec ParseCamera(const YamlMap& m) {
   c.mount.forward_m = m.GetDouble("forward_m", 0.0);
   c.mount.lateral_m = m.GetDouble("lateral_m", 0.0);
   c.rate_hz = m.GetDouble("rate_hz", c.rate_hz);
-  if (m.Has("effects")) {
-    const YamlMap e = m.GetMap("effects");
-    e.CheckKnownKeys({"noise_sigma", "invert_fraction", "gain", "bias", "blur_sigma_px"});
-    c.effects.noise_sigma = e.GetDouble("noise_sigma", 0.0);
-    c.effects.invert_fraction = e.GetDouble("invert_fraction", 0.0);
-    c.effects.gain = e.GetDouble("gain", 1.0);
-    c.effects.bias = e.GetDouble("bias", 0.0);
-    c.effects.blur_sigma_px = e.GetDouble("blur_sigma_px", 0.0);
-  }
+  if (m.Has("effects")) c.effects = ParseEffects(m.GetMap("effects"));
   try {
     c.Validate();
   } catch (const InputError& e) {
@@ -210,12 +213,16 @@ static Scenario ParseScenarioUnchecked(const std::string& yaml_text, const std::
                                        const std::string& base_dir) {
   const YamlMap root = YamlMap::LoadString(yaml_text, source);
   root.CheckKnownKeys({"name", "description", "paper", "seed", "world", "camera", "robot", "teach",
-                       "repeat", "destinations", "sessions"});
+                       "repeat", "destinations", "sessions", "labels"});
   Scenario s;
   s.source = source;
   s.name = root.GetString("name", std::filesystem::path(source).stem().string());
   s.description = root.GetString("description", "");
   s.seed = static_cast<std::uint64_t>(root.GetInt("seed", 1));
+  if (root.Has("labels")) {
+    const YamlMap labels = root.GetMap("labels");
+    for (const std::string& key : labels.Keys()) s.labels[key] = labels.GetString(key);
+  }
   if (root.Has("world") && root.node()["world"].IsScalar()) {
     // A world in its own file, relative to this scenario.
     std::filesystem::path wf(root.GetString("world"));
@@ -236,8 +243,18 @@ static Scenario ParseScenarioUnchecked(const std::string& yaml_text, const std::
   s.repeat_start = s.teach_start;
   if (root.Has("repeat")) {
     const YamlMap repeat = root.GetMap("repeat");
-    repeat.CheckKnownKeys({"start", "variant"});
+    repeat.CheckKnownKeys({"start", "variant", "effects"});
     if (repeat.Has("start")) s.repeat_start = PoseDeg(repeat, "start");
+    if (repeat.Has("effects")) {
+      CameraSpec camera = s.camera;
+      camera.effects = ParseEffects(repeat.GetMap("effects"));
+      try {
+        camera.Validate();
+      } catch (const InputError& e) {
+        repeat.Fail("effects", e.what());
+      }
+      s.repeat_effects = camera.effects;
+    }
     if (repeat.Has("variant")) {
       const YamlMap v = repeat.GetMap("variant");
       v.CheckKnownKeys({"remove", "move", "add", "leave_s"});

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -55,6 +56,11 @@ struct Scenario {
   std::vector<PathStep> teach_path;
   Pose2 repeat_start;
   WorldVariant repeat_variant;
+  // The camera's effects at repeat (and follow, navigate) time instead of `camera.effects`: light
+  // that differs from the teach's (`repeat: {effects: {gain, bias, ...}}`).
+  std::optional<ImageEffects> repeat_effects;
+  // Free labels (`labels: {key: value}`): what a generated world was drawn with (generator.h).
+  std::map<std::string, std::string> labels;
   std::vector<Eigen::Vector2d> destinations;  // goals for destination-guided navigation
   std::optional<WorldChange> sessions;        // how the world changes between sessions
 
