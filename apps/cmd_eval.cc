@@ -3,16 +3,20 @@
 // JSON object {"suite", "results": [{"scenario", "controller", "runs", "successes",
 // "final_error_m_rms", ...}]} with --json, and a readable table.
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
+#include <mutex>
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
 #include "interrupt.h"
 #include "mapless/core/check.h"
 #include "mapless/run/fleet_eval.h"
+#include "mapless/run/generated_suite.h"
 #include "mapless/run/report.h"
 #include "mapless/run/suites.h"
 #include "progress.h"
@@ -139,6 +143,84 @@ void AddFleetEvalOptions(CLI::App* eval, run::FleetEvalOptions* a) {
   eval->add_option("--keep", a->keep, "keep the routes and logs in this directory");
 }
 
+// A directory that will be written later: it must be a directory, or not exist yet under a
+// writable one.
+void CheckWritableDir(const std::string& dir, const std::string& option) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path p = fs::absolute(dir, ec);
+  if (fs::exists(p, ec) && !fs::is_directory(p, ec))
+    throw InputError(option + " " + dir + ": is not a directory");
+  while (!p.empty() && !fs::exists(p, ec) && p != p.parent_path()) p = p.parent_path();
+  if (::access(p.c_str(), W_OK | X_OK) != 0)
+    throw InputError(option + " " + dir + ": " + p.string() + " is not writable");
+}
+
+// `mapless eval generated`: one method on generated worlds (or on world files, to replay one).
+void AddGeneratedSuite(CLI::App* eval) {
+  struct Args {
+    run::GeneratedSuiteOptions suite;
+    bool json = false;
+    bool failures_set = false;
+  };
+  auto a = std::make_shared<Args>();
+  CLI::App* cmd = eval->add_subcommand(
+      "generated", "One method on worlds drawn from seeds (mapless sim generate), each run once");
+  cmd->add_option("--method", a->suite.method, "funnel, eigenspace or potential")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"funnel", "eigenspace", "potential"}));
+  cmd->add_option("--worlds", a->suite.worlds, "Worlds, generated from seeds seed .. seed + N - 1")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 10000));
+  cmd->add_option("--seed", a->suite.seed, "First world's seed (also the run's noise seed)")
+      ->capture_default_str()
+      ->check(SeedCheck());
+  cmd->add_option("--kind", a->suite.kind, "Only worlds of this kind (default: drawn per seed)")
+      ->check(CLI::IsMember(sim::GeneratorKinds()));
+  cmd->add_option("--world", a->suite.world_files,
+                  "Run these scenario files instead (a failure's world: replay it with its seed)");
+  cmd->add_option("--jobs", a->suite.jobs, "Worlds evaluated in parallel")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 64));
+  cmd->add_option("--max-blocked", a->suite.max_blocked_s,
+                  "A stop that does not clear ends the run after this many seconds")
+      ->capture_default_str()
+      ->check(FiniteIn(1.0, 3600.0));
+  cmd->add_option("--failures", a->suite.failures_dir,
+                  "Directory for the worlds of failed runs (created when there is one)")
+      ->capture_default_str();
+  cmd->add_flag("--json", a->json, "Print one JSON object (the table goes to stderr)");
+  cmd->add_option("--report", a->suite.report_dir,
+                  "Write an HTML report (index.html, PNG plots, every world's file) here");
+  cmd->callback([a] {
+    run::GeneratedSuiteOptions o = a->suite;
+    for (const std::string& f : o.world_files) sim::LoadScenario(f);  // bad input before any work
+    if (!o.report_dir.empty()) {
+      RefuseOutputOverInputs(o.report_dir, "--report", o.world_files);
+      run::CheckReportDir(o.report_dir, "--report");
+    }
+    if (!o.failures_dir.empty()) {
+      RefuseOutputOverInputs(o.failures_dir, "--failures", o.world_files);
+      CheckWritableDir(o.failures_dir, "--failures");
+    }
+    std::unique_ptr<Progress> progress;
+    const auto start = std::chrono::steady_clock::now();
+    o.on_start = [&progress, start](int total) {
+      progress = std::make_unique<Progress>("eval", total, start);
+    };
+    std::mutex mutex;
+    o.on_entry_done = [&progress, &mutex](const std::string& line) {
+      const std::lock_guard<std::mutex> lock(mutex);
+      spdlog::info("eval: {}", line);
+      progress->Done();
+    };
+    const run::SuiteOutput out = run::RunGeneratedSuite(o);
+    progress.reset();
+    Print(out, a->json);
+    if (!o.report_dir.empty()) spdlog::info("eval: report in {}/index.html", o.report_dir);
+  });
+}
+
 }  // namespace
 
 void AddEvalCommand(CLI::App* app) {
@@ -150,6 +232,7 @@ void AddEvalCommand(CLI::App* app) {
                  "The funnel-lane repeat on the held-out scenarios (indoor, outdoor, aliasing)");
   AddRepeatSuite(eval, "obstacles",
                  "The funnel-lane repeat with objects put on the route at repeat time");
+  AddGeneratedSuite(eval);
   auto potential = std::make_shared<SuiteArgs>();
   CLI::App* p = eval->add_subcommand(
       "potential", "Ohnishi & Imiya, Section 5: corridors, obstacles, destinations and homing");

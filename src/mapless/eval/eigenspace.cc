@@ -227,7 +227,7 @@ EigenspaceRun RunEigenspaceFollow(const sim::Scenario& scenario,
     const sim::World added = ObjectsAddedAtRepeat(scenario);
     bool was_blocked = false;
     const robot::LoopResult result = robot::RunLoop(
-        method, link, robot::LoopOptions{},
+        method, link, BlockedLoop(options.max_blocked_s),
         [&](const robot::Observation& obs, const robot::Decision& decision) {
           const auto& step = decision.DetailAs<robot::FollowerDetail>()->step;
           const Pose2 truth = link.truth();

@@ -44,6 +44,9 @@ struct EigenspaceRunOptions {
   double converged_lateral_m = 0.15;
   double arrive_tolerance_m = 0.6;  // success: arrived within this distance of the route end
   double timeout_factor = 3.0;      // give up after this many times the nominal duration
+  // A stop that does not clear (an obstacle that stays, ground that cannot be checked) ends the
+  // run after this long, as a robot file's safety.max_blocked_s does on a robot (0: never).
+  double max_blocked_s = 60.0;
   std::vector<sim::CameraFaultWindow> camera_faults;  // the follower's camera (sim/camera_faults.h)
   navigation::AppearanceLeaderOptions leader;
   navigation::AppearanceFollowerOptions follower;

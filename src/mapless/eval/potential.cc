@@ -131,7 +131,8 @@ PotentialRun RunPotential(const sim::Scenario& scenario,
   PotentialRun run;
   bool passed_end = false;
   const robot::LoopResult result = robot::RunLoop(
-      method, wrapped ? *wrapped : static_cast<robot::RobotLink&>(link), robot::LoopOptions{},
+      method, wrapped ? *wrapped : static_cast<robot::RobotLink&>(link),
+      BlockedLoop(options.max_blocked_s),
       [&](const robot::Observation& obs, const robot::Decision& decision) {
         const auto& step = decision.DetailAs<robot::PotentialDetail>()->step;
         const Pose2 pose = link.truth();

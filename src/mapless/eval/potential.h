@@ -38,6 +38,9 @@ struct PotentialRunOptions {
   bool homing = false;            // return to the start after the destination
   double timeout_factor = 3.0;    // of the path length at T_m (destination and back for homing)
   double success_radius_m = 0.3;  // final distance to the goal (the issue: 0.3 m)
+  // A stop that does not clear (an obstacle that stays, ground that cannot be checked) ends the
+  // run after this long, as a robot file's safety.max_blocked_s does on a robot (0: never).
+  double max_blocked_s = 60.0;
   std::vector<sim::CameraFaultWindow> camera_faults;  // hardening tests (sim/camera_faults.h)
   std::uint64_t seed = 1;
   robot::LinkWrapper wrap_link;  // between the loop and the simulator (a recording)

@@ -28,6 +28,12 @@ double RepeatSpeedFor(const sim::Scenario& scenario, double cap_mps) {
   return std::min(scenario.teach_speed_mps, std::max(cap_mps, 0.5 * scenario.teach_speed_mps));
 }
 
+robot::LoopOptions BlockedLoop(double max_blocked_s) {
+  robot::LoopOptions loop;
+  loop.max_blocked_s = max_blocked_s;
+  return loop;
+}
+
 double DistanceToPath(const std::vector<Pose2>& path, double x_m, double y_m) {
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i + 1 < path.size(); ++i) {
@@ -106,15 +112,16 @@ RepeatRun RepeatOnSimulator(const sim::Scenario& scenario, const TaughtRoute& ta
   const std::unique_ptr<robot::RobotLink> wrapped =
       options.wrap_link ? options.wrap_link(link) : nullptr;
   RepeatRun run;
-  const robot::LoopResult result = robot::RunLoop(
-      method, wrapped ? *wrapped : static_cast<robot::RobotLink&>(link), robot::LoopOptions{},
-      [&](const robot::Observation& obs, const robot::Decision& decision) {
-        const auto& step = decision.DetailAs<robot::RepeatDetail>()->step;
-        run.path.push_back(link.truth());
-        if (observer) observer(link.truth(), obs.image, step);
-        run.steps.push_back(step);
-        return true;
-      });
+  const robot::LoopResult result =
+      robot::RunLoop(method, wrapped ? *wrapped : static_cast<robot::RobotLink&>(link),
+                     BlockedLoop(options.max_blocked_s),
+                     [&](const robot::Observation& obs, const robot::Decision& decision) {
+                       const auto& step = decision.DetailAs<robot::RepeatDetail>()->step;
+                       run.path.push_back(link.truth());
+                       if (observer) observer(link.truth(), obs.image, step);
+                       run.steps.push_back(step);
+                       return true;
+                     });
   if (navigation::RepeatSession* session = method.session()) {
     run.learned = session->TakeLearned();
     run.used_views = session->used_views();

@@ -9,6 +9,7 @@
 
 #include "mapless/navigation/repeat.h"
 #include "mapless/navigation/teach.h"
+#include "mapless/robot/loop.h"
 #include "mapless/robot/sim_link.h"
 #include "mapless/sim/camera_faults.h"
 #include "mapless/sim/scenario.h"
@@ -35,6 +36,9 @@ struct RepeatRunOptions {
   double timeout_factor = 3.0;        // of the taught duration
   double max_repeat_speed_mps = 0.2;  // suites: repeat at the teach speed, at most this
   double success_radius_m = 0.5;      // final pose within this of the taught end
+  // A stop that does not clear (an obstacle that stays, ground that cannot be checked) ends the
+  // run after this long, as a robot file's safety.max_blocked_s does on a robot (0: never).
+  double max_blocked_s = 60.0;
   std::vector<sim::CameraFaultWindow> camera_faults;  // hardening tests (sim/camera_faults.h)
   std::uint64_t seed = 1;
   robot::LinkWrapper wrap_link;  // between the loop and the simulator (a recording)
@@ -81,6 +85,9 @@ double RepeatSpeedFor(const sim::Scenario& scenario, double cap_mps);
 
 // Why a closed-loop run on the simulator must end now (robot/sim_link.h).
 using robot::SimulationStop;
+
+// The loop of a run on the simulator: no limits but the time a stop may last.
+robot::LoopOptions BlockedLoop(double max_blocked_s);
 
 // Distance from a point to a polyline (the taught path).
 double DistanceToPath(const std::vector<Pose2>& path, double x_m, double y_m);
