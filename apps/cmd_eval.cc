@@ -161,7 +161,7 @@ void AddGeneratedSuite(CLI::App* eval) {
   struct Args {
     run::GeneratedSuiteOptions suite;
     bool json = false;
-    bool failures_set = false;
+    std::string on_obstacle = "stop";
   };
   auto a = std::make_shared<Args>();
   CLI::App* cmd = eval->add_subcommand(
@@ -186,6 +186,10 @@ void AddGeneratedSuite(CLI::App* eval) {
                   "A stop that does not clear ends the run after this many seconds")
       ->capture_default_str()
       ->check(FiniteIn(1.0, 3600.0));
+  cmd->add_option("--on-obstacle", a->on_obstacle,
+                  "The obstacle watch of the repeat and the follower: stop, or off (the papers')")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"stop", "off"}));
   cmd->add_option("--failures", a->suite.failures_dir,
                   "Directory for the worlds of failed runs (created when there is one)")
       ->capture_default_str();
@@ -194,6 +198,7 @@ void AddGeneratedSuite(CLI::App* eval) {
                   "Write an HTML report (index.html, PNG plots, every world's file) here");
   cmd->callback([a] {
     run::GeneratedSuiteOptions o = a->suite;
+    o.watch = a->on_obstacle == "stop";
     for (const std::string& f : o.world_files) sim::LoadScenario(f);  // bad input before any work
     if (!o.report_dir.empty()) {
       RefuseOutputOverInputs(o.report_dir, "--report", o.world_files);

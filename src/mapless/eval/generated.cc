@@ -67,6 +67,7 @@ void RunFunnel(const sim::Scenario& scenario, const GeneratedRunOptions& options
   RepeatRunOptions o;
   o.seed = options.seed;
   o.max_blocked_s = options.max_blocked_s;
+  o.repeat.obstacle.enabled = options.watch;
   const double speed = RepeatSpeedFor(scenario, o.max_repeat_speed_mps);
   o.repeat.sloped.max_speed_mps = speed;
   o.repeat.standard.forward_speed_mps = speed;
@@ -96,6 +97,7 @@ void RunFollower(const sim::Scenario& scenario, const GeneratedRunOptions& optio
   o.seed = options.seed;
   o.motion_noise = 0.1;
   o.max_blocked_s = options.max_blocked_s;
+  o.follower.obstacle.enabled = options.watch;
   StopRecorder stops(scenario, options);
   const EigenspaceRun run =
       RunEigenspaceFollow(scenario, o, [&](const navigation::FollowerStep& s, const Pose2& truth) {

@@ -31,6 +31,7 @@ struct GeneratedRunOptions {
   std::uint64_t seed = 1;         // noise and start perturbation
   double max_blocked_s = 30.0;    // a stop that does not clear ends the run after this long
   double obstacle_near_m = 1.5;   // a stop with an added object this near is before an obstacle
+  bool watch = true;              // the obstacle watch (funnel, eigenspace); false: the papers'
   void Validate() const;
 };
 

@@ -92,6 +92,13 @@ void AppearanceFollowerOptions::Validate() const {
   MAPLESS_CHECK(recover_images >= 0, "AppearanceFollowerOptions.recover_images = "
                                          << recover_images << "; must be >= 0");
   carry_on.Validate();
+  MAPLESS_CHECK(turn_in_place_min_rad > 0.0 && turn_in_place_max_m >= 0.0 &&
+                    turn_in_place_tolerance_rad > 0.0 && turn_in_place_rate_radps > 0.0,
+                "AppearanceFollowerOptions.turn_in_place_min_rad = "
+                    << turn_in_place_min_rad << ", turn_in_place_max_m = " << turn_in_place_max_m
+                    << ", turn_in_place_tolerance_rad = " << turn_in_place_tolerance_rad
+                    << ", turn_in_place_rate_radps = " << turn_in_place_rate_radps
+                    << "; must be > 0, >= 0, > 0 and > 0");
   experiences.Validate();
 }
 
@@ -248,6 +255,12 @@ FollowerStep AppearanceFollower::Update(const cv::Mat& image, const Pose2& odome
       step.reason = obstacle.reason;
     } else {
       step = Decide(image, odometry, route);
+      if (obstacle.creeping && step.state == FollowerState::kFollowing) {
+        // Straight ahead, slowly, until the watch has checked the ground (obstacle_watch.h); the
+        // follower goes on localizing meanwhile.
+        step.command = Twist2{options_.obstacle.creep_speed_mps, 0.0};
+        step.reason = obstacle.reason;
+      }
     }
     step.obstacle = obstacle;
   }
@@ -402,6 +415,12 @@ FollowerStep AppearanceFollower::Decide(const cv::Mat& image, const Pose2& odome
                   " still being taught";
     return step;
   }
+  if (const std::optional<Twist2> turn = TurnInPlace(odometry, route, &step)) {
+    stopped_frames_ = 0;
+    step.state = FollowerState::kFollowing;
+    step.command = *turn;
+    return step;
+  }
   // Steer towards the route image lookahead_images ahead; when its sub-windows give no
   // consistent fit, try its neighbours (the localization is good to about one image), then the
   // route images beyond them (recovery), then carry on along the leader's odometry.
@@ -431,6 +450,13 @@ FollowerStep AppearanceFollower::Decide(const cv::Mat& image, const Pose2& odome
   stopped_frames_ = 0;
   step.state = FollowerState::kFollowing;
   step.command = step.steering.twist;
+  if (options_.leader_turn_feedforward > 0.0) {
+    const double kappa = LeaderCurvature(route, step.index, ahead);
+    const double limit = options_.steering.max_turn_rate_radps;
+    step.command.omega_radps = std::clamp(
+        step.command.omega_radps + options_.leader_turn_feedforward * step.command.v_mps * kappa,
+        -limit, limit);
+  }
   MaybeLearn(image, low, route, recovered, &step);
   heading_offsets_.push_back(WrapAngle(
       odometry.theta_rad - route.images[static_cast<std::size_t>(step.index)]->odometry.theta_rad));

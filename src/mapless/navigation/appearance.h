@@ -178,6 +178,24 @@ struct AppearanceFollowerOptions {
   int recover_images = 10;
   int carry_on_heading_frames = 60;
   control::TaughtPathOptions carry_on;
+  // Turns in place (not in the paper): where the leader turned by turn_in_place_min_rad or more
+  // while driving less than turn_in_place_max_m, its route images (one every
+  // AppearanceLeaderOptions::image_turn_rad) are views from one spot, which the sub-window
+  // steering cannot follow (it steers a few degrees at a time while driving on, past the corner:
+  // generated worlds with a turn in place, 6 of 19 failures with the watch off). Once localized
+  // at such a place, the follower turns in place by odometry to the leader's heading after the
+  // turn (the leader's turn, corrected by the follower's mean heading offset over the last frames
+  // of following), within turn_in_place_tolerance_rad, then follows the images again.
+  double turn_in_place_min_rad = 0.5;
+  double turn_in_place_max_m = 0.1;
+  double turn_in_place_tolerance_rad = 0.05;
+  double turn_in_place_rate_radps = 0.5;
+  // Feed-forward (not in the paper): the leader's own turning between the follower's place and
+  // the image it steers towards, as a curvature (heading change over odometry distance), times
+  // the commanded speed and this factor, is added to the sub-window steering's turn rate. The
+  // images alone turned too late on curves: on a generated car park's 90 degree turn of 1.3 m
+  // radius the follower's heading lagged the leader's until it left the route. 0: the paper's.
+  double leader_turn_feedforward = 1.0;
   CameraCheckOptions camera;  // camera faults: stop until the images are usable again
   // Experiences (issue 45; appearance_experiences.h): learn views of the places whose appearance
   // has changed (learned(), used_views(): the caller writes them into the route). Off by default
@@ -287,6 +305,21 @@ class AppearanceFollower {
   double anchor_driven_m_ = 0.0;  // ... and driven_m_ when it was reached
   std::optional<control::TaughtPathPursuit> carrying_;
   bool carry_given_up_ = false;  // until the next fit or localization
+  // A turn in place taught at the route images up to `through` (appearance_turn.cc): turning to
+  // target_theta_rad (follower odometry) while active; the images up to `through` are done.
+  struct TaughtTurn {
+    bool active = false;
+    int through = -1;
+    double target_theta_rad = 0.0;     // unwrapped: a turn may be more than half a circle
+    double unwrapped_theta_rad = 0.0;  // the follower's heading, unwrapped since the turn began
+    double last_theta_rad = 0.0;
+  };
+  TaughtTurn turn_;
+  // The command of a taught turn in place at the follower's place (step->index), or nullopt.
+  std::optional<Twist2> TurnInPlace(const Pose2& odometry, const route::AppearanceRoute& route,
+                                    FollowerStep* step);
+  // The leader's curvature from route image `from` to `to` (0 over less than 5 cm).
+  static double LeaderCurvature(const route::AppearanceRoute& route, int from, int to);
   // Heading of the follower minus the leader's at its route image, over the last frames of
   // following (carry_on_heading_frames).
   std::deque<double> heading_offsets_;

@@ -121,6 +121,17 @@ void ObstacleWatchOptions::Validate() const {
                 "ObstacleWatchOptions.confirm_frames = " << confirm_frames << "; must be >= 1");
   MAPLESS_CHECK(max_unchecked_m >= 0.0,
                 "ObstacleWatchOptions.max_unchecked_m = " << max_unchecked_m << "; must be >= 0");
+  MAPLESS_CHECK(noise_eigen_factor >= 0.0, "ObstacleWatchOptions.noise_eigen_factor = "
+                                               << noise_eigen_factor << "; must be >= 0");
+  MAPLESS_CHECK(creep_m >= 0.0, "ObstacleWatchOptions.creep_m = " << creep_m << "; must be >= 0");
+  MAPLESS_CHECK(creep_m == 0.0 || creep_speed_mps * max_age_s > baseline_m,
+                "ObstacleWatchOptions.creep_speed_mps = "
+                    << creep_speed_mps << "; must cover baseline_m (" << baseline_m
+                    << ") within max_age_s (" << max_age_s << ")");
+  MAPLESS_CHECK(curvature_window_m >= 0.0 && max_curvature_per_m > 0.0,
+                "ObstacleWatchOptions.curvature_window_m = "
+                    << curvature_window_m << ", max_curvature_per_m = " << max_curvature_per_m
+                    << "; must be >= 0 and > 0");
   MAPLESS_CHECK(free_difference > 0.0,
                 "ObstacleWatchOptions.free_difference = " << free_difference << "; must be > 0");
 }
@@ -144,9 +155,14 @@ bool ObstacleWatch::InRegion(cv::Point2f p, cv::Size size) const {
   if (p.y < horizon + (options_.region_top * size.height - horizon) * options_.region_far_m /
                           route_left_m_)
     return false;
-  const double half =
-      0.5 * options_.region_width * size.width * (p.y - horizon) / (size.height - horizon);
-  return std::abs(p.x - 0.5 * size.width) <= half;
+  const double below = p.y - horizon;
+  const double half = 0.5 * options_.region_width * size.width * below / (size.height - horizon);
+  // The strip bends with the path: at distance d ahead it is curvature * d^2 / 2 to the side
+  // (metres), half / region_half_width_m pixels a metre on this row.
+  const double d = options_.region_far_m * (options_.region_top * size.height - horizon) / below;
+  const double centre =
+      0.5 * size.width - curvature_ * 0.5 * d * d * half / options_.region_half_width_m;
+  return std::abs(p.x - centre) <= half;
 }
 
 ObstacleCheck ObstacleWatch::Update(const cv::Mat& grey, Timestamp t_ns, double forward_m,
@@ -169,11 +185,10 @@ ObstacleCheck ObstacleWatch::Update(const cv::Mat& grey, Timestamp t_ns, double 
     std::vector<cv::Mat> pyramid;
     cv::buildOpticalFlowPyramid(grey, pyramid, cv::Size(options_.window_px, options_.window_px),
                                 options_.levels, true);
+    curvature_ = Curvature();
+    min_eigen_ = MinEigen(grey);
     check = Look(grey, pyramid, t_ns, known_px);
-    unchecked_m_ = check.observed ? 0.0 : unchecked_m_ + std::max(0.0, forward_m);
-    check.unchecked_m = unchecked_m_;
-    if (!blocked_ && options_.max_unchecked_m > 0.0 && unchecked_m_ > options_.max_unchecked_m)
-      StopUnchecked(grey, &check);
+    Unchecked(grey, forward_m, &check);
     if (!blocked_) {
       Frame frame{{}, t_ns, forward_m_, turned_rad_};
       for (std::size_t l = 0; l < pyramid.size(); l += 2) frame.pyramid.push_back(pyramid[l]);
@@ -193,6 +208,7 @@ ObstacleCheck ObstacleWatch::Update(const cv::Mat& grey, Timestamp t_ns, double 
 
 void ObstacleWatch::Resume() {
   blocked_ = false;
+  creeping_ = false;
   unchecked_m_ = 0.0;
   votes_ = 0;
   free_votes_ = 0;
@@ -328,12 +344,45 @@ void ObstacleWatch::Vote(const cv::Mat& grey, const cv::Rect& region, int obstac
   }
 }
 
+void ObstacleWatch::Unchecked(const cv::Mat& grey, double forward_m, ObstacleCheck* check) {
+  unchecked_m_ = check->observed ? 0.0 : unchecked_m_ + std::max(0.0, forward_m);
+  check->unchecked_m = unchecked_m_;
+  if (creeping_) {
+    crept_m_ += std::max(0.0, forward_m);
+    if (check->observed || blocked_) {
+      creeping_ = false;  // the check had its say
+    } else if (crept_m_ > options_.creep_m) {
+      creeping_ = false;
+      StopUnchecked(grey, check);
+    }
+  } else if (!blocked_ && options_.max_unchecked_m > 0.0 &&
+             unchecked_m_ > options_.max_unchecked_m) {
+    if (options_.creep_m > 0.0) {
+      creeping_ = true;
+      crept_m_ = 0.0;
+    } else {
+      StopUnchecked(grey, check);
+    }
+  }
+  if (creeping_) {
+    std::ostringstream why;
+    why.precision(2);
+    why << std::fixed << "the ground ahead was not checked over the last " << unchecked_m_
+        << " m: creeping straight ahead to check it (" << crept_m_ << " of " << options_.creep_m
+        << " m)";
+    check->creeping = true;
+    check->reason = why.str();
+  }
+}
+
 void ObstacleWatch::StopUnchecked(const cv::Mat& grey, ObstacleCheck* check) {
   std::ostringstream why;
   why.precision(2);
   why << std::fixed << "the ground ahead was not checked over the last " << unchecked_m_ << " m ("
       << check->region_points << " points tracked there, " << options_.min_region_points
-      << " needed, or the robot turned): stopped";
+      << " needed"
+      << (options_.creep_m > 0.0 ? ", also creeping straight ahead" : ", or the robot turned")
+      << "): stopped";
   // The whole region: the view changing there frees it.
   Hold(grey, cv::Mat(Region(grey.size()).size(), CV_8UC1, cv::Scalar(255)), why.str(),
        "the ground ahead could not be checked: stopped, waiting for the view to change", check);
@@ -375,7 +424,7 @@ ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, const std::vector<cv::Mat
   const cv::Size window(options_.window_px, options_.window_px);
   const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.03);
   cv::calcOpticalFlowPyrLK(pyramid, earlier->pyramid, grid, moved, ok, err, window, options_.levels,
-                           stop, 0, options_.min_eigen);
+                           stop, 0, min_eigen_);
   const double fit_row = options_.fit_top * size.height;
   const double draw_row = options_.draw_top * size.height;
   std::vector<cv::Point2f> here, there;  // the tracked points below fit_top
@@ -428,7 +477,7 @@ ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, const std::vector<cv::Mat
     std::vector<cv::Point2f> back;
     std::vector<uchar> ok_back;
     cv::calcOpticalFlowPyrLK(earlier->pyramid, pyramid, candidates_there, back, ok_back, err,
-                             window, options_.levels, stop, 0, options_.min_eigen);
+                             window, options_.levels, stop, 0, min_eigen_);
     for (std::size_t c = 0; c < candidates.size(); ++c) {
       const bool right =
           ok_back[c] && cv::norm(back[c] - candidates[c]) <= options_.max_round_trip_px;
@@ -443,6 +492,8 @@ ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, const std::vector<cv::Mat
     }
   }
   check.region_points = region_points;
+  check.curvature_per_m = curvature_;
+  check.min_eigen = min_eigen_;
   if (check.region_points < options_.min_region_points &&
       obstacle_points < options_.min_obstacle_points)
     return check;

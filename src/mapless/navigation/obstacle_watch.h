@@ -87,8 +87,16 @@ struct ObstacleWatchOptions {
   double max_round_trip_px = 0.5;  // forward-backward tracking error allowed
   // Texture a tracked point needs: the smaller eigenvalue of its window's gradient matrix per
   // pixel (OpenCV's minEigThreshold). On a plain floor the image noise alone tracks "well" both
-  // ways; it must not count as flow.
-  double min_eigen = 5e-3;
+  // ways; it must not count as flow. So the threshold follows the frame's own noise: at least
+  // noise_eigen_factor times the eigenvalue that noise of the frame's level gives (the median over
+  // windows of pure Gaussian noise of sigma grey levels is 1.87e-4 sigma^2, the largest about
+  // twice that; sigma is estimated on every frame from the lower image, Immerkaer's Laplacian
+  // difference with a median), and never below min_eigen. With the suites' image noise (sigma 2)
+  // that is 5e-3, the fixed threshold this replaced; on a clean camera it lets weaker floors be
+  // checked (a generated floor of half contrast: 50 tracked points of 330 with 5e-3, too few to
+  // find the ground; 350 with 1e-3, 90% of the bottom rows on one plane).
+  double min_eigen = 5e-4;
+  double noise_eigen_factor = 6.7;
   double ransac_px = 1.0;  // RANSAC inlier threshold of the ground fit, pixels
   // A point is an obstacle point when it is farther than tolerance_px + tolerance_relative *
   // |its flow| from where the ground's homography puts it.
@@ -119,6 +127,22 @@ struct ObstacleWatchOptions {
   // (docs/appearance_route_following.md). While the checks go on, each sees the ground 0.92-2.1 m
   // ahead (the simulator's camera), so 0.5 m between two keeps the ground in front covered.
   double max_unchecked_m = 0.0;
+  // When max_unchecked_m is reached, the watch first lets the robot creep straight ahead at
+  // creep_speed_mps for at most creep_m (ObstacleCheck::creeping: the caller drives so): straight
+  // motion gives the check its baseline, and a check that then observes the region ends the creep
+  // (it stops the robot if something is there). Only when the creep did not let it check either
+  // does the robot stop, saying so (0: stop at once). The creep must cover a baseline within
+  // max_age_s. The ground 0.92-2.1 m ahead was seen before the creep began, so a creep of 0.3 m
+  // after 0.5 m unchecked stays on ground that was in view.
+  double creep_m = 0.3;
+  double creep_speed_mps = 0.1;
+  // The region bends with the robot's path: the curvature driven over the last
+  // curvature_window_m (heading change over distance) continued ahead, so that on a curve the
+  // strip is the ground the robot will drive over, not the ground straight ahead (a follower at the
+  // end of a hairpin stopped for a pillar straight ahead of it, its path turning away). 0: a
+  // straight strip.
+  double curvature_window_m = 0.3;
+  double max_curvature_per_m = 2.5;  // the bend's curvature is clamped to this (1 / 0.4 m)
   void Validate() const;
 };
 
@@ -133,7 +157,11 @@ struct ObstacleCheck {
   bool blocked = false;           // the watch holds the robot (an obstacle confirmed, not gone)
   bool cleared = false;           // this frame the obstacle was seen to be gone
   double unchecked_m = 0.0;       // forward motion since the last observed check
-  std::string reason;             // why blocked (empty when free)
+  // Creeping straight ahead to check the ground (creep_m): drive at creep_speed_mps, no turning.
+  bool creeping = false;
+  double curvature_per_m = 0.0;          // the region's bend (positive: to the left)
+  double min_eigen = 0.0;                // the texture threshold used on this frame (min_eigen)
+  std::string reason;                    // why blocked (empty when free)
   std::vector<cv::Point2f> obstacle_px;  // the obstacle points (debug pictures)
   // With avoid: every point below fit_top off the ground's plane (the region's obstacle points
   // and those beside it: the obstacle's extent, walls), for going round.
@@ -179,8 +207,15 @@ class ObstacleWatch {
   // The check observed the region: the votes, and the robot blocked when they say so.
   void Vote(const cv::Mat& grey, const cv::Rect& region, int obstacle_points, ObstacleCheck* check);
   ObstacleCheck WatchBlocked(const cv::Mat& grey);
-  // The ground ahead not checked for max_unchecked_m: stop as for an obstacle over the region.
+  // The ground ahead not checked for max_unchecked_m (and, with creep_m, not while creeping
+  // either): stop as for an obstacle over the region.
   void StopUnchecked(const cv::Mat& grey, ObstacleCheck* check);
+  // After Look: the unchecked distance, and the creep or the stop when it is too long.
+  void Unchecked(const cv::Mat& grey, double forward_m, ObstacleCheck* check);
+  // The curvature driven over the last curvature_window_m (history_), and this frame's texture
+  // threshold from its noise (obstacle_watch_region.cc).
+  double Curvature() const;
+  double MinEigen(const cv::Mat& grey) const;
   // Stops the robot: `why` for this frame, `waiting` while it stays stopped; it goes on when the
   // view in `mask` (over the region) changes.
   void Hold(const cv::Mat& grey, cv::Mat mask, std::string why, std::string waiting,
@@ -198,7 +233,11 @@ class ObstacleWatch {
   int settle_ = 0;            // frames since the stop (the first few are the reference view)
   int free_votes_ = 0;        // successive frames with the region changed
   double unchecked_m_ = 0.0;  // forward motion since the last observed check
-  std::string blocked_why_;   // what holds the robot (WatchBlocked's reason)
+  bool creeping_ = false;     // creeping to check the ground (creep_m)
+  double crept_m_ = 0.0;
+  double curvature_ = 0.0;   // the region's bend on this frame (Curvature)
+  double min_eigen_ = 0.0;   // the texture threshold on this frame (MinEigen)
+  std::string blocked_why_;  // what holds the robot (WatchBlocked's reason)
 };
 
 }  // namespace mapless::navigation

@@ -258,6 +258,11 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns,
       if (obstacle.cleared && waiting_) waiting_since_ns_ = t_ns;
       if (obstacle.cleared && short_since_ns_) short_since_ns_ = t_ns;
       step = Decide(grey, t_ns);
+      if (obstacle.creeping && step.status == RepeatStatus::kDriving) {
+        // Straight ahead, slowly, until the watch has checked the ground (obstacle_watch.h).
+        step.command = Twist2{options_.obstacle.creep_speed_mps, 0.0};
+        step.reason = obstacle.reason;
+      }
       step.current_px = current_px_;
       step.destination_px = destination_px_;
     }

@@ -165,6 +165,7 @@ SuiteOutput RunGeneratedSuite(const GeneratedSuiteOptions& options) {
   eval::GeneratedRunOptions run_options;
   run_options.method = options.method;
   run_options.max_blocked_s = options.max_blocked_s;
+  run_options.watch = options.watch;
   run_options.Validate();
   MAPLESS_CHECK(options.worlds >= 1 || !options.world_files.empty(),
                 "GeneratedSuiteOptions.worlds = " << options.worlds << "; must be >= 1");
@@ -206,6 +207,7 @@ SuiteOutput RunGeneratedSuite(const GeneratedSuiteOptions& options) {
                       {"seed", options.seed},
                       {"kind", options.kind},
                       {"max_blocked_s", options.max_blocked_s},
+                      {"on_obstacle", options.watch ? "stop" : "off"},
                       {"results", nlohmann::json::array()}};
   std::string table;
   Appendf(&table, "%-22s %-9s %-4s %-4s %-19s %5s %6s %7s  %s\n", "world", "kind", "feas", "obst",

@@ -24,6 +24,7 @@ struct GeneratedSuiteOptions {
   // A stop that does not clear ends a run after this long (the worlds' objects never leave, so a
   // stop before one would last for ever; a robot file's default is 60 s).
   double max_blocked_s = 30.0;
+  bool watch = true;  // the obstacle watch (--on-obstacle stop); false: off, the papers' methods
   std::string failures_dir = "generated_failures";  // the failures' worlds go here
   std::string report_dir;                           // "" : no report
   std::function<void(int total)> on_start;

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -199,8 +200,12 @@ void WriteSuiteReport(const std::string& dir, const std::string& suite, int runs
     const sim::Scenario scenario = sim::LoadScenario(r.scenario);
     RunSection s;
     const std::string what = experiments[k].empty() ? r.controller : experiments[k];
-    s.title = r.scenario + ": " + what;
-    s.slug = r.scenario + "_" + what;
+    s.title = scenario.name + ": " + what;
+    // A file name: the scenario's name (r.scenario may be a path) and the experiment, without
+    // anything a file name should not hold.
+    s.slug = scenario.name + "_" + what;
+    for (char& c : s.slug)
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
     s.summary = std::to_string(r.successes) + " of " + std::to_string(r.runs) +
                 " runs succeeded; " + std::to_string(r.collisions) + " collisions.";
     for (const std::string& f : r.failures) s.summary += " " + f + ".";

@@ -1,0 +1,58 @@
+// The obstacle watch's view of the frame (obstacle_watch.h): how the region bends with the path
+// the robot drives, and how much texture a tracked point needs given the frame's noise.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "mapless/navigation/obstacle_watch.h"
+
+namespace mapless::navigation {
+
+double ObstacleWatch::Curvature() const {
+  if (options_.curvature_window_m <= 0.0 || history_.empty()) return 0.0;
+  // The newest frame at least the window behind, else the oldest kept (at least 5 cm behind).
+  const Frame* from = nullptr;
+  for (auto it = history_.rbegin(); it != history_.rend(); ++it) {
+    from = &*it;
+    if (forward_m_ - it->forward_m >= options_.curvature_window_m) break;
+  }
+  const double driven = forward_m_ - from->forward_m;
+  if (driven < 0.05) return 0.0;
+  const double k = (turned_rad_ - from->turned_rad) / driven;
+  return std::clamp(k, -options_.max_curvature_per_m, options_.max_curvature_per_m);
+}
+
+double ObstacleWatch::MinEigen(const cv::Mat& grey) const {
+  if (options_.noise_eigen_factor <= 0.0) return options_.min_eigen;
+  // Immerkaer (1996): the image filtered with the difference of two Laplacians has, on Gaussian
+  // noise of sigma grey levels, a standard deviation of 6 sigma; texture adds to it only where
+  // it is fine, so the median over the lower image (every other row and column) measures the
+  // noise (a textured frame reads a little high: a stricter threshold, the safe side).
+  const int top = static_cast<int>(std::lround(options_.fit_top * grey.rows));
+  const cv::Mat lower = grey.rowRange(std::clamp(top, 0, grey.rows - 3), grey.rows);
+  cv::Mat response;
+  const cv::Mat kernel = (cv::Mat_<short>(3, 3) << 1, -2, 1, -2, 4, -2, 1, -2, 1);
+  cv::filter2D(lower, response, CV_16S, kernel, cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
+  std::array<int, 4096> histogram{};
+  int count = 0;
+  for (int y = 1; y + 1 < response.rows; y += 2) {
+    const short* row = response.ptr<short>(y);
+    for (int x = 1; x + 1 < response.cols; x += 2) {
+      ++histogram[static_cast<std::size_t>(std::min(std::abs(static_cast<int>(row[x])), 4095))];
+      ++count;
+    }
+  }
+  int median = 0;
+  int seen = 0;
+  while (median < 4095 && seen + histogram[static_cast<std::size_t>(median)] <= count / 2) {
+    seen += histogram[static_cast<std::size_t>(median)];
+    ++median;
+  }
+  const double sigma = median / (0.6745 * 6.0);
+  constexpr double kNoiseEigenPerSigma2 = 1.87e-4;  // the median window's (see the options)
+  return std::max(options_.min_eigen,
+                  options_.noise_eigen_factor * kNoiseEigenPerSigma2 * sigma * sigma);
+}
+
+}  // namespace mapless::navigation
