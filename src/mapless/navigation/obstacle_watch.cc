@@ -121,6 +121,8 @@ void ObstacleWatchOptions::Validate() const {
                 "ObstacleWatchOptions.confirm_frames = " << confirm_frames << "; must be >= 1");
   MAPLESS_CHECK(max_unchecked_m >= 0.0,
                 "ObstacleWatchOptions.max_unchecked_m = " << max_unchecked_m << "; must be >= 0");
+  MAPLESS_CHECK(min_eigen_clean > 0.0,
+                "ObstacleWatchOptions.min_eigen_clean = " << min_eigen_clean << "; must be > 0");
   MAPLESS_CHECK(noise_eigen_factor >= 0.0, "ObstacleWatchOptions.noise_eigen_factor = "
                                                << noise_eigen_factor << "; must be >= 0");
   MAPLESS_CHECK(creep_m >= 0.0, "ObstacleWatchOptions.creep_m = " << creep_m << "; must be >= 0");

@@ -87,15 +87,18 @@ struct ObstacleWatchOptions {
   double max_round_trip_px = 0.5;  // forward-backward tracking error allowed
   // Texture a tracked point needs: the smaller eigenvalue of its window's gradient matrix per
   // pixel (OpenCV's minEigThreshold). On a plain floor the image noise alone tracks "well" both
-  // ways; it must not count as flow. So the threshold follows the frame's own noise: at least
-  // noise_eigen_factor times the eigenvalue that noise of the frame's level gives (the median over
-  // windows of pure Gaussian noise of sigma grey levels is 1.87e-4 sigma^2, the largest about
-  // twice that; sigma is estimated on every frame from the lower image, Immerkaer's Laplacian
-  // difference with a median), and never below min_eigen. With the suites' image noise (sigma 2)
-  // that is 5e-3, the fixed threshold this replaced; on a clean camera it lets weaker floors be
-  // checked (a generated floor of half contrast: 50 tracked points of 330 with 5e-3, too few to
-  // find the ground; 350 with 1e-3, 90% of the bottom rows on one plane).
-  double min_eigen = 5e-4;
+  // ways; it must not count as flow. min_eigen was set with the suites' image noise (sigma 2 grey
+  // levels). A frame with less noise needs less: the threshold is noise_eigen_factor times the
+  // eigenvalue that noise of the frame's level gives (the median over windows of pure Gaussian
+  // noise of sigma grey levels is 1.87e-4 sigma^2, the largest about twice that: 6.7 times it is
+  // min_eigen at sigma 2), between min_eigen_clean and min_eigen. Sigma is estimated on every frame
+  // from the lower image (Immerkaer's difference of Laplacians, its median); texture adds to the
+  // estimate, so a textured frame keeps min_eigen, as before. On a clean camera weaker floors can
+  // be checked: a generated floor of half contrast gave 50 tracked points of 330 with 5e-3, too
+  // few to find the ground, and 350 with 1e-3, 90% of the bottom rows on one plane. (Raising the
+  // threshold above min_eigen on textured frames lost a corridor's box: 0/10 stops.)
+  double min_eigen = 5e-3;
+  double min_eigen_clean = 5e-4;
   double noise_eigen_factor = 6.7;
   double ransac_px = 1.0;  // RANSAC inlier threshold of the ground fit, pixels
   // A point is an obstacle point when it is farther than tolerance_px + tolerance_relative *

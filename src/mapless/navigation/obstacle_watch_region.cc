@@ -28,7 +28,7 @@ double ObstacleWatch::MinEigen(const cv::Mat& grey) const {
   // Immerkaer (1996): the image filtered with the difference of two Laplacians has, on Gaussian
   // noise of sigma grey levels, a standard deviation of 6 sigma; texture adds to it only where
   // it is fine, so the median over the lower image (every other row and column) measures the
-  // noise (a textured frame reads a little high: a stricter threshold, the safe side).
+  // noise (a textured frame reads high, and keeps min_eigen).
   const int top = static_cast<int>(std::lround(options_.fit_top * grey.rows));
   const cv::Mat lower = grey.rowRange(std::clamp(top, 0, grey.rows - 3), grey.rows);
   cv::Mat response;
@@ -51,8 +51,8 @@ double ObstacleWatch::MinEigen(const cv::Mat& grey) const {
   }
   const double sigma = median / (0.6745 * 6.0);
   constexpr double kNoiseEigenPerSigma2 = 1.87e-4;  // the median window's (see the options)
-  return std::max(options_.min_eigen,
-                  options_.noise_eigen_factor * kNoiseEigenPerSigma2 * sigma * sigma);
+  return std::clamp(options_.noise_eigen_factor * kNoiseEigenPerSigma2 * sigma * sigma,
+                    std::min(options_.min_eigen_clean, options_.min_eigen), options_.min_eigen);
 }
 
 }  // namespace mapless::navigation
