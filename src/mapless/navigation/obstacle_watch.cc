@@ -425,8 +425,15 @@ ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, const std::vector<cv::Mat
   std::vector<float> err;
   const cv::Size window(options_.window_px, options_.window_px);
   const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.03);
+  // Each point starts where the ground model puts it (PredictGround): the robot's motion taken
+  // out of the flow, so that LK only refines (a floor of regular tiles tracked from zero flow
+  // locked onto the next tile; a turn moved the view further than the pyramid reaches).
+  moved.reserve(grid.size());
+  for (const cv::Point2f& p : grid)
+    moved.push_back(
+        PredictGround(p, size, forward_m_ - earlier->forward_m, turned_rad_ - earlier->turned_rad));
   cv::calcOpticalFlowPyrLK(pyramid, earlier->pyramid, grid, moved, ok, err, window, options_.levels,
-                           stop, 0, min_eigen_);
+                           stop, cv::OPTFLOW_USE_INITIAL_FLOW, min_eigen_);
   const double fit_row = options_.fit_top * size.height;
   const double draw_row = options_.draw_top * size.height;
   std::vector<cv::Point2f> here, there;  // the tracked points below fit_top
@@ -476,10 +483,11 @@ ObstacleCheck ObstacleWatch::Look(const cv::Mat& grey, const std::vector<cv::Mat
   // One that does not is a wrong track, neither obstacle nor ground: out of the count.
   int obstacle_points = 0;
   if (!candidates.empty()) {
-    std::vector<cv::Point2f> back;
     std::vector<uchar> ok_back;
+    std::vector<cv::Point2f> back = candidates;  // back where they started, if right
     cv::calcOpticalFlowPyrLK(earlier->pyramid, pyramid, candidates_there, back, ok_back, err,
-                             window, options_.levels, stop, 0, min_eigen_);
+                             window, options_.levels, stop, cv::OPTFLOW_USE_INITIAL_FLOW,
+                             min_eigen_);
     for (std::size_t c = 0; c < candidates.size(); ++c) {
       const bool right =
           ok_back[c] && cv::norm(back[c] - candidates[c]) <= options_.max_round_trip_px;

@@ -219,6 +219,12 @@ class ObstacleWatch {
   // threshold from its noise (obstacle_watch_region.cc).
   double Curvature() const;
   double MinEigen(const cv::Mat& grey) const;
+  // Where a ground point seen at `p` now was seen in a frame taken `forward_m` behind and
+  // `turned_rad` of heading ago: the ground model the region's options imply (f h from
+  // region_far_m at region_top, f from region_width and region_half_width_m; a level camera on the
+  // rotation axis), the prior of each tracked point (obstacle_watch_region.cc).
+  cv::Point2f PredictGround(cv::Point2f p, cv::Size size, double forward_m,
+                            double turned_rad) const;
   // Stops the robot: `why` for this frame, `waiting` while it stays stopped; it goes on when the
   // view in `mask` (over the region) changes.
   void Hold(const cv::Mat& grey, cv::Mat mask, std::string why, std::string waiting,

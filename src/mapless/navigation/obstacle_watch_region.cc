@@ -23,6 +23,26 @@ double ObstacleWatch::Curvature() const {
   return std::clamp(k, -options_.max_curvature_per_m, options_.max_curvature_per_m);
 }
 
+cv::Point2f ObstacleWatch::PredictGround(cv::Point2f p, cv::Size size, double forward_m,
+                                         double turned_rad) const {
+  const double horizon = options_.horizon * size.height;
+  const double fh = options_.region_far_m * (options_.region_top * size.height - horizon);
+  const double f = 0.5 * options_.region_width * size.width / options_.region_half_width_m * fh /
+                   (size.height - horizon);
+  const double cx = 0.5 * (size.width - 1);
+  const double below = p.y - horizon;
+  if (below < 1.0 || fh <= 0.0) return p;
+  // The ground point in the current robot frame (forward d, left), then in the earlier one: the
+  // robot turned by turned_rad while it drove forward_m along the chord of its arc.
+  const double d = fh / below;
+  const double left = -(p.x - cx) * d / f;
+  const double c = std::cos(turned_rad), s = std::sin(turned_rad);
+  const double forward = c * d - s * left + forward_m * std::cos(0.5 * turned_rad);
+  const double side = s * d + c * left + forward_m * std::sin(0.5 * turned_rad);
+  if (forward < 0.05) return p;
+  return {static_cast<float>(cx - f * side / forward), static_cast<float>(horizon + fh / forward)};
+}
+
 double ObstacleWatch::MinEigen(const cv::Mat& grey) const {
   if (options_.noise_eigen_factor <= 0.0) return options_.min_eigen;
   // Immerkaer (1996): the image filtered with the difference of two Laplacians has, on Gaussian
