@@ -346,50 +346,6 @@ void ObstacleWatch::Vote(const cv::Mat& grey, const cv::Rect& region, int obstac
   }
 }
 
-void ObstacleWatch::Unchecked(const cv::Mat& grey, double forward_m, ObstacleCheck* check) {
-  unchecked_m_ = check->observed ? 0.0 : unchecked_m_ + std::max(0.0, forward_m);
-  check->unchecked_m = unchecked_m_;
-  if (creeping_) {
-    crept_m_ += std::max(0.0, forward_m);
-    if (check->observed || blocked_) {
-      creeping_ = false;  // the check had its say
-    } else if (crept_m_ > options_.creep_m) {
-      creeping_ = false;
-      StopUnchecked(grey, check);
-    }
-  } else if (!blocked_ && options_.max_unchecked_m > 0.0 &&
-             unchecked_m_ > options_.max_unchecked_m) {
-    if (options_.creep_m > 0.0) {
-      creeping_ = true;
-      crept_m_ = 0.0;
-    } else {
-      StopUnchecked(grey, check);
-    }
-  }
-  if (creeping_) {
-    std::ostringstream why;
-    why.precision(2);
-    why << std::fixed << "the ground ahead was not checked over the last " << unchecked_m_
-        << " m: creeping straight ahead to check it (" << crept_m_ << " of " << options_.creep_m
-        << " m)";
-    check->creeping = true;
-    check->reason = why.str();
-  }
-}
-
-void ObstacleWatch::StopUnchecked(const cv::Mat& grey, ObstacleCheck* check) {
-  std::ostringstream why;
-  why.precision(2);
-  why << std::fixed << "the ground ahead was not checked over the last " << unchecked_m_ << " m ("
-      << check->region_points << " points tracked there, " << options_.min_region_points
-      << " needed"
-      << (options_.creep_m > 0.0 ? ", also creeping straight ahead" : ", or the robot turned")
-      << "): stopped";
-  // The whole region: the view changing there frees it.
-  Hold(grey, cv::Mat(Region(grey.size()).size(), CV_8UC1, cv::Scalar(255)), why.str(),
-       "the ground ahead could not be checked: stopped, waiting for the view to change", check);
-}
-
 void ObstacleWatch::Hold(const cv::Mat& grey, cv::Mat mask, std::string why, std::string waiting,
                          ObstacleCheck* check) {
   blocked_ = true;

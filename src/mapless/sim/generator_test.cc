@@ -25,7 +25,8 @@ std::vector<Eigen::Vector2d> DensePath(const Scenario& s) {
   for (const PathStep& step : s.teach_path) {
     if (step.kind != PathStep::Kind::kGoTo) continue;
     const int n = std::max(1, static_cast<int>((step.target - at).norm() / 0.05));
-    for (int i = 0; i <= n; ++i) out.push_back(at + (step.target - at) * (static_cast<double>(i) / n));
+    for (int i = 0; i <= n; ++i)
+      out.push_back(at + (step.target - at) * (static_cast<double>(i) / n));
     at = step.target;
   }
   return out;
