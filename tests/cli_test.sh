@@ -40,7 +40,7 @@ need_drive() {  # $TMP/d1: a recorded drive of rotation_in_place (frames, poses)
 
 section_basics() {
   # Every subcommand answers --help with exit 0 and a usage text.
-  for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "bench" "shift" "teach" "repeat" "route" "route info" "route prune" "eval" "eval table1" "eval obstacles" "soak" "flow" "ground" "navigate" "localize" "follow" "sim serve" "teleop" "lead" "fleet"; do
+  for sub in "" "demo" "sim" "sim list" "sim render" "sim drive" "sim generate" "eval generated" "bench" "shift" "teach" "repeat" "route" "route info" "route prune" "eval" "eval table1" "eval obstacles" "soak" "flow" "ground" "navigate" "localize" "follow" "sim serve" "teleop" "lead" "fleet"; do
     # shellcheck disable=SC2086
     expect_exit "help: mapless $sub --help" 0 "$MAPLESS" $sub --help
     grep -qi "usage" "$TMP/out"; check "help text: mapless $sub" $?
@@ -57,7 +57,7 @@ section_basics() {
   # docs/cli.md lists every option a command offers (one meaning per name, issue 42).
   if [ -f "$HERE/../docs/cli.md" ]; then
     missing=""
-    for sub in demo "sim render" "sim drive" "sim serve" bench shift teach lead repeat "route info" "eval table1" "eval potential" "eval eigenspace" "eval obstacles" "eval fleet" soak flow ground navigate localize follow teleop "fleet keygen"; do
+    for sub in demo "sim render" "sim drive" "sim serve" "sim generate" "eval generated" bench shift teach lead repeat "route info" "eval table1" "eval potential" "eval eigenspace" "eval obstacles" "eval fleet" soak flow ground navigate localize follow teleop "fleet keygen"; do
       # shellcheck disable=SC2086
       for opt in $("$MAPLESS" $sub --help | grep -oE '^  --[a-z0-9-]+' | tr -d ' '); do
         [ "$opt" = --help ] || grep -q "^| \`$opt\` |" "$HERE/../docs/cli.md" || missing="$missing $sub:$opt"
@@ -65,6 +65,16 @@ section_basics() {
     done
     [ -z "$missing" ]; check "docs/cli.md lists every option${missing:+; missing:$missing}" $?
   fi
+
+  # sim generate: the same seed gives the same file; an existing file is kept unless --overwrite.
+  expect_exit "sim generate" 0 "$MAPLESS" sim generate --seed 11 --out "$TMP/g1.yaml"
+  expect_exit "sim generate again" 0 "$MAPLESS" sim generate --seed 11 --out "$TMP/g2.yaml"
+  cmp -s "$TMP/g1.yaml" "$TMP/g2.yaml"; check "sim generate: the same seed, the same world" $?
+  expect_exit "sim generate over a file exits 2" 2 "$MAPLESS" sim generate --seed 12 --out "$TMP/g1.yaml"
+  cmp -s "$TMP/g1.yaml" "$TMP/g2.yaml"; check "sim generate: the existing file is kept" $?
+  expect_exit "a generated world renders" 0 "$MAPLESS" sim render --scenario "$TMP/g1.yaml" --pose 0,0,0 --out "$TMP/g1.png"
+  expect_exit "eval generated, a missing world, exits 2" 2 "$MAPLESS" eval generated --world "$TMP/none.yaml"
+  [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "eval generated, a missing world: one error line" $?
 
   # sim list: one name per line, the paper scenarios among them.
   expect_exit "sim list" 0 "$MAPLESS" sim list
