@@ -8,6 +8,7 @@
 #include "cli_common.h"
 #include "interrupt.h"
 #include "mapless/core/check.h"
+#include "mapless/robot/robot_file.h"
 #include "mapless/run/status_line.h"
 
 namespace mapless::app {
@@ -154,6 +155,9 @@ run::RunOutcome RunOnSim(robot::Method& method, run::SimRun& sim, const std::str
   options.observer = observer;
   options.recorder = recorder;
   options.live = live;
+  // A stop that does not clear ends the run as on a robot with the robot file's default
+  // (safety.max_blocked_s), not by the simulator's timeout.
+  options.loop.max_blocked_s = robot::RobotFile{}.max_blocked_s;
   const run::RunOutcome outcome = run::RunMethod(method, sim.link(), options);
   ThrowIfInterrupted();
   return outcome;
