@@ -19,6 +19,7 @@
 #include "mapless/run/generated_suite.h"
 #include "mapless/run/report.h"
 #include "mapless/run/suites.h"
+#include "mapless/sim/generator.h"
 #include "progress.h"
 
 namespace mapless::app {

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "mapless/core/check.h"
+#include "mapless/core/pose.h"
 #include "mapless/core/rng.h"
 #include "mapless/sim/generator_layout.h"
 
