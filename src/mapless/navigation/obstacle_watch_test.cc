@@ -172,44 +172,61 @@ TEST(ObstacleWatch, AStandingRobotSeesNoParallaxAndDecidesNothing) {
 }
 
 // A robot that turns 0.03 rad a frame while it drives 2 cm: no two frames a baseline apart are
-// within max_baseline_rad, so nothing is checked. With max_unchecked_m it stops once it has driven
-// that far unchecked, says why, and goes on when its view changes; without, it drives on.
-TEST(ObstacleWatch, GroundLeftUncheckedForMaxUncheckedStopsTheRobot) {
+// within max_baseline_rad, so nothing is checked. With max_unchecked_m it first creeps (creep_m;
+// a caller drives straight ahead then, this one goes on turning, so the creep checks nothing
+// either), then stops, says why, and goes on when its view changes; without a limit it drives on.
+TEST(ObstacleWatch, GroundLeftUncheckedForMaxUncheckedCreepsThenStopsTheRobot) {
   cv::Mat image(240, 320, CV_8UC1);
   cv::randu(image, 0, 255);
   for (const double limit : {0.0, 0.45}) {
-    ObstacleWatchOptions options;
-    options.max_unchecked_m = limit;
-    ObstacleWatch watch(options);
-    int first_blocked = -1;
-    for (int i = 0; i < 60 && first_blocked < 0; ++i) {
-      const ObstacleCheck c = watch.Update(image, FromSeconds(0.1 * i), 0.02, 0.03);
-      EXPECT_FALSE(c.observed);
-      EXPECT_NEAR(c.unchecked_m, 0.02 * (i + 1), 1e-9);
-      if (c.blocked) {
-        first_blocked = i;
-        EXPECT_NE(c.reason.find("not checked over the last 0.46 m"), std::string::npos) << c.reason;
+    for (const double creep : {0.0, 0.3}) {
+      ObstacleWatchOptions options;
+      options.max_unchecked_m = limit;
+      options.creep_m = creep;
+      ObstacleWatch watch(options);
+      int first_creeping = -1, first_blocked = -1;
+      for (int i = 0; i < 80 && first_blocked < 0; ++i) {
+        const ObstacleCheck c = watch.Update(image, FromSeconds(0.1 * i), 0.02, 0.03);
+        EXPECT_FALSE(c.observed);
+        EXPECT_NEAR(c.unchecked_m, 0.02 * (i + 1), 1e-9);
+        if (c.creeping && first_creeping < 0) {
+          first_creeping = i;
+          EXPECT_NE(c.reason.find("creeping straight ahead to check it"), std::string::npos)
+              << c.reason;
+        }
+        if (c.blocked) {
+          first_blocked = i;
+          EXPECT_FALSE(c.creeping);
+          EXPECT_NE(c.reason.find("was not checked over the last"), std::string::npos) << c.reason;
+        }
       }
+      if (limit == 0.0) {
+        EXPECT_EQ(first_creeping, -1);
+        EXPECT_EQ(first_blocked, -1);
+        continue;
+      }
+      if (creep == 0.0) {
+        EXPECT_EQ(first_creeping, -1);
+        EXPECT_EQ(first_blocked, 22);  // 0.46 m > 0.45 m
+      } else {
+        EXPECT_EQ(first_creeping, 22);
+        EXPECT_NEAR(first_blocked, 22 + 16, 1);  // then 0.3 m of creeping, 2 cm a frame
+      }
+      // Standing, the same view: it waits and says so.
+      for (int i = 0; i < 10; ++i) {
+        const ObstacleCheck c = watch.Update(image, FromSeconds(6.0 + 0.1 * i), 0.0, 0.0);
+        EXPECT_TRUE(c.blocked);
+        EXPECT_NE(c.reason.find("could not be checked"), std::string::npos) << c.reason;
+      }
+      // Another view (something was moved): it goes on, the count starting again.
+      cv::Mat other = 255 - image;
+      bool cleared = false;
+      for (int i = 0; i < 5 && !cleared; ++i)
+        cleared = watch.Update(other, FromSeconds(8.0 + 0.1 * i), 0.0, 0.0).cleared;
+      EXPECT_TRUE(cleared);
+      EXPECT_FALSE(watch.blocked());
+      EXPECT_NEAR(watch.Update(other, FromSeconds(9.0), 0.02, 0.03).unchecked_m, 0.02, 1e-9);
     }
-    if (limit == 0.0) {
-      EXPECT_EQ(first_blocked, -1);
-      continue;
-    }
-    EXPECT_EQ(first_blocked, 22);  // 0.46 m > 0.45 m
-    // Standing, the same view: it waits and says so.
-    for (int i = 0; i < 10; ++i) {
-      const ObstacleCheck c = watch.Update(image, FromSeconds(6.0 + 0.1 * i), 0.0, 0.0);
-      EXPECT_TRUE(c.blocked);
-      EXPECT_NE(c.reason.find("could not be checked"), std::string::npos) << c.reason;
-    }
-    // Another view (something was moved): it goes on, the count starting again.
-    cv::Mat other = 255 - image;
-    bool cleared = false;
-    for (int i = 0; i < 5 && !cleared; ++i)
-      cleared = watch.Update(other, FromSeconds(8.0 + 0.1 * i), 0.0, 0.0).cleared;
-    EXPECT_TRUE(cleared);
-    EXPECT_FALSE(watch.blocked());
-    EXPECT_NEAR(watch.Update(other, FromSeconds(9.0), 0.02, 0.03).unchecked_m, 0.02, 1e-9);
   }
 }
 
