@@ -258,7 +258,7 @@ FollowerStep AppearanceFollower::Update(const cv::Mat& image, const Pose2& odome
       if (obstacle.creeping && step.state == FollowerState::kFollowing) {
         // Straight ahead, slowly, until the watch has checked the ground (obstacle_watch.h); the
         // follower goes on localizing meanwhile.
-        step.command = Twist2{options_.obstacle.creep_speed_mps, 0.0};
+        step.command = Twist2{options_.obstacle.CreepSpeedMps(), 0.0};
         step.reason = obstacle.reason;
       }
     }

@@ -126,10 +126,8 @@ void ObstacleWatchOptions::Validate() const {
   MAPLESS_CHECK(noise_eigen_factor >= 0.0, "ObstacleWatchOptions.noise_eigen_factor = "
                                                << noise_eigen_factor << "; must be >= 0");
   MAPLESS_CHECK(creep_m >= 0.0, "ObstacleWatchOptions.creep_m = " << creep_m << "; must be >= 0");
-  MAPLESS_CHECK(creep_m == 0.0 || creep_speed_mps * max_age_s > baseline_m,
-                "ObstacleWatchOptions.creep_speed_mps = "
-                    << creep_speed_mps << "; must cover baseline_m (" << baseline_m
-                    << ") within max_age_s (" << max_age_s << ")");
+  MAPLESS_CHECK(creep_m == 0.0 || creep_speed_mps > 0.0,
+                "ObstacleWatchOptions.creep_speed_mps = " << creep_speed_mps << "; must be > 0");
   MAPLESS_CHECK(curvature_window_m >= 0.0 && max_curvature_per_m > 0.0,
                 "ObstacleWatchOptions.curvature_window_m = "
                     << curvature_window_m << ", max_curvature_per_m = " << max_curvature_per_m

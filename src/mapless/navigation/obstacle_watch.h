@@ -134,9 +134,10 @@ struct ObstacleWatchOptions {
   // creep_speed_mps for at most creep_m (ObstacleCheck::creeping: the caller drives so): straight
   // motion gives the check its baseline, and a check that then observes the region ends the creep
   // (it stops the robot if something is there). Only when the creep did not let it check either
-  // does the robot stop, saying so (0: stop at once). The creep must cover a baseline within
-  // max_age_s. The ground 0.92-2.1 m ahead was seen before the creep began, so a creep of 0.3 m
-  // after 0.5 m unchecked stays on ground that was in view.
+  // does the robot stop, saying so (0: stop at once). The creep goes fast enough to cover a
+  // baseline within three quarters of max_age_s (CreepSpeedMps), whatever creep_speed_mps says. The
+  // ground 0.92-2.1 m ahead was seen before the creep began, so a creep of 0.3 m after 0.5 m
+  // unchecked stays on ground that was in view.
   double creep_m = 0.3;
   double creep_speed_mps = 0.1;
   // The region bends with the robot's path: the curvature driven over the last
@@ -147,6 +148,10 @@ struct ObstacleWatchOptions {
   double curvature_window_m = 0.3;
   double max_curvature_per_m = 2.5;  // the bend's curvature is clamped to this (1 / 0.4 m)
   void Validate() const;
+  double CreepSpeedMps() const {
+    return creep_speed_mps > baseline_m / (0.75 * max_age_s) ? creep_speed_mps
+                                                             : baseline_m / (0.75 * max_age_s);
+  }
 };
 
 struct ObstacleCheck {

@@ -260,7 +260,7 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns,
       step = Decide(grey, t_ns);
       if (obstacle.creeping && step.status == RepeatStatus::kDriving) {
         // Straight ahead, slowly, until the watch has checked the ground (obstacle_watch.h).
-        step.command = Twist2{options_.obstacle.creep_speed_mps, 0.0};
+        step.command = Twist2{options_.obstacle.CreepSpeedMps(), 0.0};
         step.reason = obstacle.reason;
       }
       step.current_px = current_px_;
