@@ -323,6 +323,8 @@ class AppearanceFollower {
   // Heading of the follower minus the leader's at its route image, over the last frames of
   // following (carry_on_heading_frames).
   std::deque<double> heading_offsets_;
+  // Their circular mean; without any, the current heading minus the leader's at `leader`.
+  double HeadingOffset(const Pose2& odometry, const Pose2& leader) const;
   appearance::Vector projection_;  // the current frame's (Decide)
   std::vector<LearnedAppearanceView> learned_;
   mutable std::vector<int> used_views_;  // per place (SteerTowards marks them)

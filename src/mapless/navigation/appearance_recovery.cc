@@ -75,6 +75,17 @@ bool AppearanceFollower::Recover(int ahead, const cv::Mat& low, const route::App
   return true;
 }
 
+double AppearanceFollower::HeadingOffset(const Pose2& odometry, const Pose2& leader) const {
+  if (heading_offsets_.empty()) return WrapAngle(odometry.theta_rad - leader.theta_rad);
+  double s = 0.0;
+  double c = 0.0;
+  for (const double a : heading_offsets_) {
+    s += std::sin(a);
+    c += std::cos(a);
+  }
+  return std::atan2(s, c);
+}
+
 std::optional<Twist2> AppearanceFollower::CarryOn(const Pose2& odometry,
                                                   const route::AppearanceRoute& route,
                                                   FollowerStep* step) {
@@ -91,16 +102,7 @@ std::optional<Twist2> AppearanceFollower::CarryOn(const Pose2& odometry,
     for (int j = step->index + 1; j < route.size(); ++j)
       taught.push_back(route.images[static_cast<std::size_t>(j)]->odometry);
     const Pose2& from = route.images[static_cast<std::size_t>(step->index)]->odometry;
-    double offset = WrapAngle(odometry.theta_rad - from.theta_rad);
-    if (!heading_offsets_.empty()) {
-      double s = 0.0;
-      double c = 0.0;
-      for (const double a : heading_offsets_) {
-        s += std::sin(a);
-        c += std::cos(a);
-      }
-      offset = std::atan2(s, c);
-    }
+    const double offset = HeadingOffset(odometry, from);
     carrying_.emplace(std::move(taught), from,
                       Pose2{odometry.x_m, odometry.y_m, WrapAngle(from.theta_rad + offset)},
                       options_.carry_on);

@@ -46,16 +46,7 @@ std::optional<Twist2> AppearanceFollower::TurnInPlace(const Pose2& odometry,
     }
     if (std::abs(turned) < options_.turn_in_place_min_rad) return std::nullopt;
     // The follower's heading offset to the leader at this place, as carrying on takes it.
-    double offset = WrapAngle(odometry.theta_rad - image(from).odometry.theta_rad);
-    if (!heading_offsets_.empty()) {
-      double s = 0.0;
-      double c = 0.0;
-      for (const double a : heading_offsets_) {
-        s += std::sin(a);
-        c += std::cos(a);
-      }
-      offset = std::atan2(s, c);
-    }
+    const double offset = HeadingOffset(odometry, image(from).odometry);
     turn_.active = true;
     turn_.through = last;
     // Target: this place's heading plus the offset, turned as the leader turned (not wrapped).
