@@ -99,6 +99,7 @@ void AddDemoCommand(CLI::App* app);
 void AddBenchCommand(CLI::App* app);
 void AddShiftCommand(CLI::App* app);
 void AddEvalCommand(CLI::App* app);
+void AddRealDataEvals(CLI::App* eval);  // eval shift, localize, ground
 void AddSoakCommand(CLI::App* app);
 void AddTeachRepeatCommands(CLI::App* app);
 void AddFollowCommand(CLI::App* app);

@@ -231,8 +231,10 @@ void AddGeneratedSuite(CLI::App* eval) {
 
 void AddEvalCommand(CLI::App* app) {
   CLI::App* eval = app->add_subcommand(
-      "eval", "Run an evaluation suite on the simulator: mapless eval SUITE [its options]");
+      "eval",
+      "Run an evaluation suite on the simulator or on real images: mapless eval SUITE [options]");
   eval->require_subcommand(1);
+  AddRealDataEvals(eval);
   AddRepeatSuite(eval, "table1", "Kassir et al., Table I: the funnel lanes on its four routes");
   AddRepeatSuite(eval, "funnel-scenarios",
                  "The funnel-lane repeat on the held-out scenarios (indoor, outdoor, aliasing)");

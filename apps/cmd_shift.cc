@@ -19,8 +19,9 @@ void AddShiftCommand(CLI::App* app) {
     std::string reference;
     std::string current;
     bool json = false;
-    std::string detector = "akaze_upright";
-    double ratio = 0.85;
+    std::string detector =
+        features::DetectorTypeName(features::ShiftOptions{}.features.type);
+    double ratio = features::ShiftOptions{}.matching.ratio;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app->add_subcommand(
@@ -30,9 +31,9 @@ void AddShiftCommand(CLI::App* app) {
   cmd->add_option("CURRENT", args->current, "Current image")->required();
   cmd->add_flag("--json", args->json,
                 "Print {\"dx_px\", \"matches\", \"inliers\", \"ok\"} as JSON");
-  cmd->add_option("--detector", args->detector, "orb, akaze, akaze_upright or sift")
+  cmd->add_option("--detector", args->detector, "orb, akaze, akaze_upright, sift or akaze_sift")
       ->capture_default_str();
-  cmd->add_option("--ratio", args->ratio, "Ratio-test threshold")
+  cmd->add_option("--ratio", args->ratio, "Ratio-test threshold (1: none; matches are cross-checked)")
       ->capture_default_str()
       ->check(FiniteIn(0.01, 1.0));
   cmd->callback([args] {

@@ -57,7 +57,7 @@ section_basics() {
   # docs/cli.md lists every option a command offers (one meaning per name, issue 42).
   if [ -f "$HERE/../docs/cli.md" ]; then
     missing=""
-    for sub in demo "sim render" "sim drive" "sim serve" "sim generate" "eval generated" bench shift teach lead repeat "route info" "eval table1" "eval potential" "eval eigenspace" "eval obstacles" "eval fleet" soak flow ground navigate localize follow teleop "fleet keygen"; do
+    for sub in demo "eval shift" "sim render" "sim drive" "sim serve" "sim generate" "eval generated" bench shift teach lead repeat "route info" "eval table1" "eval potential" "eval eigenspace" "eval obstacles" "eval fleet" soak flow ground navigate localize follow teleop "fleet keygen"; do
       # shellcheck disable=SC2086
       for opt in $("$MAPLESS" $sub --help | grep -oE '^  --[a-z0-9-]+' | tr -d ' '); do
         [ "$opt" = --help ] || grep -q "^| \`$opt\` |" "$HERE/../docs/cli.md" || missing="$missing $sub:$opt"

@@ -19,7 +19,8 @@ struct TypeName {
 constexpr TypeName kTypeNames[] = {{DetectorType::kOrb, "orb"},
                                    {DetectorType::kAkaze, "akaze"},
                                    {DetectorType::kAkazeUpright, "akaze_upright"},
-                                   {DetectorType::kSift, "sift"}};
+                                   {DetectorType::kSift, "sift"},
+                                   {DetectorType::kAkazeSift, "akaze_sift"}};
 
 }  // namespace
 
@@ -31,16 +32,19 @@ DescriptorLayout DescriptorLayoutOf(DetectorType type) {
     case DetectorType::kAkazeUpright:
       return {CV_8U, 61};  // MLDB, full size: 486 bits
     case DetectorType::kSift:
+    case DetectorType::kAkazeSift:
       return {CV_32F, 128};
   }
   return {};
 }
 
+bool IsBinary(DetectorType type) { return DescriptorLayoutOf(type).type == CV_8U; }
+
 DetectorType ParseDetectorType(const std::string& name) {
   for (const auto& t : kTypeNames) {
     if (name == t.name) return t.type;
   }
-  throw InputError("unknown detector '" + name + "' (known: orb, akaze, akaze_upright, sift)");
+  throw InputError("unknown detector '" + name + "' (known: orb, akaze, akaze_upright, sift, akaze_sift)");
 }
 
 const char* DetectorTypeName(DetectorType type) {
@@ -86,6 +90,11 @@ FeatureExtractor::FeatureExtractor(FeatureOptions options) : options_(options) {
     case DetectorType::kSift:
       detector_ = cv::SIFT::create(options_.max_features);
       break;
+    case DetectorType::kAkazeSift:
+      detector_ = cv::AKAZE::create(cv::AKAZE::DESCRIPTOR_MLDB_UPRIGHT, 0, 3,
+                                    static_cast<float>(options_.akaze_threshold));
+      describer_ = cv::SIFT::create();
+      break;
   }
 }
 
@@ -94,9 +103,15 @@ Features FeatureExtractor::Extract(const cv::Mat& image) const {
   cv::Mat grey = image;
   if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
   Features out;
-  out.binary = options_.type != DetectorType::kSift;
+  out.binary = IsBinary(options_.type);
   if (orb_) {
     orb_->DetectAndCompute(grey, &out.keypoints, &out.descriptors);
+  } else if (describer_) {
+    detector_->detect(grey, out.keypoints);
+    // The strongest max_features; upright (a ground robot's camera does not roll).
+    cv::KeyPointsFilter::retainBest(out.keypoints, options_.max_features);
+    for (auto& k : out.keypoints) k.angle = 0.0F;
+    describer_->compute(grey, out.keypoints, out.descriptors);
   } else {
     detector_->detectAndCompute(grey, cv::noArray(), out.keypoints, out.descriptors);
   }
@@ -252,7 +267,8 @@ MatchBinary(const Features& query, const Features& train, const MatchOptions& op
     if (f.best < 0) continue;
     // Lowe's ratio test when there is a second candidate (with BFMatcher's knnMatch, a lone
     // candidate in the window passes too).
-    if (f.second_d != kNoMatch && !(f.best_d < options.ratio * static_cast<double>(f.second_d)))
+    if (options.ratio < 1.0 && f.second_d != kNoMatch &&
+        !(f.best_d < options.ratio * static_cast<double>(f.second_d)))
       continue;
     const cv::Point2f& a = query.keypoints[static_cast<std::size_t>(i)].pt;
     const cv::Point2f& b = train.keypoints[static_cast<std::size_t>(f.best)].pt;
@@ -310,7 +326,8 @@ std::vector<cv::DMatch> MatchFeaturesBruteForce(const Features& query, const Fea
   }
   for (const auto& k : knn) {
     if (k.empty()) continue;
-    if (k.size() >= 2 && !(k[0].distance < options.ratio * k[1].distance)) continue;
+    if (options.ratio < 1.0 && k.size() >= 2 && !(k[0].distance < options.ratio * k[1].distance))
+      continue;
     const cv::Point2f& a = query.keypoints[static_cast<std::size_t>(k[0].queryIdx)].pt;
     const cv::Point2f& b = train.keypoints[static_cast<std::size_t>(k[0].trainIdx)].pt;
     if (std::abs(b.y - a.y) > options.max_dy_px) continue;

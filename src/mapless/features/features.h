@@ -14,9 +14,12 @@
 
 namespace mapless::features {
 
-enum class DetectorType { kOrb, kAkaze, kAkazeUpright, kSift };
+// kAkazeSift: upright AKAZE keypoints described by upright SIFT (the shift estimator's default:
+// AKAZE's nonlinear scale space finds corners that survive the seasons, SIFT's gradient histograms
+// describe them more distinctively than MLDB's binary tests; docs/results.md, real images).
+enum class DetectorType { kOrb, kAkaze, kAkazeUpright, kSift, kAkazeSift };
 
-// "orb", "akaze", "akaze_upright", "sift"; throws InputError on an unknown name.
+// "orb", "akaze", "akaze_upright", "sift", "akaze_sift"; throws InputError on an unknown name.
 DetectorType ParseDetectorType(const std::string& name);
 const char* DetectorTypeName(DetectorType type);
 
@@ -27,10 +30,12 @@ struct DescriptorLayout {
   int length = 0;
 };
 DescriptorLayout DescriptorLayoutOf(DetectorType type);
+// Hamming (binary descriptors) or L2 distance.
+bool IsBinary(DetectorType type);
 
 struct FeatureOptions {
   DetectorType type = DetectorType::kOrb;
-  int max_features = 500;           // ORB and SIFT: keep at most this many (strongest first)
+  int max_features = 500;           // ORB, SIFT, AKAZE+SIFT: keep at most this many (strongest)
   int orb_fast_threshold = 10;      // ORB: FAST corner threshold, grey levels (OpenCV's default
                                     // is 20; 10 keeps features on low-texture walls)
   double akaze_threshold = 0.0005;  // AKAZE: detector response threshold
@@ -55,11 +60,12 @@ class FeatureExtractor {
  private:
   FeatureOptions options_;
   std::unique_ptr<OrbDetector> orb_;  // ORB
-  cv::Ptr<cv::Feature2D> detector_;   // the others
+  cv::Ptr<cv::Feature2D> detector_;   // the others (the keypoints of kAkazeSift)
+  cv::Ptr<cv::Feature2D> describer_;  // kAkazeSift: SIFT on the upright AKAZE keypoints
 };
 
 struct MatchOptions {
-  double ratio = 0.85;     // Lowe's ratio test: best distance < ratio * second best
+  double ratio = 0.85;     // Lowe's ratio test: best distance < ratio * second best (1: none)
   double max_dy_px = 1e9;  // reject matches whose vertical offset exceeds this
   bool mutual = false;     // keep only matches that are also best in the other direction
   // Guided matching: when max_ddx_px is finite, a query feature at x may only match a train

@@ -13,7 +13,7 @@ void RepeatSession::AddKeyframeFeatures(const route::Keyframe& kf) {
   features::Features f;
   f.keypoints = kf.keypoints;
   f.descriptors = kf.descriptors;
-  f.binary = options_.features.type != features::DetectorType::kSift;
+  f.binary = features::IsBinary(options_.features.type);
   keyframe_features_.push_back(std::move(f));
   learned_views_.emplace_back();
   chosen_view_.push_back(-1);
@@ -27,7 +27,7 @@ void RepeatSession::AddNewViews(std::size_t at, const route::Keyframe& kf) {
     View view;
     view.features.keypoints = v.keypoints;
     view.features.descriptors = v.descriptors;
-    view.features.binary = options_.features.type != features::DetectorType::kSift;
+    view.features.binary = features::IsBinary(options_.features.type);
     view.offset_px = v.offset_px;
     views.push_back(std::move(view));
   }

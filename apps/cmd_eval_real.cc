@@ -1,0 +1,42 @@
+// `mapless eval shift|localize|ground`: mapless and stock baselines on a user's real images, in one
+// run (run/real_data.h; the dataset layouts are in docs/real_data.md).
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "cli_common.h"
+#include "mapless/run/real_data.h"
+
+namespace mapless::app {
+
+namespace {
+
+void Print(const run::SuiteOutput& out, bool json) {
+  std::fputs(out.table.c_str(), json ? stderr : stdout);
+  if (json) std::cout << out.json.dump() << "\n";
+}
+
+void AddShiftEval(CLI::App* eval) {
+  struct Args {
+    std::string dir;
+    eval::ShiftEvalOptions options;
+    bool json = false;
+  };
+  auto a = std::make_shared<Args>();
+  CLI::App* cmd = eval->add_subcommand(
+      "shift", "Horizontal shift across sessions on real images, with stock baselines");
+  cmd->add_option("--sessions", a->dir,
+                  "DIR/SSPP.png and DIR/offsets.txt, or DIR/summer/, DIR/winter/ and DIR/dx.txt")
+      ->required();
+  cmd->add_option("--tolerance", a->options.tolerance_px, "A shift is right within this many px")
+      ->capture_default_str()
+      ->check(FiniteIn(0.1, 1e4));
+  cmd->add_flag("--json", a->json, "Print one JSON object (the table goes to stderr)");
+  cmd->callback([a] { Print(run::RunShiftEval(a->dir, a->options), a->json); });
+}
+
+}  // namespace
+
+void AddRealDataEvals(CLI::App* eval) { AddShiftEval(eval); }
+
+}  // namespace mapless::app

@@ -1,0 +1,17 @@
+// The evaluations on a user's real images (issue 66): `mapless eval shift`, `eval localize` and
+// `eval ground`. Each prints mapless's figure and stock baselines computed in the same run on the
+// same images, with the cost per item; the layouts are in docs/real_data.md.
+#pragma once
+
+#include <string>
+
+#include "mapless/eval/real_shift.h"
+#include "mapless/run/suites.h"
+
+namespace mapless::run {
+
+// {"suite": "shift", "dir", "layout", "images", "pairs", "tolerance_px", "methods": [{"method",
+// "pairs", "within", "not_ok", "fraction", "extract_ms", "match_ms", "pair_ms"}]}; mapless first.
+SuiteOutput RunShiftEval(const std::string& dir, const eval::ShiftEvalOptions& options);
+
+}  // namespace mapless::run
