@@ -35,8 +35,40 @@ void AddShiftEval(CLI::App* eval) {
   cmd->callback([a] { Print(run::RunShiftEval(a->dir, a->options), a->json); });
 }
 
+void AddLocalizeEval(CLI::App* eval) {
+  struct Args {
+    std::string database;
+    std::string query;
+    eval::LocalizeEvalOptions options;
+    bool json = false;
+  };
+  auto a = std::make_shared<Args>();
+  CLI::App* cmd = eval->add_subcommand(
+      "localize", "Localization across seasons on real images, with stock baselines");
+  cmd->add_option("--database", a->database, "Route images: a folder, file-name order")
+      ->required();
+  cmd->add_option("--query", a->query,
+                  "Query images: a folder, file-name order; the truth is the database image of "
+                  "the same name")
+      ->required();
+  cmd->add_option("--advance", a->options.filter.advance,
+                  "Motion model: database images per query image")
+      ->capture_default_str()
+      ->check(FiniteIn(0.0, 1000.0));
+  cmd->add_option("--advance-sigma", a->options.filter.advance_sigma,
+                  "Motion model: its standard deviation per query, database images")
+      ->capture_default_str()
+      ->check(FiniteIn(0.01, 1000.0));
+  cmd->add_flag("--json", a->json, "Print one JSON object (the table goes to stderr)");
+  cmd->callback(
+      [a] { Print(run::RunLocalizeEval(a->database, a->query, a->options), a->json); });
+}
+
 }  // namespace
 
-void AddRealDataEvals(CLI::App* eval) { AddShiftEval(eval); }
+void AddRealDataEvals(CLI::App* eval) {
+  AddShiftEval(eval);
+  AddLocalizeEval(eval);
+}
 
 }  // namespace mapless::app

@@ -57,7 +57,7 @@ section_basics() {
   # docs/cli.md lists every option a command offers (one meaning per name, issue 42).
   if [ -f "$HERE/../docs/cli.md" ]; then
     missing=""
-    for sub in demo "eval shift" "sim render" "sim drive" "sim serve" "sim generate" "eval generated" bench shift teach lead repeat "route info" "eval table1" "eval potential" "eval eigenspace" "eval obstacles" "eval fleet" soak flow ground navigate localize follow teleop "fleet keygen"; do
+    for sub in demo "eval shift" "eval localize" "sim render" "sim drive" "sim serve" "sim generate" "eval generated" bench shift teach lead repeat "route info" "eval table1" "eval potential" "eval eigenspace" "eval obstacles" "eval fleet" soak flow ground navigate localize follow teleop "fleet keygen"; do
       # shellcheck disable=SC2086
       for opt in $("$MAPLESS" $sub --help | grep -oE '^  --[a-z0-9-]+' | tr -d ' '); do
         [ "$opt" = --help ] || grep -q "^| \`$opt\` |" "$HERE/../docs/cli.md" || missing="$missing $sub:$opt"
@@ -188,6 +188,13 @@ section_localize_eval() {
   # eval experiences (issue 45) on the bundled Stromovka subset: two places, sessions 01, 06, 12.
   expect_exit "eval experiences --json" 0 "$MAPLESS" eval experiences --sessions "$HERE/data/stromovka" --json
   grep -Eq '"single_fraction":[0-9.]+' "$TMP/out" && grep -Eq '"experiences_fraction":[0-9.]+' "$TMP/out" && [ "$(grep -o '"place":' "$TMP/out" | wc -l)" -eq 2 ]; check "eval experiences: both fractions, one row per place" $?
+  # eval shift and eval localize (issue 66): mapless and the stock baselines of the same run.
+  expect_exit "eval shift --json" 0 "$MAPLESS" eval shift --sessions "$HERE/data/stromovka" --json
+  grep -q '"method":"mapless"' "$TMP/out" && grep -q '"method":"fast_sift"' "$TMP/out" && grep -q '"pairs":12' "$TMP/out"; check "eval shift: mapless and the baselines over 12 pairs" $?
+  expect_exit "eval shift on a folder with neither list exits 2" 2 "$MAPLESS" eval shift --sessions "$NL/summer"
+  grep -q "dx.txt" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "eval shift names the missing list in one line" $?
+  expect_exit "eval localize --json" 0 "$MAPLESS" eval localize --database "$NL/summer" --query "$NL/winter" --json
+  grep -q '"method":"seqslam"' "$TMP/out" && grep -Eq '"within5":[0-9.]+' "$TMP/out"; check "eval localize: mapless and the baselines" $?
   expect_exit "eval experiences on a folder without offsets.txt exits 2" 2 "$MAPLESS" eval experiences --sessions "$NL/summer"
   grep -q "$NL/summer/offsets.txt" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "eval experiences names the missing offsets.txt in one line" $?
 

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "mapless/core/check.h"
+#include "mapless/eval/cost.h"
 #include "mapless/eval/experiences.h"
 #include "mapless/io/atomic_file.h"
 #include "mapless/io/image_file.h"
@@ -73,17 +74,6 @@ ShiftDataset FromTwoFolders(const std::string& dir) {
   }
   MAPLESS_CHECK(!data.pairs.empty(), file << ": no image listed");
   return data;
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
-
-double MsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
 }
 
 using Extract = std::function<features::Features(const cv::Mat&)>;

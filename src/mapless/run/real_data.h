@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "mapless/eval/real_localize.h"
 #include "mapless/eval/real_shift.h"
 #include "mapless/run/suites.h"
 
@@ -13,5 +14,11 @@ namespace mapless::run {
 // {"suite": "shift", "dir", "layout", "images", "pairs", "tolerance_px", "methods": [{"method",
 // "pairs", "within", "not_ok", "fraction", "extract_ms", "match_ms", "pair_ms"}]}; mapless first.
 SuiteOutput RunShiftEval(const std::string& dir, const eval::ShiftEvalOptions& options);
+
+// {"suite": "localize", "database", "query", "database_images", "queries", "methods": [{"method",
+// "queries", "within0", "within1", "within5", "within10", "recall_at_full_precision" (null: no
+// confidence), "query_ms"}]}; mapless first.
+SuiteOutput RunLocalizeEval(const std::string& database, const std::string& query,
+                            const eval::LocalizeEvalOptions& options);
 
 }  // namespace mapless::run
