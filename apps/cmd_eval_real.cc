@@ -45,8 +45,7 @@ void AddLocalizeEval(CLI::App* eval) {
   auto a = std::make_shared<Args>();
   CLI::App* cmd = eval->add_subcommand(
       "localize", "Localization across seasons on real images, with stock baselines");
-  cmd->add_option("--database", a->database, "Route images: a folder, file-name order")
-      ->required();
+  cmd->add_option("--database", a->database, "Route images: a folder, file-name order")->required();
   cmd->add_option("--query", a->query,
                   "Query images: a folder, file-name order; the truth is the database image of "
                   "the same name")
@@ -60,8 +59,7 @@ void AddLocalizeEval(CLI::App* eval) {
       ->capture_default_str()
       ->check(FiniteIn(0.01, 1000.0));
   cmd->add_flag("--json", a->json, "Print one JSON object (the table goes to stderr)");
-  cmd->callback(
-      [a] { Print(run::RunLocalizeEval(a->database, a->query, a->options), a->json); });
+  cmd->callback([a] { Print(run::RunLocalizeEval(a->database, a->query, a->options), a->json); });
 }
 
 }  // namespace

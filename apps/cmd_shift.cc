@@ -19,8 +19,7 @@ void AddShiftCommand(CLI::App* app) {
     std::string reference;
     std::string current;
     bool json = false;
-    std::string detector =
-        features::DetectorTypeName(features::ShiftOptions{}.features.type);
+    std::string detector = features::DetectorTypeName(features::ShiftOptions{}.features.type);
     double ratio = features::ShiftOptions{}.matching.ratio;
   };
   auto args = std::make_shared<Args>();
@@ -33,7 +32,8 @@ void AddShiftCommand(CLI::App* app) {
                 "Print {\"dx_px\", \"matches\", \"inliers\", \"ok\"} as JSON");
   cmd->add_option("--detector", args->detector, "orb, akaze, akaze_upright, sift or akaze_sift")
       ->capture_default_str();
-  cmd->add_option("--ratio", args->ratio, "Ratio-test threshold (1: none; matches are cross-checked)")
+  cmd->add_option("--ratio", args->ratio,
+                  "Ratio-test threshold (1: none; matches are cross-checked)")
       ->capture_default_str()
       ->check(FiniteIn(0.01, 1.0));
   cmd->callback([args] {

@@ -40,8 +40,9 @@ Folder ReadFolder(const std::string& dir, const std::string& option) {
   for (const std::string& name : folder.names) {
     folder.images.push_back(io::ReadImage(dir + "/" + name, cv::IMREAD_GRAYSCALE, 4));
     pixels += static_cast<double>(folder.images.back().total());
-    MAPLESS_CHECK(pixels <= kMaxPixels, option << " " << dir << ": more than " << kMaxPixels / 1e6
-                                               << " megapixels in all; use fewer or smaller images");
+    MAPLESS_CHECK(pixels <= kMaxPixels, option
+                                            << " " << dir << ": more than " << kMaxPixels / 1e6
+                                            << " megapixels in all; use fewer or smaller images");
   }
   return folder;
 }
@@ -140,18 +141,21 @@ LocalizeEvalFigures EvalLocalize(const std::string& database_dir, const std::str
       ms.push_back(MsSince(start));
     }
     const auto start = std::chrono::steady_clock::now();
-    const std::vector<int> estimate = localization::SeqSlamPastOnly(differences, options.seqslam_length);
+    const std::vector<int> estimate =
+        localization::SeqSlamPastOnly(differences, options.seqslam_length);
     const double search_ms = MsSince(start) / std::max<std::size_t>(1, query.images.size());
     out.methods.push_back(Score("seqslam", estimate, truth, {}, Median(ms) + search_ms));
   }
   // The paper's Markov localization and nearest projection on an incremental-PCA eigenspace.
-  for (const auto method : {localization::SequenceMethod::kMarkov, localization::SequenceMethod::kNearest}) {
+  for (const auto method :
+       {localization::SequenceMethod::kMarkov, localization::SequenceMethod::kNearest}) {
     localization::SequenceLocalizationOptions o;
     o.method = method;
     o.image.width = options.filter.width;
     o.image.height = options.filter.height;
     o.pca.max_dimensions = options.pca_dimensions;
-    const appearance::Eigenspace eigenspace = localization::BuildRouteEigenspace(database.images, o);
+    const appearance::Eigenspace eigenspace =
+        localization::BuildRouteEigenspace(database.images, o);
     const auto start = std::chrono::steady_clock::now();
     const auto results = localization::LocalizeSequence(eigenspace, query.images, o);
     const double ms = MsSince(start) / std::max<std::size_t>(1, query.images.size());
@@ -161,8 +165,9 @@ LocalizeEvalFigures EvalLocalize(const std::string& database_dir, const std::str
       estimate.push_back(r.index);
       confidence.push_back(r.probability);
     }
-    out.methods.push_back(Score(method == localization::SequenceMethod::kMarkov ? "markov_pca" : "nearest_pca",
-                                estimate, truth, confidence, ms));
+    out.methods.push_back(
+        Score(method == localization::SequenceMethod::kMarkov ? "markov_pca" : "nearest_pca",
+              estimate, truth, confidence, ms));
   }
   return out;
 }

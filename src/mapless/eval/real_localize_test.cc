@@ -1,5 +1,5 @@
-// `eval localize` (issue 66): the recall at full precision, and the evaluation with its baselines on
-// the 100 Nordland places bundled in tests/data/nordland.
+// `eval localize` (issue 66): the recall at full precision, and the evaluation with its baselines
+// on the 100 Nordland places bundled in tests/data/nordland.
 #include "mapless/eval/real_localize.h"
 
 #include <gtest/gtest.h>

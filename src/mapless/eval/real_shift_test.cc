@@ -1,6 +1,7 @@
-// `eval shift` (issue 66): both dataset layouts and the baselines in the same run. The acceptance on
-// all 660 pairs of ../shared/data/stromovka_sessions is EstimateShift.StromovkaAllSessionPairs...
-// (features_test); the baselines' figures there come from `mapless eval shift` (docs/results.md).
+// `eval shift` (issue 66): both dataset layouts and the baselines in the same run. The acceptance
+// on all 660 pairs of ../shared/data/stromovka_sessions is
+// EstimateShift.StromovkaAllSessionPairs... (features_test); the baselines' figures there come from
+// `mapless eval shift` (docs/results.md).
 #include "mapless/eval/real_shift.h"
 
 #include <gtest/gtest.h>

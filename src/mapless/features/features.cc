@@ -44,7 +44,8 @@ DetectorType ParseDetectorType(const std::string& name) {
   for (const auto& t : kTypeNames) {
     if (name == t.name) return t.type;
   }
-  throw InputError("unknown detector '" + name + "' (known: orb, akaze, akaze_upright, sift, akaze_sift)");
+  throw InputError("unknown detector '" + name +
+                   "' (known: orb, akaze, akaze_upright, sift, akaze_sift)");
 }
 
 const char* DetectorTypeName(DetectorType type) {

@@ -51,8 +51,8 @@ ShiftEstimate VoteShift(const std::vector<double>& dx_px, double bin_px, int min
 
 ShiftEstimate VoteShift2D(const std::vector<double>& dx_px, const std::vector<double>& dy_px,
                           double bin_px, double bin_dy_px, int min_votes) {
-  MAPLESS_CHECK(dx_px.size() == dy_px.size(), "VoteShift2D: " << dx_px.size() << " dx but "
-                                                              << dy_px.size() << " dy");
+  MAPLESS_CHECK(dx_px.size() == dy_px.size(),
+                "VoteShift2D: " << dx_px.size() << " dx but " << dy_px.size() << " dy");
   if (bin_dy_px <= 0.0) return VoteShift(dx_px, bin_px, min_votes);
   ShiftEstimate out;
   out.matches = static_cast<int>(dx_px.size());

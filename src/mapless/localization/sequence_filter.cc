@@ -14,17 +14,17 @@ void SequenceFilterOptions::Validate() const {
                 "SequenceFilterOptions: image " << width << "x" << height
                                                 << "; each side must be in [4, 1024]");
   MAPLESS_CHECK(patch_px >= 2, "SequenceFilterOptions.patch_px = " << patch_px << "; must be >= 2");
-  MAPLESS_CHECK(contrast_window >= 1, "SequenceFilterOptions.contrast_window = "
-                                          << contrast_window << "; must be >= 1");
+  MAPLESS_CHECK(contrast_window >= 1,
+                "SequenceFilterOptions.contrast_window = " << contrast_window << "; must be >= 1");
   MAPLESS_CHECK(temperature > 0.0 && std::isfinite(temperature),
                 "SequenceFilterOptions.temperature = " << temperature << "; must be > 0");
   MAPLESS_CHECK(std::isfinite(advance) && advance >= 0.0,
                 "SequenceFilterOptions.advance = " << advance << "; must be >= 0");
   MAPLESS_CHECK(advance_sigma > 0.0 && std::isfinite(advance_sigma),
                 "SequenceFilterOptions.advance_sigma = " << advance_sigma << "; must be > 0");
-  MAPLESS_CHECK(uniform_mixing >= 0.0 && uniform_mixing < 1.0,
-                "SequenceFilterOptions.uniform_mixing = " << uniform_mixing
-                                                          << "; must be in [0, 1)");
+  MAPLESS_CHECK(
+      uniform_mixing >= 0.0 && uniform_mixing < 1.0,
+      "SequenceFilterOptions.uniform_mixing = " << uniform_mixing << "; must be in [0, 1)");
   MAPLESS_CHECK(confidence_window >= 0, "SequenceFilterOptions.confidence_window = "
                                             << confidence_window << "; must be >= 0");
 }
@@ -57,7 +57,8 @@ std::vector<double> EnhancedDifferences(const cv::Mat& route, const cv::Mat& que
                 "EnhancedDifferences: descriptors of different kinds");
   const int n = route.rows;
   std::vector<double> d(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) d[static_cast<std::size_t>(i)] = cv::norm(route.row(i), query, cv::NORM_L1) / query.cols;
+  for (int i = 0; i < n; ++i)
+    d[static_cast<std::size_t>(i)] = cv::norm(route.row(i), query, cv::NORM_L1) / query.cols;
   // Prefix sums for the window means and variances.
   std::vector<double> s1(static_cast<std::size_t>(n) + 1, 0.0), s2(s1);
   for (int i = 0; i < n; ++i) {
@@ -70,9 +71,13 @@ std::vector<double> EnhancedDifferences(const cv::Mat& route, const cv::Mat& que
     const int a = std::max(0, i - window);
     const int b = std::min(n - 1, i + window);
     const double count = b - a + 1;
-    const double mean = (s1[static_cast<std::size_t>(b) + 1] - s1[static_cast<std::size_t>(a)]) / count;
-    const double var = (s2[static_cast<std::size_t>(b) + 1] - s2[static_cast<std::size_t>(a)]) / count - mean * mean;
-    z[static_cast<std::size_t>(i)] = (d[static_cast<std::size_t>(i)] - mean) / std::sqrt(std::max(var, 1e-12));
+    const double mean =
+        (s1[static_cast<std::size_t>(b) + 1] - s1[static_cast<std::size_t>(a)]) / count;
+    const double var =
+        (s2[static_cast<std::size_t>(b) + 1] - s2[static_cast<std::size_t>(a)]) / count -
+        mean * mean;
+    z[static_cast<std::size_t>(i)] =
+        (d[static_cast<std::size_t>(i)] - mean) / std::sqrt(std::max(var, 1e-12));
   }
   return z;
 }
@@ -80,8 +85,8 @@ std::vector<double> EnhancedDifferences(const cv::Mat& route, const cv::Mat& que
 SequenceFilter::SequenceFilter(cv::Mat route, SequenceFilterOptions options)
     : route_(std::move(route)), options_(options) {
   options_.Validate();
-  MAPLESS_CHECK(route_.rows >= 2, "sequence filter: the route needs at least 2 images, got "
-                                      << route_.rows);
+  MAPLESS_CHECK(route_.rows >= 2,
+                "sequence filter: the route needs at least 2 images, got " << route_.rows);
   belief_.assign(static_cast<std::size_t>(route_.rows), 1.0 / route_.rows);
   const int half = static_cast<int>(std::ceil(4.0 * options_.advance_sigma)) + 1;
   for (int k = -half; k <= half; ++k) {
@@ -105,7 +110,8 @@ SequenceEstimate SequenceFilter::Update(const cv::Mat& query_descriptor) {
         const double w = b * kernel_[static_cast<std::size_t>(k + half)];
         const int j0 = i + whole + k;
         if (j0 >= 0 && j0 < n) predicted[static_cast<std::size_t>(j0)] += w * (1.0 - frac);
-        if (frac > 0.0 && j0 + 1 >= 0 && j0 + 1 < n) predicted[static_cast<std::size_t>(j0) + 1] += w * frac;
+        if (frac > 0.0 && j0 + 1 >= 0 && j0 + 1 < n)
+          predicted[static_cast<std::size_t>(j0) + 1] += w * frac;
       }
     }
     double sum = 0.0;
@@ -116,7 +122,8 @@ SequenceEstimate SequenceFilter::Update(const cv::Mat& query_descriptor) {
     }
   }
   first_ = false;
-  const std::vector<double> z = EnhancedDifferences(route_, query_descriptor, options_.contrast_window);
+  const std::vector<double> z =
+      EnhancedDifferences(route_, query_descriptor, options_.contrast_window);
   const double z_min = *std::min_element(z.begin(), z.end());
   double sum = 0.0;
   for (std::size_t i = 0; i < size; ++i) {
@@ -149,7 +156,8 @@ std::vector<int> SeqSlamPastOnly(const std::vector<std::vector<double>>& differe
         for (int k = 0; k < length && inside; ++k) {
           const int j = i - static_cast<int>(std::lround(v10 * k / 10.0));
           inside = j >= 0;
-          if (inside) sum += differences[q - static_cast<std::size_t>(k)][static_cast<std::size_t>(j)];
+          if (inside)
+            sum += differences[q - static_cast<std::size_t>(k)][static_cast<std::size_t>(j)];
         }
         if (inside && sum / length < best) {
           best = sum / length;

@@ -20,7 +20,7 @@
 namespace mapless::localization {
 
 struct SequenceFilterOptions {
-  int width = 64;              // low-resolution image, px
+  int width = 64;  // low-resolution image, px
   int height = 32;
   int patch_px = 8;            // patch normalisation
   int contrast_window = 10;    // R, route images each side

@@ -8,9 +8,12 @@ SuiteOutput RunShiftEval(const std::string& dir, const eval::ShiftEvalOptions& o
   const eval::ShiftDataset data = eval::LoadShiftDataset(dir);
   const eval::ShiftEvalFigures f = eval::EvalShift(data, options);
   SuiteOutput out;
-  out.json = {{"suite", "shift"},          {"dir", dir},
-              {"layout", data.layout},     {"images", f.images},
-              {"pairs", f.pairs},          {"tolerance_px", f.tolerance_px},
+  out.json = {{"suite", "shift"},
+              {"dir", dir},
+              {"layout", data.layout},
+              {"images", f.images},
+              {"pairs", f.pairs},
+              {"tolerance_px", f.tolerance_px},
               {"methods", nlohmann::json::array()}};
   out.table = Format("%-10s %6s %7s %7s %9s %11s %9s %8s\n", "method", "pairs", "within", "not ok",
                      "fraction", "extract ms", "match ms", "pair ms");
@@ -39,8 +42,12 @@ SuiteOutput RunLocalizeEval(const std::string& database, const std::string& quer
                             const eval::LocalizeEvalOptions& options) {
   const eval::LocalizeEvalFigures f = eval::EvalLocalize(database, query, options);
   SuiteOutput out;
-  out.json = {{"suite", "localize"},  {"database", database},         {"query", query},
-              {"queries", f.queries}, {"database_images", f.database}, {"methods", nlohmann::json::array()}};
+  out.json = {{"suite", "localize"},
+              {"database", database},
+              {"query", query},
+              {"queries", f.queries},
+              {"database_images", f.database},
+              {"methods", nlohmann::json::array()}};
   out.table = Format("%-12s %7s %7s %7s %7s %8s %9s %9s\n", "method", "queries", "exact", "+-1",
                      "+-5", "+-10", "recall@P1", "query ms");
   for (const auto& m : f.methods) {
@@ -56,9 +63,9 @@ SuiteOutput RunLocalizeEval(const std::string& database, const std::string& quer
                                    {"query_ms", m.query_ms}});
     const std::string r =
         m.recall_at_full_precision >= 0.0 ? Format("%.3f", m.recall_at_full_precision) : "-";
-    out.table += Format("%-12s %7d %7.3f %7.3f %7.3f %8.3f %9s %9.3f\n", m.method.c_str(),
-                        m.queries, m.within0, m.within1, m.within5, m.within10, r.c_str(),
-                        m.query_ms);
+    out.table +=
+        Format("%-12s %7d %7.3f %7.3f %7.3f %8.3f %9s %9.3f\n", m.method.c_str(), m.queries,
+               m.within0, m.within1, m.within5, m.within10, r.c_str(), m.query_ms);
   }
   out.table +=
       "fraction of queries within 0, 1, 5 and 10 places of the truth (the database image of the\n"
