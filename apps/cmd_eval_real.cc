@@ -58,8 +58,33 @@ void AddLocalizeEval(CLI::App* eval) {
                   "Motion model: its standard deviation per query, database images")
       ->capture_default_str()
       ->check(FiniteIn(0.01, 1000.0));
+  cmd->add_option("--start-sigma", a->options.filter.start_sigma,
+                  "The queries start within about this many database images of the first (0: "
+                  "anywhere)")
+      ->capture_default_str()
+      ->check(FiniteIn(0.0, 1e6));
   cmd->add_flag("--json", a->json, "Print one JSON object (the table goes to stderr)");
   cmd->callback([a] { Print(run::RunLocalizeEval(a->database, a->query, a->options), a->json); });
+}
+
+void AddGroundEval(CLI::App* eval) {
+  struct Args {
+    std::string frames;
+    std::string masks;
+    bool json = false;
+  };
+  auto a = std::make_shared<Args>();
+  CLI::App* cmd = eval->add_subcommand(
+      "ground", "The ground from optical flow on real images against labels, with a baseline");
+  cmd->add_option("--frames", a->frames, "Consecutive frames: a folder, file-name order")
+      ->required();
+  cmd->add_option("--masks", a->masks,
+                  "Ground labels: a folder, one image per frame of the same name (> 127: ground)")
+      ->required();
+  cmd->add_flag("--json", a->json, "Print one JSON object (the table goes to stderr)");
+  cmd->callback([a] {
+    Print(run::RunGroundEval(a->frames, a->masks, eval::DefaultGroundEvalOptions()), a->json);
+  });
 }
 
 }  // namespace
@@ -67,6 +92,7 @@ void AddLocalizeEval(CLI::App* eval) {
 void AddRealDataEvals(CLI::App* eval) {
   AddShiftEval(eval);
   AddLocalizeEval(eval);
+  AddGroundEval(eval);
 }
 
 }  // namespace mapless::app

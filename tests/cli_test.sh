@@ -57,7 +57,7 @@ section_basics() {
   # docs/cli.md lists every option a command offers (one meaning per name, issue 42).
   if [ -f "$HERE/../docs/cli.md" ]; then
     missing=""
-    for sub in demo "eval shift" "eval localize" "sim render" "sim drive" "sim serve" "sim generate" "eval generated" bench shift teach lead repeat "route info" "eval table1" "eval potential" "eval eigenspace" "eval obstacles" "eval fleet" soak flow ground navigate localize follow teleop "fleet keygen"; do
+    for sub in demo "eval shift" "eval localize" "eval ground" "sim render" "sim drive" "sim serve" "sim generate" "eval generated" bench shift teach lead repeat "route info" "eval table1" "eval potential" "eval eigenspace" "eval obstacles" "eval fleet" soak flow ground navigate localize follow teleop "fleet keygen"; do
       # shellcheck disable=SC2086
       for opt in $("$MAPLESS" $sub --help | grep -oE '^  --[a-z0-9-]+' | tr -d ' '); do
         [ "$opt" = --help ] || grep -q "^| \`$opt\` |" "$HERE/../docs/cli.md" || missing="$missing $sub:$opt"
@@ -195,6 +195,8 @@ section_localize_eval() {
   grep -q "dx.txt" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "eval shift names the missing list in one line" $?
   expect_exit "eval localize --json" 0 "$MAPLESS" eval localize --database "$NL/summer" --query "$NL/winter" --json
   grep -q '"method":"seqslam"' "$TMP/out" && grep -Eq '"within5":[0-9.]+' "$TMP/out"; check "eval localize: mapless and the baselines" $?
+  expect_exit "eval ground on folders with no labelled pair exits 2" 2 "$MAPLESS" eval ground --frames "$NL/summer" --masks "$HERE/data/stromovka"
+  grep -q "no mask has the name of a frame" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "eval ground says why in one line" $?
   expect_exit "eval experiences on a folder without offsets.txt exits 2" 2 "$MAPLESS" eval experiences --sessions "$NL/summer"
   grep -q "$NL/summer/offsets.txt" "$TMP/err" && [ "$(wc -l <"$TMP/err")" -eq 1 ]; check "eval experiences names the missing offsets.txt in one line" $?
 

@@ -25,6 +25,8 @@ void SequenceFilterOptions::Validate() const {
   MAPLESS_CHECK(
       uniform_mixing >= 0.0 && uniform_mixing < 1.0,
       "SequenceFilterOptions.uniform_mixing = " << uniform_mixing << "; must be in [0, 1)");
+  MAPLESS_CHECK(start_sigma >= 0.0 && std::isfinite(start_sigma),
+                "SequenceFilterOptions.start_sigma = " << start_sigma << "; must be >= 0");
   MAPLESS_CHECK(confidence_window >= 0, "SequenceFilterOptions.confidence_window = "
                                             << confidence_window << "; must be >= 0");
 }
@@ -88,6 +90,16 @@ SequenceFilter::SequenceFilter(cv::Mat route, SequenceFilterOptions options)
   MAPLESS_CHECK(route_.rows >= 2,
                 "sequence filter: the route needs at least 2 images, got " << route_.rows);
   belief_.assign(static_cast<std::size_t>(route_.rows), 1.0 / route_.rows);
+  if (options_.start_sigma > 0.0) {  // near the first image, and a floor anywhere
+    double sum = 0.0;
+    for (int i = 0; i < route_.rows; ++i) {
+      const double x = i / options_.start_sigma;
+      auto& b = belief_[static_cast<std::size_t>(i)];
+      b = std::exp(-0.5 * x * x) + options_.uniform_mixing;
+      sum += b;
+    }
+    for (double& b : belief_) b /= sum;
+  }
   const int half = static_cast<int>(std::ceil(4.0 * options_.advance_sigma)) + 1;
   for (int k = -half; k <= half; ++k) {
     kernel_.push_back(std::exp(-0.5 * k * k / (options_.advance_sigma * options_.advance_sigma)));

@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "mapless/eval/real_ground.h"
 #include "mapless/eval/real_localize.h"
 #include "mapless/eval/real_shift.h"
 #include "mapless/run/suites.h"
@@ -20,5 +21,10 @@ SuiteOutput RunShiftEval(const std::string& dir, const eval::ShiftEvalOptions& o
 // confidence), "query_ms"}]}; mapless first.
 SuiteOutput RunLocalizeEval(const std::string& database, const std::string& query,
                             const eval::LocalizeEvalOptions& options);
+
+// {"suite": "ground", "frames", "masks", "pairs", "flow_ms", "methods": [{"method", "pairs",
+// "mean_iou", "plane_ms"}]}; mapless first.
+SuiteOutput RunGroundEval(const std::string& frames, const std::string& masks,
+                          const eval::GroundEvalOptions& options);
 
 }  // namespace mapless::run
