@@ -27,6 +27,9 @@ nlohmann::json BenchStages(const StageOptions& options);
 void BenchTeachRepeat(nlohmann::json* j);
 void BenchPotential(int repeats, nlohmann::json* j);
 void BenchEigenspace(int repeats, nlohmann::json* j);
+// Issue 66: the shift on a 512x192 pair against ORB-500, the sequence filter's step on a
+// 1200-image route against DIS fast (real_images.cc).
+void BenchRealImageStages(int repeats, nlohmann::json* j);
 // A middleware's adapter latency, frame received to command published ("ros1", "ros2"); a row
 // saying why when it is not built or could not be measured.
 void BenchMiddleware(const robot::MiddlewareRegistry& middlewares, const std::string& middleware,

@@ -251,6 +251,7 @@ nlohmann::json BenchStages(const StageOptions& options) {
   BenchTeachRepeat(&j);
   BenchPotential(options.repeats, &j);
   BenchEigenspace(options.repeats, &j);
+  BenchRealImageStages(options.repeats, &j);
   return j;
 }
 

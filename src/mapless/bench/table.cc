@@ -107,7 +107,12 @@ void PrintStageTable(const nlohmann::json& j) {
                           "dominant_plane_step_dis_medium_2_threads_ms",
                           "ipca_add_1000_ms",
                           "markov_update_10000_ms",
-                          "subwindow_control_ms"}) {
+                          "subwindow_control_ms",
+                          "opencv_orb500_512x192_ms",
+                          "shift_pair_512x192_ms",
+                          "shift_step_512x192_ms",
+                          "opencv_dis_fast_real_320x240_ms",
+                          "sequence_filter_step_1200_ms"}) {
     const double ms = j[key].get<double>();
     std::printf("%-40s %10.3f %9.0f\n", key, ms, ms > 0.0 ? 1000.0 / ms : 0.0);
   }
@@ -168,6 +173,12 @@ void PrintStageTable(const nlohmann::json& j) {
     std::printf("%-34s %10.2f  (issue 5: <= 1.5)\n", (std::string(key) + " / dis_fast").c_str(),
                 j[std::string(key) + "_over_dis_fast"].get<double>());
   }
+  std::printf("%-34s %10.2f  (issue 66: <= 10; both images described)\n",
+              "shift_pair / orb500 512x192", j["shift_pair_over_orb500"].get<double>());
+  std::printf("%-34s %10.2f  (the taught view described once, as a repeat does)\n",
+              "shift_step / orb500 512x192", j["shift_step_over_orb500"].get<double>());
+  std::printf("%-34s %10.2f  (issue 66: <= 1.0)\n", "sequence_filter_1200 / dis_fast",
+              j["sequence_filter_step_over_dis_fast"].get<double>());
   PrintLinkRows(j);
 }
 
