@@ -11,6 +11,7 @@
 #include "mapless/core/check.h"
 #include "mapless/io/frame_source.h"
 #include "mapless/localization/sequence.h"
+#include "mapless/localization/sequence_filter.h"
 #include "mapless/recording/playback.h"
 
 namespace mapless::app {
@@ -48,13 +49,21 @@ Folder ReadFolder(const std::string& dir, const std::string& option,
   return folder;
 }
 
+void PrintQuery(const std::string& name, int index, double probability) {
+  nlohmann::ordered_json j;
+  j["query"] = name;
+  j["index"] = index;
+  j["probability"] = probability;
+  std::cout << j.dump() << "\n";
+}
+
 }  // namespace
 
 void AddLocalizeCommand(CLI::App* app) {
   struct Args {
     std::string database;
     std::string query;
-    std::string method = "markov";
+    std::string method = "sequence";
     std::string pca = "incremental";
     bool json = false;
     int width = 64;
@@ -62,6 +71,7 @@ void AddLocalizeCommand(CLI::App* app) {
     int dimensions = 16;
     double advance = 1.0;
     double advance_sigma = 0.2;
+    double start_sigma = localization::SequenceFilterOptions{}.start_sigma;
     recording::PlaybackOptions playback;
   };
   auto args = std::make_shared<Args>();
@@ -78,7 +88,9 @@ void AddLocalizeCommand(CLI::App* app) {
   cmd->add_option("--start", args->playback.start_s, "Begin this many seconds into each source")
       ->capture_default_str()
       ->check(FiniteIn(0.0, 1e9));
-  cmd->add_option("--localizer", args->method, "nn (nearest projection) or markov")
+  cmd->add_option("--localizer", args->method,
+                  "sequence (the sequence filter across seasons), markov (the paper's) or nn "
+                  "(nearest projection)")
       ->capture_default_str();
   AddOldName(cmd, "--method", "--localizer", &args->method);
   cmd->add_option("--pca", args->pca, "incremental or batch")->capture_default_str();
@@ -91,16 +103,20 @@ void AddLocalizeCommand(CLI::App* app) {
   cmd->add_option("--height", args->height, "Low-resolution image height, px")
       ->capture_default_str()
       ->check(CLI::Range(8, 1024));
-  cmd->add_option("--advance", args->advance,
-                  "Markov motion model: database images per query image")
+  cmd->add_option("--advance", args->advance, "Motion model: database images per query image")
       ->capture_default_str()
       ->check(FiniteIn(0.0, 1000.0));
-  cmd->add_option("--advance-sigma", args->advance_sigma,
-                  "Markov motion model: its standard deviation per query, database images")
+  CLI::Option* sigma = cmd->add_option(
+      "--advance-sigma", args->advance_sigma,
+      "Motion model: its standard deviation per query, database images (sequence: 1 unless given)");
+  sigma->capture_default_str()->check(FiniteIn(0.01, 1000.0));
+  cmd->add_option("--start-sigma", args->start_sigma,
+                  "sequence: the queries start within about this many database images of the "
+                  "first (0: anywhere)")
       ->capture_default_str()
-      ->check(FiniteIn(0.01, 1000.0));
+      ->check(FiniteIn(0.0, 1e6));
   cmd->add_flag("--json", args->json, "One JSON object per query (the only output format)");
-  cmd->callback([args] {
+  cmd->callback([args, sigma] {
     localization::SequenceLocalizationOptions options;
     options.method = localization::ParseSequenceMethod(args->method);
     MAPLESS_CHECK(args->pca == "incremental" || args->pca == "batch",
@@ -114,19 +130,24 @@ void AddLocalizeCommand(CLI::App* app) {
     options.Validate();
     const Folder database = ReadFolder(args->database, "--database", args->playback);
     const Folder query = ReadFolder(args->query, "--query", args->playback);
+    if (options.method == localization::SequenceMethod::kSequenceFilter) {
+      localization::SequenceFilterOptions filter;
+      filter.advance = args->advance;
+      if (sigma->count() > 0) filter.advance_sigma = args->advance_sigma;
+      filter.start_sigma = args->start_sigma;
+      const auto results = localization::FilterSequence(database.images, query.images, filter);
+      for (std::size_t i = 0; i < results.size(); ++i)
+        PrintQuery(query.names[i], results[i].index, results[i].confidence);
+      return;
+    }
     const appearance::Eigenspace route =
         localization::BuildRouteEigenspace(database.images, options);
     spdlog::info("localize: {} route images, eigenspace of {} dimensions ({} PCA); {} queries ({})",
                  database.images.size(), route.dimensions(), args->pca, query.images.size(),
                  args->method);
     const auto results = localization::LocalizeSequence(route, query.images, options);
-    for (std::size_t i = 0; i < results.size(); ++i) {
-      nlohmann::ordered_json j;
-      j["query"] = query.names[i];
-      j["index"] = results[i].index;
-      j["probability"] = results[i].probability;
-      std::cout << j.dump() << "\n";
-    }
+    for (std::size_t i = 0; i < results.size(); ++i)
+      PrintQuery(query.names[i], results[i].index, results[i].probability);
   });
 }
 

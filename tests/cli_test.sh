@@ -180,6 +180,10 @@ section_localize_eval() {
   m5=$(within5 "$TMP/loc_markov.jsonl"); n5=$(within5 "$TMP/loc_nn.jsonl")
   echo "     localize within +-5 places: markov $m5/100, nn $n5/100"
   [ "$m5" -ge 90 ] && [ "$m5" -gt "$n5" ]; check "localize: markov >= 90/100 within 5 places and better than nn" $?
+  expect_exit "localize (the sequence filter, the default)" 0 "$MAPLESS" localize --database "$NL/summer" --query "$NL/winter" --json
+  s5=$(within5 "$TMP/out")
+  echo "     localize within +-5 places: sequence $s5/100"
+  [ "$s5" -ge 95 ]; check "localize: the default sequence filter >= 95/100 within 5 places" $?
   expect_exit "localize with a missing folder exits 2" 2 "$MAPLESS" localize --database "$TMP/none" --query "$NL/winter"
   grep -q -- "--database $TMP/none: not a folder of images" "$TMP/err"; check "localize names the missing folder" $?
   expect_exit "localize with a bad method exits 2" 2 "$MAPLESS" localize --database "$NL/summer" --query "$NL/winter" --localizer best

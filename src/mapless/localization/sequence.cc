@@ -10,7 +10,8 @@ namespace mapless::localization {
 SequenceMethod ParseSequenceMethod(const std::string& name) {
   if (name == "nn") return SequenceMethod::kNearest;
   if (name == "markov") return SequenceMethod::kMarkov;
-  throw InputError("localization method '" + name + "' is unknown; use nn or markov");
+  if (name == "sequence") return SequenceMethod::kSequenceFilter;
+  throw InputError("localization method '" + name + "' is unknown; use sequence, markov or nn");
 }
 
 void SequenceLocalizationOptions::Validate() const {
@@ -48,6 +49,9 @@ std::vector<QueryLocalization> LocalizeSequence(const appearance::Eigenspace& ro
                                                 const std::vector<cv::Mat>& queries,
                                                 const SequenceLocalizationOptions& options) {
   options.Validate();
+  MAPLESS_CHECK(options.method != SequenceMethod::kSequenceFilter,
+                "LocalizeSequence: the sequence filter takes images, not an eigenspace "
+                "(FilterSequence)");
   std::vector<QueryLocalization> out;
   out.reserve(queries.size());
   MarkovOptions markov_options = options.markov;

@@ -15,8 +15,9 @@
 
 namespace mapless::localization {
 
-enum class SequenceMethod { kNearest, kMarkov };
-// "nn" or "markov"; throws InputError naming the value otherwise.
+// kSequenceFilter: sequence_filter.h (no eigenspace; `mapless localize`'s default since issue 66).
+enum class SequenceMethod { kNearest, kMarkov, kSequenceFilter };
+// "nn", "markov" or "sequence"; throws InputError naming the value otherwise.
 SequenceMethod ParseSequenceMethod(const std::string& name);
 
 struct SequenceLocalizationOptions {

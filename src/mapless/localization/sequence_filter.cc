@@ -152,6 +152,20 @@ SequenceEstimate SequenceFilter::Update(const cv::Mat& query_descriptor) {
   return out;
 }
 
+std::vector<SequenceEstimate> FilterSequence(const std::vector<cv::Mat>& database,
+                                             const std::vector<cv::Mat>& queries,
+                                             const SequenceFilterOptions& options) {
+  options.Validate();
+  cv::Mat route;
+  for (const cv::Mat& image : database) route.push_back(SequenceDescriptor(image, options));
+  SequenceFilter filter(route, options);
+  std::vector<SequenceEstimate> out;
+  out.reserve(queries.size());
+  for (const cv::Mat& image : queries)
+    out.push_back(filter.Update(SequenceDescriptor(image, options)));
+  return out;
+}
+
 std::vector<int> SeqSlamPastOnly(const std::vector<std::vector<double>>& differences,
                                  int sequence_length) {
   MAPLESS_CHECK(sequence_length >= 1, "SeqSLAM: sequence length " << sequence_length);

@@ -65,6 +65,11 @@ class SequenceFilter {
   bool first_ = true;
 };
 
+// Every query in order through a filter on the database images' route.
+std::vector<SequenceEstimate> FilterSequence(const std::vector<cv::Mat>& database,
+                                             const std::vector<cv::Mat>& queries,
+                                             const SequenceFilterOptions& options);
+
 // The SeqSLAM-style baseline over past queries only; `differences[q]` are query q's
 // EnhancedDifferences. Returns the route image for each query.
 std::vector<int> SeqSlamPastOnly(const std::vector<std::vector<double>>& differences,
