@@ -282,6 +282,47 @@ MatchBinary(const Features& query, const Features& train, const MatchOptions& op
 
 }  // namespace
 
+namespace {
+
+// The nearest train descriptor of each query descriptor by L2, ties to the lower index (as
+// BFMatcher); with `mutual`, only pairs that are each other's nearest. The distances come from
+// cv::batchDistance, the kernel BFMatcher uses, once for both directions.
+std::vector<cv::DMatch> MatchFloatNearest(const Features& query, const Features& train,
+                                          bool mutual) {
+  cv::Mat distances;  // query x train, squared L2
+  cv::batchDistance(query.descriptors, train.descriptors, distances, CV_32F, cv::noArray(),
+                    cv::NORM_L2SQR);
+  const int n = distances.rows;
+  const int m = distances.cols;
+  std::vector<int> best_query(static_cast<std::size_t>(m), -1);
+  std::vector<float> best_query_d(static_cast<std::size_t>(m), std::numeric_limits<float>::max());
+  std::vector<int> best_train(static_cast<std::size_t>(n), -1);
+  for (int i = 0; i < n; ++i) {
+    const float* row = distances.ptr<float>(i);
+    float best = std::numeric_limits<float>::max();
+    for (int j = 0; j < m; ++j) {
+      const float d = row[j];
+      if (d < best) {
+        best = d;
+        best_train[static_cast<std::size_t>(i)] = j;
+      }
+      if (d < best_query_d[static_cast<std::size_t>(j)]) {
+        best_query_d[static_cast<std::size_t>(j)] = d;
+        best_query[static_cast<std::size_t>(j)] = i;
+      }
+    }
+  }
+  std::vector<cv::DMatch> out;
+  for (int i = 0; i < n; ++i) {
+    const int j = best_train[static_cast<std::size_t>(i)];
+    if (j < 0 || (mutual && best_query[static_cast<std::size_t>(j)] != i)) continue;
+    out.emplace_back(i, j, std::sqrt(distances.at<float>(i, j)));
+  }
+  return out;
+}
+
+}  // namespace
+
 std::vector<cv::DMatch> MatchFeatures(const Features& query, const Features& train,
                                       const MatchOptions& options) {
   std::vector<cv::DMatch> out;
@@ -289,7 +330,11 @@ std::vector<cv::DMatch> MatchFeatures(const Features& query, const Features& tra
   MAPLESS_CHECK(query.binary == train.binary && query.descriptors.cols == train.descriptors.cols,
                 "MatchFeatures: descriptors of different kinds");
   if (query.binary) return MatchBinary(query, train, options);
-  return MatchFeaturesBruteForce(query, train, options);  // float descriptors (SIFT)
+  // Float descriptors (SIFT): without a ratio test or a window, every distance once and the best
+  // of each row and column from it (BFMatcher computes them twice with the mutual check).
+  if (options.ratio >= 1.0 && options.max_ddx_px >= 1e8 && options.max_dy_px >= 1e8)
+    return MatchFloatNearest(query, train, options.mutual);
+  return MatchFeaturesBruteForce(query, train, options);
 }
 
 std::vector<cv::DMatch> MatchFeaturesBruteForce(const Features& query, const Features& train,

@@ -92,6 +92,35 @@ TEST(MatchFeatures, GuidedMatchingResolvesARepeatingPattern) {
 // Frames along two routes matched with frames up to 1 m ahead, ORB and AKAZE, plain and guided,
 // with and without the mutual check: every match (indices and distance) equals BFMatcher's
 // (MatchFeaturesBruteForce, what MatchFeatures did for every descriptor before).
+// The float fast path (no ratio test, no window: the shift estimator's matching) gives
+// BFMatcher's nearest neighbours, with and without the mutual check.
+TEST(MatchFeatures, FloatNearestMatchesAreOpenCvBruteForceMatches) {
+  std::size_t matches_seen = 0;
+  FeatureOptions fo;
+  fo.type = DetectorType::kAkazeSift;
+  const FeatureExtractor extractor(fo);
+  for (const char* scenario : {"table1_almost_straight", "office_aliasing"}) {
+    const Features a = extractor.Extract(SimFrame(scenario, Pose2{0.5, 0.05, 0.02}));
+    const Features b = extractor.Extract(SimFrame(scenario, Pose2{0.9, 0.0, 0.0}));
+    ASSERT_FALSE(a.binary);
+    for (const bool mutual : {false, true}) {
+      MatchOptions m;
+      m.ratio = 1.0;
+      m.mutual = mutual;
+      const auto got = MatchFeatures(a, b, m);
+      const auto want = MatchFeaturesBruteForce(a, b, m);
+      ASSERT_EQ(got.size(), want.size()) << scenario << " mutual " << mutual;
+      for (std::size_t i = 0; i < got.size(); ++i) {
+        EXPECT_EQ(got[i].queryIdx, want[i].queryIdx);
+        EXPECT_EQ(got[i].trainIdx, want[i].trainIdx);
+        EXPECT_NEAR(got[i].distance, want[i].distance, 1e-3 * want[i].distance + 1e-3);
+      }
+      matches_seen += got.size();
+    }
+  }
+  EXPECT_GT(matches_seen, 4u * 20u);  // the comparisons are not of empty match sets
+}
+
 TEST(MatchFeatures, BinaryMatchesAreExactlyOpenCvBruteForceMatches) {
   int compared = 0;
   std::size_t matches_seen = 0;
