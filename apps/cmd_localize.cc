@@ -106,9 +106,9 @@ void AddLocalizeCommand(CLI::App* app) {
   cmd->add_option("--advance", args->advance, "Motion model: database images per query image")
       ->capture_default_str()
       ->check(FiniteIn(0.0, 1000.0));
-  CLI::Option* sigma = cmd->add_option(
-      "--advance-sigma", args->advance_sigma,
-      "Motion model: its standard deviation per query, database images (sequence: 1 unless given)");
+  CLI::Option* sigma = cmd->add_option("--advance-sigma", args->advance_sigma,
+                                       "Motion model: its standard deviation per query, database "
+                                       "images (sequence: 0.5 unless given)");
   sigma->capture_default_str()->check(FiniteIn(0.01, 1000.0));
   cmd->add_option("--start-sigma", args->start_sigma,
                   "sequence: the queries start within about this many database images of the "

@@ -7,9 +7,8 @@
 // and each difference contrast-enhanced against the differences of its route neighbours (z-score
 // over +-R images, so that a place is judged against the places around it). The motion model is an
 // advance per query with a Gaussian spread and a little uniform mixing (the robot may stop or speed
-// up); only past queries are used. The belief starts near the route's first image (a repeat
-// starts where the teach did; `start_sigma` 0: anywhere). The confidence is the belief mass around
-// its maximum.
+// up); only past queries are used. The belief starts uniform, or near the route's first image
+// when told (`start_sigma`). The confidence is the belief mass around its maximum.
 //
 // Also here, for evaluations, the SeqSLAM-style baseline: the same differences, and for each query
 // the route image that ends the straight sequence (0.8 to 1.2 route images per query) of least
@@ -28,11 +27,13 @@ struct SequenceFilterOptions {
   int contrast_window = 10;    // R, route images each side
   double temperature = 3.0;    // likelihood exp(-(z - z_min) / temperature)
   double advance = 1.0;        // route images per query ...
-  double advance_sigma = 1.0;  // ... and its spread per query
+  double advance_sigma = 0.5;  // ... and its spread per query (a place's worth of speed change
+                               // in a few queries; 1 blurs the belief over neighbouring places)
   double uniform_mixing = 1e-3;
-  // Where the traversal starts: within about start_sigma route images of the route's first image
-  // (a repeat starts where the teach did), or anywhere (0: a uniform belief).
-  double start_sigma = 10.0;
+  // Where the traversal starts: anywhere (0: a uniform belief, the default: no assumption), or
+  // within about start_sigma route images of the route's first image (a repeat that starts where
+  // the teach did).
+  double start_sigma = 0.0;
   // Confidence = belief mass within +- this many images of the estimate: the probability, by the
   // filter's own belief, that the estimate is within that many places (the evaluation's 5).
   int confidence_window = 5;
