@@ -32,6 +32,7 @@ struct GroundArgs {
   std::string truth;
   double epsilon_px = 0.4;
   double epsilon_relative = 0.4;
+  double nearer_fraction = 0.5;
   double roi_top = 0.5;
   double fit_bottom = 0.5;
   double iou_top = 0.5;
@@ -50,6 +51,7 @@ ground::DominantPlaneOptions PlaneOptions(const GroundArgs& args) {
   options.model = ground::ParsePlaneModel(args.model);
   options.epsilon_px = args.epsilon_px;
   options.epsilon_relative = args.epsilon_relative;
+  options.nearer_fraction = args.nearer_fraction;
   options.roi_top_fraction = args.roi_top;
   options.fit_bottom_fraction = args.fit_bottom;
   options.Validate();
@@ -142,6 +144,11 @@ void AddGroundCommand(CLI::App* app) {
                   "Tolerance grows by this fraction of |u_hat| (0: the paper's fixed epsilon)")
       ->capture_default_str()
       ->check(FiniteIn(0.0, 10.0));
+  cmd->add_option("--nearer-fraction", args->nearer_fraction,
+                  "Tolerance along the planar flow (moving more: nearer than the ground), as a "
+                  "fraction of the tolerance (1: the paper's circle)")
+      ->capture_default_str()
+      ->check(FiniteIn(0.01, 1.0));
   cmd->add_option("--roi-top", args->roi_top,
                   "Region of interest: rows below this fraction of the height (0: whole image)")
       ->capture_default_str()

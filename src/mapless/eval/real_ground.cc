@@ -65,6 +65,7 @@ GroundEvalOptions DefaultGroundEvalOptions() {
   o.plane.model = ground::PlaneModel::kHomography;
   o.plane.epsilon_px = 0.4;
   o.plane.epsilon_relative = 0.4;
+  o.plane.nearer_fraction = 0.5;
   o.plane.roi_top_fraction = 0.5;
   o.plane.fit_bottom_fraction = 0.5;
   return o;

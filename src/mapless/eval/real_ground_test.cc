@@ -44,7 +44,7 @@ TEST(EvalGround, CamVidAgainstAStockRansacHomography) {
   EXPECT_EQ(f.pairs, 50);
   std::printf("CamVid ground IoU: mapless %.3f, RANSAC homography %.3f\n", f.methods[0].mean_iou,
               f.methods[1].mean_iou);
-  EXPECT_GT(f.methods[0].mean_iou, 0.8);  // measured 0.803 (the issue asks for 0.85: not met)
+  EXPECT_GT(f.methods[0].mean_iou, 0.81);  // measured 0.819 (the issue asks for 0.85: not met)
   EXPECT_GT(f.methods[0].mean_iou, f.methods[1].mean_iou);
 }
 

@@ -48,6 +48,9 @@ const char* PlaneModelName(PlaneModel model) {
 void DominantPlaneOptions::Validate() const {
   MAPLESS_CHECK(epsilon_px > 0.0,
                 "DominantPlaneOptions.epsilon_px = " << epsilon_px << "; must be > 0");
+  MAPLESS_CHECK(
+      nearer_fraction > 0.0 && nearer_fraction <= 1.0,
+      "DominantPlaneOptions.nearer_fraction = " << nearer_fraction << "; must be in (0, 1]");
   MAPLESS_CHECK(epsilon_relative >= 0.0,
                 "DominantPlaneOptions.epsilon_relative = " << epsilon_relative << "; must be >= 0");
   MAPLESS_CHECK(
@@ -139,6 +142,7 @@ DominantPlane DetectDominantPlane(const cv::Mat& flow, const DominantPlaneOption
   const auto* m = model.ptr<double>();
   const auto eps = static_cast<float>(options.epsilon_px);
   const auto rel = static_cast<float>(options.epsilon_relative);
+  const auto nearer = static_cast<float>(options.nearer_fraction);
   for (int y = 0; y < flow.rows; ++y) {
     const auto* f = flow.ptr<cv::Vec2f>(y);
     uchar* d = result.mask.ptr<uchar>(y);
@@ -158,8 +162,12 @@ DominantPlane DetectDominantPlane(const cv::Mat& flow, const DominantPlaneOption
       const float py = (b1 * fx + b0) * s - fy;
       const float du = f[x][0] - px;
       const float dv = f[x][1] - py;
-      const float tol = eps + rel * std::sqrt(px * px + py * py);
-      d[x] = du * du + dv * dv < tol * tol ? 255 : 0;
+      const float norm = std::sqrt(px * px + py * py);
+      const float tol = eps + rel * norm;
+      // The excess along the planar flow's direction: > 0 where the pixel moves more than the
+      // ground there would, i.e. is nearer (something standing on the ground).
+      const float along = norm > 1e-6F ? (du * px + dv * py) / norm : 0.0F;
+      d[x] = du * du + dv * dv < tol * tol && along < nearer * tol ? 255 : 0;
     }
   }
   if (options.open_px > 0) {

@@ -25,6 +25,12 @@ struct DominantPlaneOptions {
   // near zero at the horizon), so a fixed epsilon is too strict below and too loose above
   // (distant buildings, whose flow is as small as the ground's there). 0: the paper's Eq. 5.
   double epsilon_relative = 0.0;
+  // Not in the paper: the tolerance in the direction of the planar flow, as a fraction of the
+  // tolerance (1: a circle, the paper's). Something standing on the ground is nearer than the
+  // ground behind it, so it moves more than the planar flow, along it: 0.5 cuts the feet of walls,
+  // cars and people out of the plane where their flow is still within the tolerance (`mapless
+  // ground`: 0.5; CamVid IoU 0.803 -> 0.820).
+  double nearer_fraction = 1.0;
   int sample_step_px = 4;  // RANSAC draws from flow vectors on this grid
   // RANSAC: adaptive iteration count from the inlier ratio (confidence), capped at the paper's
   // fixed count width * height / 2.

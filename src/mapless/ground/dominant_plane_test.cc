@@ -47,6 +47,39 @@ TEST(DetectDominantPlane, RecoversAKnownHomographyWithAnObstacle) {
   EXPECT_LT(plane.iterations, 320 * 240 / 2);  // adaptive, far below the paper's fixed count
 }
 
+TEST(DetectDominantPlane, NearerFractionCutsWhatMovesMoreThanTheGroundButNotLess) {
+  // Two blocks whose flow differs from the ground's by 1.5 px along the planar flow: one moves
+  // more (nearer than the ground: something standing on it), one less. Both are inside the
+  // circular tolerance 0.5 px + 0.4 |u_hat| (the nearer block: |u_hat| 4.3-5.1 px, 2.2-2.5 px;
+  // the farther one more); half of it along the flow (1.1-1.3 px there) cuts the first only.
+  const cv::Mat h = GroundHomography();
+  cv::Mat flow = PlanarFlow(h, cv::Size(320, 240));
+  const cv::Rect nearer(40, 180, 40, 40);
+  const cv::Rect farther(240, 180, 40, 40);
+  for (const auto& [block, sign] : {std::pair{nearer, 1.0F}, std::pair{farther, -1.0F}}) {
+    for (int y = block.y; y < block.br().y; ++y) {
+      for (int x = block.x; x < block.br().x; ++x) {
+        cv::Vec2f& u = flow.at<cv::Vec2f>(y, x);
+        u += 1.5F * sign * u / cv::norm(u);
+      }
+    }
+  }
+  DominantPlaneOptions options;
+  options.epsilon_px = 0.5;
+  options.epsilon_relative = 0.4;
+  options.open_px = 0;
+  const auto on_plane = [&](const cv::Rect& block, double nearer_fraction) {
+    options.nearer_fraction = nearer_fraction;
+    const DominantPlane plane = DetectDominantPlane(flow, options);
+    EXPECT_TRUE(plane.found);
+    return cv::countNonZero(plane.mask(block)) / static_cast<double>(block.area());
+  };
+  EXPECT_GT(on_plane(nearer, 1.0), 0.99);  // the paper's circle keeps both
+  EXPECT_GT(on_plane(farther, 1.0), 0.99);
+  EXPECT_LT(on_plane(nearer, 0.5), 0.01);
+  EXPECT_GT(on_plane(farther, 0.5), 0.99);
+}
+
 TEST(DetectDominantPlane, TheAffineModelRecoversAnAffineFlow) {
   const cv::Mat a = (cv::Mat_<double>(3, 3) << 1.01, 0.02, -2.0, -0.01, 1.03, 1.5, 0.0, 0.0, 1.0);
   const cv::Mat flow = SyntheticFlow(a, cv::Rect(0, 0, 100, 100), cv::Vec2f(5.f, 5.f));
