@@ -8,6 +8,10 @@
 
 namespace mapless::eval {
 
+// The evaluations on real images hold every image of a dataset while they run: at most this many
+// pixels in all (512 megapixels of grey), refused before the work with the file it was reached at.
+inline constexpr double kMaxHeldPixels = 512e6;
+
 inline double MsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();

@@ -81,8 +81,14 @@ GroundEvalFigures EvalGround(const std::string& frames_dir, const std::string& m
   // Every frame and mask is read and checked before the work.
   std::vector<cv::Mat> images;
   std::vector<cv::Mat> truth(frames.size());
+  double pixels = 0.0;
   for (std::size_t i = 0; i < frames.size(); ++i) {
     images.push_back(io::ReadImage(frames_dir + "/" + frames[i], cv::IMREAD_GRAYSCALE, 16));
+    pixels += 2.0 * static_cast<double>(images.back().total());  // the frame and its mask
+    MAPLESS_CHECK(pixels <= kMaxHeldPixels,
+                  "--frames " << frames_dir << ": more than " << kMaxHeldPixels / 1e6
+                              << " megapixels with the masks (at " << frames[i]
+                              << "); use fewer or smaller frames");
     if (i > 0)
       io::RequireSameSize(images[i], frames_dir + "/" + frames[i], images[0],
                           frames_dir + "/" + frames[0]);

@@ -17,7 +17,6 @@ namespace {
 
 namespace fs = std::filesystem;
 constexpr std::size_t kMaxImages = 100000;
-constexpr double kMaxPixels = 512e6;  // all images of both folders are held
 
 struct Folder {
   std::vector<std::string> names;
@@ -40,9 +39,9 @@ Folder ReadFolder(const std::string& dir, const std::string& option) {
   for (const std::string& name : folder.names) {
     folder.images.push_back(io::ReadImage(dir + "/" + name, cv::IMREAD_GRAYSCALE, 4));
     pixels += static_cast<double>(folder.images.back().total());
-    MAPLESS_CHECK(pixels <= kMaxPixels, option
-                                            << " " << dir << ": more than " << kMaxPixels / 1e6
-                                            << " megapixels in all; use fewer or smaller images");
+    MAPLESS_CHECK(pixels <= kMaxHeldPixels,
+                  option << " " << dir << ": more than " << kMaxHeldPixels / 1e6
+                         << " megapixels in all; use fewer or smaller images");
   }
   return folder;
 }

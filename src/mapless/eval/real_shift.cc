@@ -150,8 +150,14 @@ ShiftEvalFigures EvalShift(const ShiftDataset& data, const ShiftEvalOptions& opt
                 "tolerance " << options.tolerance_px << " px: must be > 0");
   // Every image is read and checked before any work: same size as the first, grey.
   std::vector<cv::Mat> images;
+  double pixels = 0.0;
   for (const std::string& path : data.images) {
     images.push_back(io::ReadImage(path, cv::IMREAD_GRAYSCALE, 16));
+    pixels += static_cast<double>(images.back().total());
+    MAPLESS_CHECK(pixels <= kMaxHeldPixels, data.dir << ": its images hold more than "
+                                                     << kMaxHeldPixels / 1e6
+                                                     << " megapixels in all (at " << path
+                                                     << "); use fewer or smaller images");
     if (images.size() > 1) io::RequireSameSize(images.back(), path, images.front(), data.images[0]);
   }
   ShiftEvalFigures out;
