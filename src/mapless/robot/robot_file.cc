@@ -118,7 +118,7 @@ void ParseTopics(const io::YamlMap& t, RobotFile* r) {
 void ParseObstacles(const io::YamlMap& o, RobotFile* r) {
   o.CheckKnownKeys({"on_obstacle", "region_top", "region_far_m", "region_width",
                     "region_half_width_m", "horizon", "baseline_m", "min_blocked_fraction",
-                    "max_unchecked_m"});
+                    "max_unchecked_m", "creep_m", "creep_speed_mps"});
   const std::string on = o.GetString("on_obstacle", "stop");
   if (on != "stop" && on != "avoid" && on != "off")
     o.Fail("on_obstacle", "'" + on + "' is not stop, avoid or off");
@@ -146,6 +146,8 @@ void ParseObstacles(const io::YamlMap& o, RobotFile* r) {
       fraction("min_blocked_fraction", r->obstacle.min_blocked_fraction, 0.01, 0.99);
   r->obstacle.max_unchecked_m = fraction("max_unchecked_m", r->obstacle.max_unchecked_m, 0.0, 10.0);
   r->obstacle_max_unchecked_given = o.Has("max_unchecked_m");
+  r->obstacle.creep_m = fraction("creep_m", r->obstacle.creep_m, 0.0, 2.0);
+  r->obstacle.creep_speed_mps = fraction("creep_speed_mps", r->obstacle.creep_speed_mps, 0.01, 0.5);
 }
 
 }  // namespace

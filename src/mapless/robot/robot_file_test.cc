@@ -99,6 +99,22 @@ TEST(RobotFile, ObstacleWatchSettings) {
   EXPECT_DOUBLE_EQ(
       ParseRobotFile("obstacles: {region_far_m: 3.5}\n", "robot.yaml").obstacle.region_far_m, 3.5);
   ExpectError("obstacles: {region_far_m: -1}\n", "region_far_m");
+  // The creep that checks unchecked ground (issue 65): how far and how fast; 0 m: stop at once.
+  const RobotFile c =
+      ParseRobotFile("obstacles: {creep_m: 0, creep_speed_mps: 0.05}\n", "robot.yaml");
+  EXPECT_DOUBLE_EQ(c.obstacle.creep_m, 0.0);
+  EXPECT_DOUBLE_EQ(c.obstacle.creep_speed_mps, 0.05);
+  EXPECT_DOUBLE_EQ(ParseRobotFile("{}\n", "robot.yaml").obstacle.creep_m, 0.3);
+  ExpectError("obstacles: {creep_m: 5}\n", "creep_m");
+  ExpectError("obstacles: {creep_speed_mps: 0}\n", "creep_speed_mps");
+}
+
+TEST(RobotFile, TheCommentedExampleLoadsWithItsStatedValues) {
+  const RobotFile r =
+      LoadRobotFile(std::string(MAPLESS_SOURCE_DIR) + "/config/robots/turtlebot.yaml");
+  EXPECT_DOUBLE_EQ(r.obstacle.creep_m, 0.3);
+  EXPECT_DOUBLE_EQ(r.obstacle.creep_speed_mps, 0.1);
+  EXPECT_DOUBLE_EQ(r.obstacle.min_blocked_fraction, 0.15);
 }
 
 }  // namespace
