@@ -244,6 +244,8 @@ int Lockstep(double seconds) {
   node.Reader("/sim/odom", new nav_msgs::msg::dds_::Odometry_PubSubType, false, &on_odom);
   node.Reader("/cmd_vel", new geometry_msgs::msg::dds_::Twist_PubSubType, true, &on_command);
   const bool driven = Wait(seconds, [] { return g.nonzero >= 30; });
+  // Debug images are best effort, 230 KB each: on a loaded machine the first may take a while.
+  Wait(5.0, [] { return g.debug_images > 0; });
   std::lock_guard<std::mutex> lock(g_mutex);
   const double moved = std::hypot(g.last_x - g.first_x, g.last_y - g.first_y);
   const bool ok = driven && frames >= 30 && bad_frames == 0 && clocks >= 30 &&
@@ -370,6 +372,8 @@ int main(int argc, char** argv) {
     if (!Wait(5.0, [] { return g.nonzero_after_release > 0; }))
       error = "not driven again after the e-stop was released";
   }
+  // Debug images are best effort, 230 KB each: on a loaded machine the first may take a while.
+  Wait(5.0, [] { return g.debug_images > 0; });
   std::lock_guard<std::mutex> lock(g_mutex);
   const double moved = std::hypot(g.last_x - g.first_x, g.last_y - g.first_y);
   const bool discovery = g.first_sim_frame_s >= 0 && g.first_sim_frame_s <= max_discovery_s &&
