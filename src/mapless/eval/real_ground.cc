@@ -6,29 +6,14 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "mapless/core/check.h"
-#include "mapless/eval/cost.h"
+#include "mapless/eval/real_common.h"
 #include "mapless/io/image_file.h"
 
 namespace mapless::eval {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr std::size_t kMaxFrames = 100000;
 constexpr int kBaselineGridPx = 4;
-
-std::vector<std::string> SortedNames(const std::string& dir, const std::string& option) {
-  MAPLESS_CHECK(fs::is_directory(dir), option << " " << dir << ": not a folder of images");
-  std::vector<std::string> names;
-  std::error_code ec;
-  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
-    if (it->is_regular_file(ec)) names.push_back(it->path().filename().string());
-    MAPLESS_CHECK(names.size() <= kMaxFrames,
-                  option << " " << dir << ": more than " << kMaxFrames << " files");
-  }
-  MAPLESS_CHECK(!ec, option << " " << dir << ": " << ec.message());
-  std::sort(names.begin(), names.end());
-  return names;
-}
 
 // The stock baseline: cv::findHomography with RANSAC on the flow's correspondences (a 4 px grid in
 // the region of interest); the ground is every pixel of the region whose flow the homography
@@ -76,7 +61,7 @@ GroundEvalFigures EvalGround(const std::string& frames_dir, const std::string& m
   options.plane.Validate();
   MAPLESS_CHECK(options.iou_top_fraction >= 0.0 && options.iou_top_fraction < 1.0,
                 "IoU region top " << options.iou_top_fraction << ": must be in [0, 1)");
-  const std::vector<std::string> frames = SortedNames(frames_dir, "--frames");
+  const std::vector<std::string> frames = ImageNamesIn(frames_dir, "--frames");
   MAPLESS_CHECK(fs::is_directory(masks_dir), "--masks " << masks_dir << ": not a folder of images");
   // Every frame and mask is read and checked before the work.
   std::vector<cv::Mat> images;

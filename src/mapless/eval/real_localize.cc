@@ -8,15 +8,12 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "mapless/core/check.h"
-#include "mapless/eval/cost.h"
+#include "mapless/eval/real_common.h"
 #include "mapless/io/image_file.h"
 #include "mapless/localization/sequence.h"
 
 namespace mapless::eval {
 namespace {
-
-namespace fs = std::filesystem;
-constexpr std::size_t kMaxImages = 100000;
 
 struct Folder {
   std::vector<std::string> names;
@@ -24,17 +21,8 @@ struct Folder {
 };
 
 Folder ReadFolder(const std::string& dir, const std::string& option) {
-  MAPLESS_CHECK(fs::is_directory(dir), option << " " << dir << ": not a folder of images");
   Folder folder;
-  std::error_code ec;
-  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
-    if (it->is_regular_file(ec)) folder.names.push_back(it->path().filename().string());
-    MAPLESS_CHECK(folder.names.size() <= kMaxImages,
-                  option << " " << dir << ": more than " << kMaxImages << " files");
-  }
-  MAPLESS_CHECK(!ec, option << " " << dir << ": " << ec.message());
-  std::sort(folder.names.begin(), folder.names.end());
-  MAPLESS_CHECK(!folder.names.empty(), option << " " << dir << ": no images in it");
+  folder.names = ImageNamesIn(dir, option);
   double pixels = 0.0;
   for (const std::string& name : folder.names) {
     folder.images.push_back(io::ReadImage(dir + "/" + name, cv::IMREAD_GRAYSCALE, 4));

@@ -10,8 +10,8 @@
 #include <sstream>
 
 #include "mapless/core/check.h"
-#include "mapless/eval/cost.h"
 #include "mapless/eval/experiences.h"
+#include "mapless/eval/real_common.h"
 #include "mapless/io/atomic_file.h"
 #include "mapless/io/image_file.h"
 

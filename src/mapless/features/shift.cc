@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <utility>
 
 #include "mapless/core/check.h"
 
@@ -16,6 +17,23 @@ void ShiftOptions::Validate() const {
                 "ShiftOptions.bin_dy_px = " << bin_dy_px << "; must be >= 0 (0: dx alone)");
   MAPLESS_CHECK(min_votes >= 1, "ShiftOptions.min_votes = " << min_votes << "; must be >= 1");
 }
+
+namespace {
+
+// The estimate from the offsets that support the winning bin: their median, ok with min_votes.
+ShiftEstimate FromSupport(std::vector<double> support, int matches, int min_votes) {
+  ShiftEstimate out;
+  out.matches = matches;
+  out.inliers = static_cast<int>(support.size());
+  if (support.empty()) return out;
+  std::nth_element(support.begin(), support.begin() + static_cast<long>(support.size() / 2),
+                   support.end());
+  out.dx_px = support[support.size() / 2];
+  out.ok = out.inliers >= min_votes;
+  return out;
+}
+
+}  // namespace
 
 ShiftEstimate VoteShift(const std::vector<double>& dx_px, double bin_px, int min_votes) {
   ShiftEstimate out;
@@ -41,12 +59,7 @@ ShiftEstimate VoteShift(const std::vector<double>& dx_px, double bin_px, int min
   for (double d : dx_px) {
     if (std::abs(d - centre) <= 1.5 * bin_px) support.push_back(d);
   }
-  out.inliers = static_cast<int>(support.size());
-  std::nth_element(support.begin(), support.begin() + static_cast<long>(support.size() / 2),
-                   support.end());
-  out.dx_px = support[support.size() / 2];
-  out.ok = out.inliers >= min_votes;
-  return out;
+  return FromSupport(std::move(support), out.matches, min_votes);
 }
 
 ShiftEstimate VoteShift2D(const std::vector<double>& dx_px, const std::vector<double>& dy_px,
@@ -86,12 +99,7 @@ ShiftEstimate VoteShift2D(const std::vector<double>& dx_px, const std::vector<do
     if (std::abs(dx_px[i] - cx) <= 1.5 * bin_px && std::abs(dy_px[i] - cy) <= 1.5 * bin_dy_px)
       support.push_back(dx_px[i]);
   }
-  out.inliers = static_cast<int>(support.size());
-  std::nth_element(support.begin(), support.begin() + static_cast<long>(support.size() / 2),
-                   support.end());
-  out.dx_px = support[support.size() / 2];
-  out.ok = out.inliers >= min_votes;
-  return out;
+  return FromSupport(std::move(support), out.matches, min_votes);
 }
 
 ShiftEstimate EstimateShift(const Features& reference, const Features& current,

@@ -25,20 +25,8 @@ cv::Mat ToGrey(const cv::Mat& in) {
 
 class FolderSource : public FrameSource {
  public:
-  FolderSource(const std::string& dir, double fps) : dir_(dir), fps_(fps) {
-    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-      if (!entry.is_regular_file()) continue;
-      std::string ext = entry.path().extension().string();
-      std::transform(ext.begin(), ext.end(), ext.begin(),
-                     [](unsigned char c) { return std::tolower(c); });
-      if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".pgm" ||
-          ext == ".ppm" || ext == ".tif" || ext == ".tiff") {
-        files_.push_back(entry.path().string());
-      }
-    }
-    std::sort(files_.begin(), files_.end());
-    if (files_.empty()) throw InputError(dir + ": no image files in this folder");
-  }
+  FolderSource(const std::string& dir, double fps)
+      : dir_(dir), fps_(fps), files_(ImageFilesIn(dir)) {}
   bool Next(Frame* frame) override {
     if (next_ >= files_.size()) return false;
     const std::string& path = files_[next_];
@@ -123,6 +111,26 @@ class CameraSource : public FrameSource {
 };
 
 }  // namespace
+
+std::vector<std::string> ImageFilesIn(const std::string& dir) {
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    std::error_code type_ec;
+    if (!it->is_regular_file(type_ec)) continue;
+    std::string ext = it->path().extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return std::tolower(c); });
+    if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".pgm" ||
+        ext == ".ppm" || ext == ".tif" || ext == ".tiff") {
+      files.push_back(it->path().string());
+    }
+  }
+  if (ec) throw InputError(dir + ": " + ec.message());
+  std::sort(files.begin(), files.end());
+  if (files.empty()) throw InputError(dir + ": no image files in this folder");
+  return files;
+}
 
 bool IsLiveCamera(const std::string& spec) {
   return spec.rfind("camera:", 0) == 0 || spec.rfind("/dev/video", 0) == 0;

@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "mapless/core/pose.h"
 
@@ -32,6 +33,11 @@ inline constexpr double kMaxFolderFps = 1000.0;
 
 // True for "camera:N" and "/dev/videoN": a live camera, not a recording.
 bool IsLiveCamera(const std::string& spec);
+
+// The image files of a folder (.png .jpg .jpeg .bmp .pgm .ppm .tif .tiff, any case), as paths in
+// file-name order; other files are not listed. Throws InputError naming the folder when it cannot
+// be read or holds no image file.
+std::vector<std::string> ImageFilesIn(const std::string& dir);
 
 // Opens `spec`: "camera:N" or "/dev/videoN" for a camera, a directory for an image folder
 // (.png .jpg .jpeg .bmp .pgm .ppm .tif .tiff), anything else as a video file. `folder_fps` gives
