@@ -402,8 +402,13 @@ FollowerStep AppearanceFollower::Decide(const cv::Mat& image, const Pose2& odome
   const int n = route.size();
   if (!Localize(projection, advance_m, odometry, route, &step)) return step;
   ++follow_frames_;
+  const bool limited = options_.use_markov && options_.ahead_margin_m >= 0.0 &&
+                       options_.start_window_m > 0.0 && start_index_ >= 0;
+  const bool driven_enough =
+      !limited || options_.arrive_odometry_slack_m < 0.0 ||
+      driven_m_ >= (n - 1 - start_index_) * route.SpacingM() - options_.arrive_odometry_slack_m;
   if (route.complete && step.index >= n - 1 - options_.arrive_within_images &&
-      follow_frames_ >= options_.min_follow_frames &&
+      follow_frames_ >= options_.min_follow_frames && driven_enough &&
       (!options_.use_markov || step.probability >= options_.arrive_min_probability)) {
     arrived_ = true;
     step.state = FollowerState::kArrived;

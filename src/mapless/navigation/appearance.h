@@ -153,7 +153,15 @@ struct AppearanceFollowerOptions {
   double anchor_probability = 0.8;
   int lookahead_images = 1;      // steer towards the route image this far ahead of the position
   int arrive_within_images = 1;  // arrived at the end of a complete route within this many
-  int wait_within_images = 2;    // wait for a leader this close to the end it has taught so far
+  // ... and, while the belief limits above are kept, once the odometry has driven the route's
+  // length from the start localization's image less this much (not in the paper). Near the end
+  // the low-resolution views of the last metre look alike (a wall or the open ground the route
+  // ends facing, growing), and the belief ran up to the ahead limit, whose slack grows with the
+  // distance (ahead_fraction): followers on generated worlds arrived 0.6-1.1 m early. The
+  // odometry's under-report (a real robot's) makes it drive on past the end by that much less
+  // this slack; a wall there stops it and it arrives (arrive_blocked_within_images). Negative: off.
+  double arrive_odometry_slack_m = 0.3;
+  int wait_within_images = 2;  // wait for a leader this close to the end it has taught so far
   // Arrived also when the obstacle watch stops the follower this close to the end of a complete
   // route (not in the paper): what stops it is beyond the end (the wall the route ends facing), as
   // the repeat's watch, cut at the route's end, would not see. Near a wall the belief lags one or

@@ -132,37 +132,22 @@ void ObstacleWatchOptions::Validate() const {
                 "ObstacleWatchOptions.curvature_window_m = "
                     << curvature_window_m << ", max_curvature_per_m = " << max_curvature_per_m
                     << "; must be >= 0 and > 0");
+  MAPLESS_CHECK(hidden_drop >= 0.0 && hidden_drop < 1.0,
+                "ObstacleWatchOptions.hidden_drop = " << hidden_drop << "; must be in [0, 1)");
+  MAPLESS_CHECK(hidden_min_reference > 0.0 && hidden_min_reference <= 1.0,
+                "ObstacleWatchOptions.hidden_min_reference = " << hidden_min_reference
+                                                               << "; must be in (0, 1]");
+  MAPLESS_CHECK(hidden_window_m > 0.0 && hidden_gap_m >= 0.0 && hidden_max_turn_rad > 0.0,
+                "ObstacleWatchOptions.hidden_window_m = "
+                    << hidden_window_m << ", hidden_gap_m = " << hidden_gap_m
+                    << ", hidden_max_turn_rad = " << hidden_max_turn_rad
+                    << "; must be > 0, >= 0 and > 0");
   MAPLESS_CHECK(free_difference > 0.0,
                 "ObstacleWatchOptions.free_difference = " << free_difference << "; must be > 0");
 }
 
 ObstacleWatch::ObstacleWatch(ObstacleWatchOptions options) : options_(std::move(options)) {
   options_.Validate();
-}
-
-cv::Rect ObstacleWatch::Region(cv::Size size) const {
-  const int top = std::clamp(static_cast<int>(std::lround(options_.region_top * size.height)), 0,
-                             size.height - 1);
-  const int w =
-      std::clamp(static_cast<int>(std::lround(options_.region_width * size.width)), 1, size.width);
-  return {(size.width - w) / 2, top, w, size.height - top};
-}
-
-bool ObstacleWatch::InRegion(cv::Point2f p, cv::Size size) const {
-  if (p.y < options_.region_top * size.height) return false;
-  const double horizon = options_.horizon * size.height;
-  // Ground farther than the route goes: rows above the one at route_left_m_.
-  if (p.y < horizon + (options_.region_top * size.height - horizon) * options_.region_far_m /
-                          route_left_m_)
-    return false;
-  const double below = p.y - horizon;
-  const double half = 0.5 * options_.region_width * size.width * below / (size.height - horizon);
-  // The strip bends with the path: at distance d ahead it is curvature * d^2 / 2 to the side
-  // (metres), half / region_half_width_m pixels a metre on this row.
-  const double d = options_.region_far_m * (options_.region_top * size.height - horizon) / below;
-  const double centre =
-      0.5 * size.width - curvature_ * 0.5 * d * d * half / options_.region_half_width_m;
-  return std::abs(p.x - centre) <= half;
 }
 
 ObstacleCheck ObstacleWatch::Update(const cv::Mat& grey, Timestamp t_ns, double forward_m,
@@ -188,6 +173,7 @@ ObstacleCheck ObstacleWatch::Update(const cv::Mat& grey, Timestamp t_ns, double 
     curvature_ = Curvature();
     min_eigen_ = MinEigen(grey);
     check = Look(grey, pyramid, t_ns, known_px);
+    if (!blocked_) Hidden(grey, pyramid, &check);
     Unchecked(grey, forward_m, &check);
     if (!blocked_) {
       Frame frame{{}, t_ns, forward_m_, turned_rad_};
@@ -212,7 +198,9 @@ void ObstacleWatch::Resume() {
   unchecked_m_ = 0.0;
   votes_ = 0;
   free_votes_ = 0;
+  hidden_votes_ = 0;
   history_.clear();
+  textures_.clear();
 }
 
 cv::Mat ObstacleWatch::FitGround(const std::vector<cv::Point2f>& here,

@@ -37,6 +37,7 @@
 // higher, is tilted or sees wider sets them in its YAML file.
 #pragma once
 
+#include <array>
 #include <deque>
 #include <limits>
 #include <opencv2/core.hpp>
@@ -147,6 +148,22 @@ struct ObstacleWatchOptions {
   // straight strip.
   double curvature_window_m = 0.3;
   double max_curvature_per_m = 2.5;  // the bend's curvature is clamped to this (1 / 0.4 m)
+  // Hidden ground (obstacle_watch_hidden.cc): a box without texture of its own in front of the
+  // robot is invisible to the flow check (no tracked points on it, and the ground behind it is
+  // hidden), and was driven into on generated worlds. So every frame, turning or not, the strip
+  // is split into a left, a middle and a right third, and the share of each third's grid points
+  // with the texture a tracked point needs (min_eigen) is compared with what the same third had
+  // over the last hidden_window_m of driving (its median, from frames at least hidden_gap_m back
+  // and within hidden_max_turn_rad of today's heading). A third that had at least
+  // hidden_min_reference of its points textured and now has less than hidden_drop times that, on
+  // confirm_frames successive frames, is hidden: the robot stops as for an obstacle, and goes on
+  // when the view there changes. A floor too plain to have a reference is not judged (its ground
+  // is not checked either: max_unchecked_m). 0 for hidden_drop: off.
+  double hidden_drop = 0.3;
+  double hidden_min_reference = 0.55;
+  double hidden_window_m = 1.2;
+  double hidden_gap_m = 0.3;
+  double hidden_max_turn_rad = 0.3;
   void Validate() const;
   double CreepSpeedMps() const {
     return creep_speed_mps > baseline_m / (0.75 * max_age_s) ? creep_speed_mps
@@ -174,6 +191,10 @@ struct ObstacleCheck {
   // With avoid: every point below fit_top off the ground's plane (the region's obstacle points
   // and those beside it: the obstacle's extent, walls), for going round.
   std::vector<cv::Point2f> off_plane_px;
+  // The textured share of the strip's left, middle and right thirds this frame, and what they had
+  // before (hidden_drop; -1: no reference).
+  std::array<double, 3> textured{{0.0, 0.0, 0.0}};
+  std::array<double, 3> textured_before{{-1.0, -1.0, -1.0}};
 };
 
 class ObstacleWatch {
@@ -203,6 +224,9 @@ class ObstacleWatch {
   };
   cv::Rect Region(cv::Size size) const;  // the region's bounding box
   bool InRegion(cv::Point2f p, cv::Size size) const;
+  // Where p lies across the strip: -1 at its left edge, 1 at its right (infinite: not on the
+  // strip's rows).
+  double StripOffset(cv::Point2f p, cv::Size size) const;
   // The ground's homography (current -> earlier pixels), or empty when the points below
   // draw_top do not agree on one.
   cv::Mat FitGround(const std::vector<cv::Point2f>& here, const std::vector<cv::Point2f>& there,
@@ -220,6 +244,9 @@ class ObstacleWatch {
   void StopUnchecked(const cv::Mat& grey, ObstacleCheck* check);
   // After Look: the unchecked distance, and the creep or the stop when it is too long.
   void Unchecked(const cv::Mat& grey, double forward_m, ObstacleCheck* check);
+  // Every frame: the thirds' texture against their reference, and the stop when one is hidden
+  // (hidden_drop; obstacle_watch_hidden.cc).
+  void Hidden(const cv::Mat& grey, const std::vector<cv::Mat>& pyramid, ObstacleCheck* check);
   // The curvature driven over the last curvature_window_m (history_), and this frame's texture
   // threshold from its noise (obstacle_watch_region.cc).
   double Curvature() const;
@@ -252,6 +279,13 @@ class ObstacleWatch {
   double curvature_ = 0.0;   // the region's bend on this frame (Curvature)
   double min_eigen_ = 0.0;   // the texture threshold on this frame (MinEigen)
   std::string blocked_why_;  // what holds the robot (WatchBlocked's reason)
+  struct Texture {
+    double forward_m = 0.0;
+    double turned_rad = 0.0;
+    std::array<double, 3> share{};  // textured share of each third (-1: too few points)
+  };
+  std::deque<Texture> textures_;  // the last frames' (Hidden)
+  int hidden_votes_ = 0;
 };
 
 }  // namespace mapless::navigation

@@ -4,12 +4,43 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
 #include "mapless/navigation/obstacle_watch.h"
 
 namespace mapless::navigation {
+
+cv::Rect ObstacleWatch::Region(cv::Size size) const {
+  const int top = std::clamp(static_cast<int>(std::lround(options_.region_top * size.height)), 0,
+                             size.height - 1);
+  const int w =
+      std::clamp(static_cast<int>(std::lround(options_.region_width * size.width)), 1, size.width);
+  return {(size.width - w) / 2, top, w, size.height - top};
+}
+
+bool ObstacleWatch::InRegion(cv::Point2f p, cv::Size size) const {
+  return std::abs(StripOffset(p, size)) <= 1.0;
+}
+
+double ObstacleWatch::StripOffset(cv::Point2f p, cv::Size size) const {
+  constexpr double kOut = std::numeric_limits<double>::infinity();
+  if (p.y < options_.region_top * size.height) return kOut;
+  const double horizon = options_.horizon * size.height;
+  // Ground farther than the route goes: rows above the one at route_left_m_.
+  if (p.y < horizon + (options_.region_top * size.height - horizon) * options_.region_far_m /
+                          route_left_m_)
+    return kOut;
+  const double below = p.y - horizon;
+  const double half = 0.5 * options_.region_width * size.width * below / (size.height - horizon);
+  // The strip bends with the path: at distance d ahead it is curvature * d^2 / 2 to the side
+  // (metres), half / region_half_width_m pixels a metre on this row.
+  const double d = options_.region_far_m * (options_.region_top * size.height - horizon) / below;
+  const double centre =
+      0.5 * size.width - curvature_ * 0.5 * d * d * half / options_.region_half_width_m;
+  return (p.x - centre) / half;
+}
 
 double ObstacleWatch::Curvature() const {
   if (options_.curvature_window_m <= 0.0 || history_.empty()) return 0.0;

@@ -18,6 +18,7 @@ struct WatchRun {
   double max_fraction = 0.0;       // over observed frames before any block
   int observed = 0;                // frames that compared two views
   int cleared_frame = -1;
+  std::string reason;  // why it blocked
 };
 
 // Drives straight along +x at `speed` through table1_almost_straight's hall (with a 0.5 m box at
@@ -28,7 +29,8 @@ struct WatchRun {
 // commanded forward motion since the start taken off, plus the repeat's 0.3 m margin).
 WatchRun DriveAt(double box_x, double box_leaves_s, double drive_s, std::uint64_t seed,
                  const ObstacleWatchOptions& options = {}, double box_y = 0.0,
-                 double zigzag_radps = 0.0, double route_end_x = -1.0) {
+                 double zigzag_radps = 0.0, double route_end_x = -1.0,
+                 sim::TextureType box_texture = sim::TextureType::kBlobs) {
   sim::Scenario s = sim::LoadScenario("table1_almost_straight");
   sim::World world = s.world;
   if (box_x > 0.0) {
@@ -38,7 +40,7 @@ WatchRun DriveAt(double box_x, double box_leaves_s, double drive_s, std::uint64_
     box.size_m = {0.5, 0.5};
     box.height_m = 0.5;
     box.leaves_s = box_leaves_s;
-    box.texture.type = sim::TextureType::kBlobs;
+    box.texture.type = box_texture;
     box.texture.texel_m = 0.004;
     box.texture.mean = 110;
     world.objects.push_back(box);
@@ -77,6 +79,7 @@ WatchRun DriveAt(double box_x, double box_leaves_s, double drive_s, std::uint64_
     if (c.blocked && out.first_blocked < 0) {
       out.first_blocked = i;
       out.clearance_at_block = box_x - 0.25 - simulation.robot(r).pose().x_m - robot.radius_m;
+      out.reason = c.reason;
     }
     if (c.cleared && out.cleared_frame < 0) out.cleared_frame = i;
     const double turn = i % 2 == 0 ? zigzag_radps : -zigzag_radps;
@@ -144,6 +147,26 @@ TEST(ObstacleWatch, ARobotThatZigzagsIsWatchedToo) {
     EXPECT_GT(run.observed, 20) << "seed " << seed;
     ASSERT_GE(run.first_blocked, 0) << "seed " << seed;
     EXPECT_GE(run.clearance_at_block, 0.3) << "seed " << seed;
+  }
+}
+
+// A box without texture (plain grey) gives the flow check no points: it only hides the floor's.
+// The hidden-ground check stops the robot before it; without it (hidden_drop 0) the robot drives
+// on to the box (a generated world's repeat did so).
+TEST(ObstacleWatch, APlainBoxHidesTheGroundAndStopsTheRobot) {
+  for (std::uint64_t seed : Seeds()) {
+    const WatchRun run =
+        DriveAt(3.0, 1000.0, 14.0, seed, {}, 0.0, 0.0, -1.0, sim::TextureType::kPlain);
+    ASSERT_GE(run.first_blocked, 0) << "seed " << seed;
+    EXPECT_GE(run.clearance_at_block, 0.2) << "seed " << seed;
+    EXPECT_NE(run.reason.find("hidden"), std::string::npos) << run.reason;
+    ObstacleWatchOptions blind;
+    blind.hidden_drop = 0.0;
+    const WatchRun flow_only =
+        DriveAt(3.0, 1000.0, 14.0, seed, blind, 0.0, 0.0, -1.0, sim::TextureType::kPlain);
+    EXPECT_TRUE(flow_only.first_blocked < 0 || flow_only.clearance_at_block < 0.2)
+        << "seed " << seed << ": the flow check alone stopped " << flow_only.clearance_at_block
+        << " m before it";
   }
 }
 

@@ -97,6 +97,8 @@ void RepeatOptions::Validate() const {
                                                  << carry_on_reach_factor << "; must be > 0");
   MAPLESS_CHECK(carry_on_keyframes >= 0,
                 "RepeatOptions.carry_on_keyframes = " << carry_on_keyframes << "; must be >= 0");
+  MAPLESS_CHECK(carry_on_unchecked_m > 0.0,
+                "RepeatOptions.carry_on_unchecked_m = " << carry_on_unchecked_m << "; must be > 0");
   MAPLESS_CHECK(recovery_min_features >= 2, "RepeatOptions.recovery_min_features = "
                                                 << recovery_min_features << "; must be >= 2");
   // recovery_after_s >= abort_after_s is allowed: the repeat then aborts before it recovers.
@@ -245,6 +247,7 @@ RepeatStep RepeatSession::Update(const cv::Mat& image, Timestamp t_ns,
   } else {
     // The obstacle watch first: a blocked robot does not look for its keyframe.
     const ObstacleCheck obstacle = WatchAndDetect(grey, t_ns, dt);
+    watch_unchecked_m_ = options_.obstacle.enabled ? obstacle.unchecked_m : 0.0;
     const bool started = !detour_ && obstacle.blocked && StartDetour(obstacle, grey.size());
     if (detour_) {
       // Going round it (--on-obstacle avoid) until back on the route; the obstacle that started

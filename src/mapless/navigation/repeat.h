@@ -96,13 +96,18 @@ struct RepeatOptions {
   // unmatched keyframe and up to carry_on_keyframes after it, matching each of them every
   // frame; the first that matches becomes the destination and the funnel lane takes over. It
   // gives up after carry_on.max_distance_m (then waits and aborts as before). The obstacle watch
-  // guards the way as always. max_distance_m = 0: off. As with recovery, a keyframe k farther
-  // than the next one qualifies only as far as the robot has come: keyframe k - 1 taught at most
-  // carry_on_reach_factor times the robot's odometry displacement since the last switch from
-  // keyframe destination - 1 (straight lines both). Without it a far keyframe of a straight
-  // route, which looks like the near one from afar, could end carrying on metres too early.
+  // guards the way, and must see it: carrying on is driving without the route's view, most often
+  // because something new hides it, so it gives up as soon as the watch has not observed the
+  // ground ahead over carry_on_unchecked_m of forward motion (a box without texture in front of
+  // the robot hides the keyframe and the ground's points alike, and was driven into so).
+  // max_distance_m = 0: off. As with recovery, a keyframe k farther than the next one qualifies
+  // only as far as the robot has come: keyframe k - 1 taught at most carry_on_reach_factor times
+  // the robot's odometry displacement since the last switch from keyframe destination - 1 (straight
+  // lines both). Without it a far keyframe of a straight route, which looks like the near one from
+  // afar, could end carrying on metres too early.
   control::TaughtPathOptions carry_on;
   int carry_on_keyframes = 6;
+  double carry_on_unchecked_m = 0.3;
   double carry_on_reach_factor = 1.25;
   // Guided matching (not in the paper): matches must lie within this many pixels of the
   // horizontal displacement predicted from the previous frame (at a segment switch: the previous
@@ -306,6 +311,7 @@ class RepeatSession {
   // turn the homography wins and the near objects' matches, right under parallax, are outliers
   // to it) on a frame detected afresh, the tracked matches otherwise.
   std::vector<cv::Point2f> scene_px_;
+  double watch_unchecked_m_ = 0.0;  // this frame's ObstacleCheck::unchecked_m (0: no watch)
   int last_matches_ = 0;
   bool have_expected_dx_ = false;  // guided matching: a predicted x_current - x_destination
   double expected_dx_ = 0.0;

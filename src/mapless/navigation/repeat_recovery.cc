@@ -123,7 +123,10 @@ std::optional<Twist2> RepeatSession::CarryOn(Timestamp t_ns, RepeatStep* step) {
       options_.carry_on_reach_factor *
       std::hypot(odometry_->x_m - switch_odometry_->x_m, odometry_->y_m - switch_odometry_->y_m);
   if (SwitchToMatching(destination_ + 1, last, reach, step)) return {};
-  const std::optional<Twist2> command = carrying_->Command(*odometry_, RouteSpeed());
+  // Blind twice over is too much: without the route's view, the ground ahead must be seen.
+  const bool unseen = watch_unchecked_m_ > options_.carry_on_unchecked_m;
+  const std::optional<Twist2> command =
+      unseen ? std::nullopt : carrying_->Command(*odometry_, RouteSpeed());
   if (!command) {
     // Given up: the robot stops and the abort countdown starts afresh; no second try at this
     // destination.

@@ -118,7 +118,8 @@ void ParseTopics(const io::YamlMap& t, RobotFile* r) {
 void ParseObstacles(const io::YamlMap& o, RobotFile* r) {
   o.CheckKnownKeys({"on_obstacle", "region_top", "region_far_m", "region_width",
                     "region_half_width_m", "horizon", "baseline_m", "min_blocked_fraction",
-                    "max_unchecked_m", "creep_m", "creep_speed_mps"});
+                    "max_unchecked_m", "creep_m", "creep_speed_mps", "hidden_drop",
+                    "hidden_min_reference"});
   const std::string on = o.GetString("on_obstacle", "stop");
   if (on != "stop" && on != "avoid" && on != "off")
     o.Fail("on_obstacle", "'" + on + "' is not stop, avoid or off");
@@ -148,6 +149,9 @@ void ParseObstacles(const io::YamlMap& o, RobotFile* r) {
   r->obstacle_max_unchecked_given = o.Has("max_unchecked_m");
   r->obstacle.creep_m = fraction("creep_m", r->obstacle.creep_m, 0.0, 2.0);
   r->obstacle.creep_speed_mps = fraction("creep_speed_mps", r->obstacle.creep_speed_mps, 0.01, 0.5);
+  r->obstacle.hidden_drop = fraction("hidden_drop", r->obstacle.hidden_drop, 0.0, 0.95);
+  r->obstacle.hidden_min_reference =
+      fraction("hidden_min_reference", r->obstacle.hidden_min_reference, 0.05, 1.0);
 }
 
 }  // namespace

@@ -99,6 +99,11 @@ TEST(RobotFile, ObstacleWatchSettings) {
   EXPECT_DOUBLE_EQ(
       ParseRobotFile("obstacles: {region_far_m: 3.5}\n", "robot.yaml").obstacle.region_far_m, 3.5);
   ExpectError("obstacles: {region_far_m: -1}\n", "region_far_m");
+  const RobotFile h =
+      ParseRobotFile("obstacles: {hidden_drop: 0, hidden_min_reference: 0.7}\n", "robot.yaml");
+  EXPECT_DOUBLE_EQ(h.obstacle.hidden_drop, 0.0);
+  EXPECT_DOUBLE_EQ(h.obstacle.hidden_min_reference, 0.7);
+  ExpectError("obstacles: {hidden_drop: 1.5}\n", "hidden_drop");
   // The creep that checks unchecked ground (issue 65): how far and how fast; 0 m: stop at once.
   const RobotFile c =
       ParseRobotFile("obstacles: {creep_m: 0, creep_speed_mps: 0.05}\n", "robot.yaml");
@@ -114,6 +119,8 @@ TEST(RobotFile, TheCommentedExampleLoadsWithItsStatedValues) {
       LoadRobotFile(std::string(MAPLESS_SOURCE_DIR) + "/config/robots/turtlebot.yaml");
   EXPECT_DOUBLE_EQ(r.obstacle.creep_m, 0.3);
   EXPECT_DOUBLE_EQ(r.obstacle.creep_speed_mps, 0.1);
+  EXPECT_DOUBLE_EQ(r.obstacle.hidden_drop, 0.3);
+  EXPECT_DOUBLE_EQ(r.obstacle.hidden_min_reference, 0.55);
   EXPECT_DOUBLE_EQ(r.obstacle.min_blocked_fraction, 0.15);
 }
 
