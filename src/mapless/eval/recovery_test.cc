@@ -98,6 +98,32 @@ TEST(KeyframeRecovery, ARepeatCarriesOnByOdometryThroughThreeKeyframesGone) {
       << " m; keyframe " << resumed_at - 1 << " was taught at x = " << before.x_m << " m";
 }
 
+// Carrying on is driving without the route's view; it needs the watch to see the ground ahead
+// (RepeatOptions::carry_on_unchecked_m). Here the watch is made blind (no check has enough
+// points to count): carrying on gives up within 0.3 m of unchecked driving, and the robot stops.
+TEST(KeyframeRecovery, CarryingOnGivesUpWhenTheWatchCannotSeeTheGround) {
+  const auto& [scenario, taught] = TaughtOnce("table1_almost_straight");
+  const int n = static_cast<int>(taught.route->keyframes.size());
+  ASSERT_GE(n, 7);
+  const int gone = n / 2 - 1;
+  const TaughtRoute broken = WithKeyframesGone(taught, gone, 3);
+  RepeatRunOptions options;
+  options.seed = 3;
+  options.repeat.obstacle.min_region_points = 1000000;
+  options.repeat.obstacle.min_obstacle_points = 1000000;
+  const RepeatRun run = RepeatOnSimulator(scenario, broken, options);
+  EXPECT_FALSE(run.completed) << run.status;
+  EXPECT_FALSE(run.collided);
+  const double step_m = 0.2 * 0.1 * 1.2;  // one frame at the repeat's speed, with its noise
+  int carrying = 0;
+  for (const auto& step : run.steps) {
+    if (!step.carrying_on) continue;
+    ++carrying;
+    EXPECT_LE(step.obstacle.unchecked_m, options.repeat.carry_on_unchecked_m + step_m);
+  }
+  EXPECT_LT(carrying, 20);  // it began, and gave up
+}
+
 // On an intact route the repeat passes the keyframes in order, one at a time: neither recovery
 // nor carrying on steps in. (Until 2026-11-26 this test ran on a route that the test above had
 // broken by accident, the descriptors being shared: it then allowed one recovery.)
