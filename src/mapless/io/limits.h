@@ -11,6 +11,10 @@ namespace mapless::io {
 // Hand-written YAML: scenarios, worlds, run configurations, calibrations. The largest built-in
 // scenario is 3 KB; yaml-cpp needs about 100 bytes of memory per byte of dense YAML.
 inline constexpr std::size_t kMaxYamlFileBytes = std::size_t{1} << 20;  // 1 MiB
+// The values of a YAML document with every alias expanded (docs/hardening.md): a 1 MiB document
+// without aliases has at most half a million ("[1,1,1,...]"), so only aliases within aliases reach
+// it; walking a million takes about 0.1 s.
+inline constexpr std::uint64_t kMaxYamlExpandedNodes = std::uint64_t{1} << 20;
 // A route's manifest.json (about 120 bytes per keyframe).
 inline constexpr std::size_t kMaxManifestBytes = std::size_t{16} << 20;  // 16 MiB
 // One keyframe file (keypoints and descriptors as YAML; an ORB-500 keyframe is about 150 KB).

@@ -1,9 +1,13 @@
 #include "mapless/io/yaml_reader.h"
 
+#include <yaml-cpp/eventhandler.h>
+#include <yaml-cpp/parser.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
+#include <unordered_map>
 
 #include "mapless/core/check.h"
 #include "mapless/io/atomic_file.h"
@@ -43,6 +47,80 @@ void RefuseDuplicateKeys(const YAML::Node& node, const std::string& name, int de
   }
 }
 
+// Counts the nodes of a document as its readers see it, every alias expanded, from the parser's
+// events (each anchored node's expanded size is kept, so this is linear in the text whatever the
+// aliases do), and refuses a document that expands past kMaxYamlExpandedNodes. yaml-cpp shares an
+// aliased node instead of copying it, so a 1 KB file of nested aliases (the "billion laughs"
+// shape) loads at once; it is every walk over it (the duplicate-key check, a reader's loop) that
+// would take ten to the tenth steps.
+class ExpansionCounter : public YAML::EventHandler {
+ public:
+  explicit ExpansionCounter(std::string name) : name_(std::move(name)) {}
+
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t anchor) override { Leaf(mark, anchor); }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t anchor) override {
+    const auto it = sizes_.find(anchor);
+    Add(mark, it == sizes_.end() ? 1 : it->second);
+  }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+                const std::string&) override {
+    Leaf(mark, anchor);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+                       YAML::EmitterStyle::value) override {
+    open_.push_back({mark, anchor, 1});
+  }
+  void OnSequenceEnd() override { Close(); }
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+                  YAML::EmitterStyle::value) override {
+    open_.push_back({mark, anchor, 1});
+  }
+  void OnMapEnd() override { Close(); }
+
+ private:
+  struct Open {
+    YAML::Mark mark;
+    YAML::anchor_t anchor;
+    std::uint64_t size;
+  };
+  void Leaf(const YAML::Mark& mark, YAML::anchor_t anchor) {
+    if (anchor != YAML::NullAnchor) sizes_[anchor] = 1;
+    Add(mark, 1);
+  }
+  void Close() {
+    if (open_.empty()) return;
+    const Open done = open_.back();
+    open_.pop_back();
+    if (done.anchor != YAML::NullAnchor) sizes_[done.anchor] = done.size;
+    if (!open_.empty()) open_.back().size += done.size;
+  }
+  void Add(const YAML::Mark& mark, std::uint64_t size) {
+    if (!open_.empty()) open_.back().size += size;
+    total_ += size;
+    if (total_ > kMaxYamlExpandedNodes) {
+      std::ostringstream out;
+      out << name_ << ":" << mark.line + 1 << ":" << mark.column + 1
+          << ": the document expands to more than " << kMaxYamlExpandedNodes
+          << " values with its aliases (nested aliases: refused before it is read)";
+      throw InputError(out.str());
+    }
+  }
+
+  std::string name_;
+  std::vector<Open> open_;
+  std::unordered_map<YAML::anchor_t, std::uint64_t> sizes_;
+  std::uint64_t total_ = 0;  // the expanded size so far (every alias counted as its copy)
+};
+
+void RefuseExpandingDocument(const std::string& text, const std::string& name) {
+  std::istringstream in(text);
+  YAML::Parser parser(in);
+  ExpansionCounter counter(name);
+  parser.HandleNextDocument(counter);
+}
+
 }  // namespace
 
 YamlMap YamlMap::LoadFile(const std::string& path) {
@@ -52,6 +130,7 @@ YamlMap YamlMap::LoadFile(const std::string& path) {
 YamlMap YamlMap::LoadString(const std::string& text, const std::string& name) {
   YAML::Node root;
   try {
+    RefuseExpandingDocument(text, name);
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     std::ostringstream out;

@@ -29,6 +29,29 @@ TEST(YamlMap, ADuplicateKeyIsRefusedAtAnyDepth) {
   EXPECT_NO_THROW(YamlMap::LoadString("a: {x: 1}\nb: {x: 1}\n", "ok.yaml"));
 }
 
+// "Billion laughs": ten levels of ten aliases each, a 600-byte file that is 10^10 values when
+// read. Refused by its expanded size before anything walks it (it took minutes of CPU before).
+std::string NestedAliases(int levels) {
+  std::string text = "x0: &a0 [x, x, x, x, x, x, x, x, x, x]\n";
+  for (int i = 1; i < levels; ++i) {
+    text += "x" + std::to_string(i) + ": &a" + std::to_string(i) + " [";
+    for (int k = 0; k < 10; ++k) text += (k ? ", *a" : "*a") + std::to_string(i - 1);
+    text += "]\n";
+  }
+  return text;
+}
+
+TEST(YamlMap, ADocumentThatExpandsWithItsAliasesIsRefusedByItsSize) {
+  const std::string err =
+      testing::InputErrorOf([] { YamlMap::LoadString(NestedAliases(10), "laughs.yaml"); });
+  EXPECT_NE(err.find("laughs.yaml:"), std::string::npos) << err;
+  EXPECT_NE(err.find("expands to more than 1048576 values"), std::string::npos) << err;
+  // Aliases as people use them, and five levels (10^5 values), are read.
+  EXPECT_NO_THROW(YamlMap::LoadString(NestedAliases(5), "ok.yaml"));
+  const YamlMap m = YamlMap::LoadString("base: &b {x: 1}\nother: *b\n", "ok.yaml");
+  EXPECT_EQ(m.GetMap("other").GetInt("x"), 1);
+}
+
 TEST(YamlMap, MalformedYamlNamesFileAndLine) {
   const std::string err =
       testing::InputErrorOf([] { YamlMap::LoadString("a: 1\nb: [1, 2\n", "bad.yaml"); });
