@@ -75,6 +75,11 @@ void AddSwitchingOptions(CLI::App* cmd, SwitchingArgs* a) {
 
 Pose2 ParsePoseDeg(const std::string& text, const std::string& option) {
   const std::vector<double> v = ParseNumbers(text, option, 3, "X,Y,THETA_DEG");
+  // A heading of 1e300 degrees is no heading (it rendered): ten turns either way at most, the
+  // limit of a taught rotation.
+  if (!(std::abs(v[2]) <= 3600.0))
+    throw InputError(option + " " + text + ": THETA_DEG " + text.substr(text.rfind(',') + 1) +
+                     " is beyond ten turns (-3600 to 3600 degrees)");
   return Pose2{v[0], v[1], WrapAngle(DegToRad(v[2]))};
 }
 

@@ -1,5 +1,6 @@
 #include "mapless/io/planar_flow_calibration.h"
 
+#include <cmath>
 #include <sstream>
 
 #include "mapless/core/check.h"
@@ -8,9 +9,30 @@
 namespace mapless::io {
 namespace {
 
-void CheckModel(const cv::Mat& m, const char* field) {
+// A ground homography of one frame period: finite, invertible, and moving the ground (the
+// navigator divides by the mean flow of each). A zero matrix, or the identity, is no calibration;
+// it was taken to the scene ("the dominant plane does not move like the ground").
+void CheckModel(const cv::Mat& m, const char* field, int width, int height) {
   MAPLESS_CHECK(m.rows == 3 && m.cols == 3 && m.type() == CV_64F && cv::checkRange(m),
                 "PlanarFlowCalibration." << field << ": expected a finite 3x3 matrix");
+  const double scale = cv::norm(m);
+  MAPLESS_CHECK(scale > 0.0 && std::abs(cv::determinant(m / scale)) > 1e-12,
+                field << ": a singular homography (all zeros?) is not a motion of the ground");
+  double moved = 0.0;
+  int points = 0;
+  for (int i = 0; i <= 4; ++i)
+    for (int j = 0; j <= 4; ++j) {
+      const double x = width * i / 4.0, y = height * j / 4.0;
+      const double w = m.at<double>(2, 0) * x + m.at<double>(2, 1) * y + m.at<double>(2, 2);
+      if (std::abs(w) < 1e-12) continue;
+      const double u = (m.at<double>(0, 0) * x + m.at<double>(0, 1) * y + m.at<double>(0, 2)) / w;
+      const double v = (m.at<double>(1, 0) * x + m.at<double>(1, 1) * y + m.at<double>(1, 2)) / w;
+      moved += std::hypot(u - x, v - y);
+      ++points;
+    }
+  MAPLESS_CHECK(points > 0 && moved / points > 1e-3,
+                field << ": the homography moves no pixel (the identity?): the calibrated flow "
+                         "is zero (did the robot move?)");
 }
 
 }  // namespace
@@ -22,8 +44,10 @@ void PlanarFlowCalibration::Validate() const {
                 "PlanarFlowCalibration.speed_mps = " << speed_mps << "; must be > 0");
   MAPLESS_CHECK(omega_radps > 0.0,
                 "PlanarFlowCalibration.omega_radps = " << omega_radps << "; must be > 0");
-  CheckModel(translational, "translational");
-  CheckModel(rotational, "rotational");
+  MAPLESS_CHECK(width <= 16384 && height <= 16384,
+                "PlanarFlowCalibration: width and height must be at most 16384");
+  CheckModel(translational, "translational", width, height);
+  CheckModel(rotational, "rotational", width, height);
 }
 
 std::string CalibrationToYaml(const PlanarFlowCalibration& c) {

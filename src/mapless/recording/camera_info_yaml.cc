@@ -48,6 +48,9 @@ rosmsg::CameraInfoFields ParseCameraInfoYaml(const std::string& text, const std:
     if (height < io::kMinImageSide || height > io::kMaxImageSide)
       y.Fail("image_height", "expected " + std::to_string(io::kMinImageSide) + " to " +
                                  std::to_string(io::kMaxImageSide) + " pixels");
+    if (std::int64_t{width} * height > io::kMaxImagePixels)
+      y.Fail("image_height", std::to_string(width) + "x" + std::to_string(height) + ": at most " +
+                                 std::to_string(io::kMaxImagePixels / 1'000'000) + " megapixels");
     info.width = static_cast<std::uint32_t>(width);
     info.height = static_cast<std::uint32_t>(height);
     const std::vector<double> k = Matrix(y, "camera_matrix", 3, 3);

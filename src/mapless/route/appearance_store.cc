@@ -293,6 +293,9 @@ StoredAppearanceRoute ParseAppearanceManifest(const std::string& text, const std
   if (version == kAppearanceRouteViewsFormatVersion) route.visits = integer("visits", 0, 1'000'000);
   route.image_width = integer("image_width", 16, io::kMaxImageSide);
   route.image_height = integer("image_height", 16, io::kMaxImageSide);
+  MAPLESS_CHECK(std::int64_t{route.image_width} * route.image_height <= io::kMaxImagePixels,
+                name << ": image size " << route.image_width << "x" << route.image_height
+                     << ": at most " << io::kMaxImagePixels / 1'000'000 << " megapixels");
   route.low_width = integer("low_width", 8, 1024);
   route.low_height = integer("low_height", 8, 1024);
   MAPLESS_CHECK(j.contains("complete") && j["complete"].is_boolean(),

@@ -258,6 +258,10 @@ Keyframe ParseKeyframe(const std::string& text, const std::string& name) {
     if (!root.Has("end") || root.GetInt("end") != 1) {
       throw InputError(name + ": truncated keyframe file");
     }
+    // The whole value: "1 trailing" is a string, not version 1 (it was accepted).
+    if (root.GetString("version", "") != std::to_string(kRouteFormatVersion))
+      root.Fail("version", "expected " + std::to_string(kRouteFormatVersion) + ", got '" +
+                               root.GetString("version", "") + "'");
     Keyframe kf;
     kf.index = root.GetInt("index");
     if (kf.index < 0) root.Fail("index", "must be >= 0");

@@ -313,7 +313,8 @@ Manifest ParseManifest(const std::string& text, const std::string& name) {
     throw InputError(name + ": image size " + std::to_string(m.image_width) + "x" +
                      std::to_string(m.image_height) + " is out of range (" +
                      std::to_string(io::kMinImageSide) + " to " +
-                     std::to_string(io::kMaxImageSide) + " a side)");
+                     std::to_string(io::kMaxImageSide) + " pixels a side, at most " +
+                     std::to_string(io::kMaxImagePixels / 1'000'000) + " megapixels)");
   }
   return m;
 }
