@@ -71,16 +71,21 @@ sim::DriveSummary DriveToDirectory(const sim::Scenario& scenario, const sim::Dri
 // A CLI11 check for seeds: a whole number 0 .. 2^64 - 1 (CLI11 would wrap "-1" round).
 CLI::Validator SeedCheck();
 
-// The old name of a renamed option (one meaning per name, issue 42): hidden from --help, it sets
-// the same value and warns that the option is now `new_name`. Returns it for its checks.
+// The old name of a renamed option (one meaning per name, issue 42): it sets the same value and
+// warns that the option is now `new_name`; listed in --help under "Old names" (a hidden option's
+// errors name no option: CLI11 names hidden options ""), and refused together with `new_name`
+// (given both, the old one silently won). Add `new_name` first. Returns it for its checks.
 template <typename T>
 CLI::Option* AddOldName(CLI::App* cmd, const std::string& old_name, const std::string& new_name,
                         T* value) {
-  return cmd->add_option(old_name, *value)
-      ->group("")
-      ->each([old_name, new_name](const std::string&) {
-        spdlog::warn("{} is now {} here; the old name will go", old_name, new_name);
-      });
+  CLI::Option* old = cmd->add_option(old_name, *value, "Old name of " + new_name)
+                         ->group("Old names")
+                         ->each([old_name, new_name](const std::string&) {
+                           spdlog::warn("{} is now {} here; the old name will go", old_name,
+                                        new_name);
+                         });
+  if (CLI::Option* renamed = cmd->get_option_no_throw(new_name)) old->excludes(renamed);
+  return old;
 }
 // A CLI11 check: a finite number in [lo, hi] (CLI::Range lets nan through).
 CLI::Validator FiniteIn(double lo, double hi);

@@ -6,6 +6,9 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <cstring>
+#include <cerrno>
+#include <filesystem>
 #include <iostream>
 #include <opencv2/core.hpp>
 #include <opencv2/core/utils/logger.hpp>
@@ -88,6 +91,24 @@ std::string VersionText() {
                         : links);
 }
 
+// An empty value is no value: `--live ""` ran without a live view, `eval lifelong --only ""` ran
+// the whole suite, as if the option had not been given. No option of mapless takes "" to mean
+// anything, so an empty argument is refused, naming the option before it (or its place).
+void RefuseEmptyArguments(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const std::size_t eq = arg.find('=');
+    if (arg.rfind("--", 0) == 0 && eq != std::string::npos && eq + 1 == arg.size())
+      throw mapless::InputError(arg.substr(0, eq) + ": an empty value");
+    if (!arg.empty()) continue;
+    const std::string before = i > 1 ? argv[i - 1] : "";
+    if (before.rfind("-", 0) == 0 && before.size() > 1)
+      throw mapless::InputError(before + ": an empty value");
+    throw mapless::InputError("argument " + std::to_string(i) + " is empty" +
+                              (before.empty() ? "" : " (after '" + before + "')"));
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -122,6 +143,7 @@ int main(int argc, char** argv) {
   mapless::app::AddSoakCommand(&app);
   mapless::app::AddBenchCommand(&app);
   try {
+    RefuseEmptyArguments(argc, argv);
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
@@ -141,6 +163,17 @@ int main(int argc, char** argv) {
   } catch (const mapless::app::RunFailed& e) {
     std::cerr << "mapless: " << OneLine(e.what()) << "\n";
     return mapless::app::kExitRunFailed;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // A path of the user's that the library could not follow (a symlink loop, no permission):
+    // the path and the reason, not the library's "filesystem error: status: ..." line. A disk
+    // that is full or failing is the run's failure, not bad input.
+    std::string paths = e.path1().string();
+    if (!e.path2().empty()) paths += " -> " + e.path2().string();
+    const int code = e.code().value();
+    std::cerr << "mapless: error: " << OneLine(paths) << ": " << OneLine(e.code().message())
+              << "\n";
+    return code == ENOSPC || code == EIO || code == EDQUOT ? mapless::app::kExitRunFailed
+                                                          : mapless::app::kExitBadInput;
   } catch (const cv::Exception& e) {
     // Inputs are checked before they reach OpenCV; one that still trips it is a mapless bug.
     std::cerr << "mapless: error: internal (OpenCV " << e.func << "): " << OneLine(e.err)
@@ -148,6 +181,16 @@ int main(int argc, char** argv) {
     return mapless::app::kExitRunFailed;
   } catch (const std::exception& e) {
     std::cerr << "mapless: error: " << OneLine(e.what()) << "\n";
+    return mapless::app::kExitRunFailed;
+  }
+  // The results go to standard output: when they could not all be written (`--json >` a full
+  // disk, a closed pipe) the run has failed, whatever it computed.
+  std::cout.flush();
+  errno = 0;
+  if (!std::cout.good() || std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    const int err = errno;
+    std::cerr << "mapless: error: standard output: the results could not be written ("
+              << (err != 0 ? std::strerror(err) : "write error") << ")\n";
     return mapless::app::kExitRunFailed;
   }
   return 0;
