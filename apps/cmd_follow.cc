@@ -78,9 +78,7 @@ void FollowStored(const FollowArgs& a) {
   // --learn writes into the route: no other process may write it meanwhile.
   const auto lock = a.learn ? std::make_unique<io::DirectoryLock>(a.route) : nullptr;
   const route::StoredAppearanceRoute stored = route::LoadAppearanceRoute(a.route);
-  if (a.learn && !stored.complete)
-    throw InputError("follow --learn: " + a.route +
-                     " is an interrupted teach; views are learned into complete routes");
+  if (a.learn) run::CheckLearnable(a.route, stored.complete, stored.visits, "views", "follow --learn");
   cv::Size size;
   const std::shared_ptr<const route::AppearanceRoute> route = RebuildRoute(a.route, stored, &size);
   robot::FollowMethod method([route] { return route; }, follower, size);

@@ -106,6 +106,8 @@ void Repeat(const RepeatArgs& r) {
   // --learn writes into the route: no other process may write it meanwhile.
   const auto lock = r.learn ? std::make_unique<io::DirectoryLock>(r.route) : nullptr;
   auto route = std::make_shared<route::Route>(route::LoadRoute(r.route));
+  if (r.learn)
+    run::CheckLearnable(r.route, route->complete, route->visits, "keyframes", "repeat --learn");
   if (!route->complete)
     spdlog::warn("repeat: {} is an interrupted teach; repeating its {} keyframes", r.route,
                  route->keyframes.size());

@@ -113,6 +113,11 @@ TEST(Experiences, MergingAddsTheOtherCopysNewViewsAfterItsOwnVisits) {
   EXPECT_EQ(route.keyframes[1].views[0].last_used, 7);
   EXPECT_TRUE(route.keyframes[1].views[0].file.empty());   // written anew
   EXPECT_EQ(navigation::MergeViews(&route, other, 5), 0);  // all there already
+  EXPECT_EQ(route.visits, 7);  // and idempotent: merging again counts no visits
+  // The visits together may not pass the most a route counts.
+  route::Route worn = other;
+  worn.visits = route::kMaxRouteVisits;
+  EXPECT_THROW(navigation::MergeViews(&worn, route, 5), InputError);
   // With room for one learned view per place, the most recently useful one stays.
   route::Route full = route;
   EXPECT_EQ(navigation::MergeViews(&full, other, 2), 0);

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "mapless/core/check.h"
+#include "mapless/route/route.h"
 #include "mapless/navigation/appearance.h"
 
 namespace mapless::navigation {
@@ -42,6 +43,8 @@ int ApplyAppearanceVisit(route::StoredAppearanceRoute* route, const std::vector<
                          std::vector<LearnedAppearanceView> learned,
                          const AppearanceExperienceOptions& options) {
   options.Validate();
+  MAPLESS_CHECK(route->visits < route::kMaxRouteVisits,
+                "the route has " << route->visits << " visits, the most it counts");
   const int visit = ++route->visits;
   const int n = static_cast<int>(route->images.size());
   for (int p = 0; p < n && p < static_cast<int>(used_views.size()); ++p) {

@@ -90,6 +90,8 @@ void LearnView(std::vector<ExperienceView>* views, const ViewChoice& choice,
 int ApplyVisit(route::Route* route, const std::vector<int>& used_views,
                std::vector<LearnedView> learned, const ExperienceOptions& options) {
   options.Validate();
+  MAPLESS_CHECK(route->visits < route::kMaxRouteVisits,
+                "the route has " << route->visits << " visits, the most it counts");
   const int visit = ++route->visits;
   auto& kfs = route->keyframes;
   for (std::size_t k = 0; k < kfs.size() && k < used_views.size(); ++k) {
@@ -153,8 +155,11 @@ int MergeViews(route::Route* into, const route::Route& from, int max_views) {
     MAPLESS_CHECK(a.keypoints.size() == b.keypoints.size() && SameMat(a.descriptors, b.descriptors),
                   "the routes were not taught together: keyframe " << k << " differs");
   }
+  MAPLESS_CHECK(from.visits <= route::kMaxRouteVisits - into->visits,
+                "the routes have " << into->visits << " and " << from.visits
+                                   << " visits: more than " << route::kMaxRouteVisits
+                                   << " together");
   const int shift = into->visits;
-  into->visits += from.visits;
   int added = 0;
   for (std::size_t k = 0; k < from.keyframes.size(); ++k) {
     auto& views = into->keyframes[k].views;
@@ -171,6 +176,9 @@ int MergeViews(route::Route* into, const route::Route& from, int max_views) {
     }
     KeepAtMost(&views, 0, max_views - 1);
   }
+  // Merging the same route again adds nothing and counts no visits (idempotent): the visits of
+  // `from` join only with views that came with them.
+  if (added > 0) into->visits += from.visits;
   return added;
 }
 

@@ -12,6 +12,7 @@
 #include "mapless/io/image_file.h"
 #include "mapless/io/limits.h"
 #include "mapless/route/manifest_text.h"
+#include "mapless/route/route_store.h"
 
 namespace mapless::route {
 
@@ -178,7 +179,8 @@ void SaveAppearanceViews(const std::string& dir, StoredAppearanceRoute* route) {
   if (!fs::is_directory(views)) return;
   for (const auto& file : fs::directory_iterator(views)) {
     const std::string name = "views/" + file.path().filename().string();
-    if (listed.count(name) == 0 && name.find("-visit-") != std::string::npos) {
+    if (listed.count(name) == 0 && IsViewFileName(file.path().filename().string(), ".png") &&
+        file.is_regular_file() && !file.is_symlink()) {
       std::error_code ignored;
       fs::remove(file.path(), ignored);
     }
@@ -290,7 +292,7 @@ StoredAppearanceRoute ParseAppearanceManifest(const std::string& text, const std
            << kAppearanceRouteFormatVersion << " and " << kAppearanceRouteViewsFormatVersion
            << ")");
   StoredAppearanceRoute route;
-  if (version == kAppearanceRouteViewsFormatVersion) route.visits = integer("visits", 0, 1'000'000);
+  if (version == kAppearanceRouteViewsFormatVersion) route.visits = integer("visits", 0, kMaxRouteVisits);
   route.image_width = integer("image_width", 16, io::kMaxImageSide);
   route.image_height = integer("image_height", 16, io::kMaxImageSide);
   MAPLESS_CHECK(std::int64_t{route.image_width} * route.image_height <= io::kMaxImagePixels,

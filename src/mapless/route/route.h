@@ -13,6 +13,10 @@
 
 namespace mapless::route {
 
+// A route's visits (repeat --learn, follow --learn, route merge): a million repeats is 30 a day for
+// a century; the count must never reach int's end (2^31-1 visits overflowed on the next visit).
+inline constexpr int kMaxRouteVisits = 1'000'000;
+
 // A view of a keyframe's place learned on a later visit (issue 45; navigation/experiences.h): its
 // features, and the horizontal offset the repeat measured when it learned it (x in this view - x
 // in the taught view), which maps its features back into the taught view's coordinates.

@@ -269,7 +269,9 @@ Manifest ParseManifest(const std::string& text, const std::string& name) {
                        std::to_string(kRouteViewsFormatVersion) + ")");
     }
     if (m.version == kRouteViewsFormatVersion) m.visits = ManifestInt(j, "visits", name);
-    if (m.visits < 0) throw InputError(name + ": corrupt manifest (visits is negative)");
+    if (m.visits < 0 || m.visits > kMaxRouteVisits)
+      throw InputError(name + ": corrupt manifest (visits " + std::to_string(m.visits) +
+                       "; must be 0 to " + std::to_string(kMaxRouteVisits) + ")");
     m.detector = j.at("detector").get<std::string>();
     m.image_width = ManifestInt(j, "image_width", name);
     m.image_height = ManifestInt(j, "image_height", name);

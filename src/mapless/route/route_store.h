@@ -30,6 +30,9 @@ inline constexpr int kRouteFormatVersion = 1;
 // views stays version 1.
 inline constexpr int kRouteViewsFormatVersion = 2;
 inline constexpr int kMaxViewsPerKeyframe = 64;
+// A view file mapless wrote into a route: "NNNNNN-visit-VVVV.EXT" (keyframes/*.yml, views/*.png).
+// Only such files are ever removed from a route (a user's "my-visit-notes.txt" is not).
+bool IsViewFileName(const std::string& name, const std::string& extension);
 
 struct Manifest;
 

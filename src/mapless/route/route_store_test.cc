@@ -245,8 +245,18 @@ TEST(RouteStore, LearnedViewsRoundTripAndPrunedOnesLeaveNoFile) {
   loaded.visits = 3;
   loaded.keyframes[1].views.erase(loaded.keyframes[1].views.begin());
   loaded.keyframes[2].views = {MakeView(2, 3, 40.0)};
+  // A file of the user's whose name merely contains "-visit-" is not mapless's to remove.
+  const std::string users = dir + "/keyframes/my-visit-notes.yml";
+  std::ofstream(users) << "notes\n";
   SaveViews(dir, &loaded);
   EXPECT_FALSE(std::filesystem::exists(dir + "/" + first_file));
+  EXPECT_TRUE(std::filesystem::exists(users));
+  EXPECT_TRUE(IsViewFileName("000001-visit-0001.yml", ".yml"));
+  EXPECT_TRUE(IsViewFileName("000001-visit-1000000.yml", ".yml"));
+  EXPECT_FALSE(IsViewFileName("000001-visit-0001.yml.bak", ".yml"));
+  EXPECT_FALSE(IsViewFileName("00001x-visit-0001.yml", ".yml"));
+  EXPECT_FALSE(IsViewFileName("000001-visit-.yml", ".yml"));
+  std::filesystem::remove(users);
   const Route again = LoadRoute(dir);
   EXPECT_EQ(again.keyframes[1].views.size(), 1u);
   EXPECT_EQ(again.keyframes[1].views[0].offset_px, -3.25);

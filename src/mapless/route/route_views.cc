@@ -15,6 +15,19 @@
 
 namespace mapless::route {
 
+bool IsViewFileName(const std::string& name, const std::string& extension) {
+  const std::size_t dash = name.find("-visit-");
+  const std::size_t dot = name.rfind('.');
+  if (dash != 6 || dot == std::string::npos || dot < dash + 11 || name.substr(dot) != extension)
+    return false;
+  const auto digits = [&](std::size_t from, std::size_t to) {
+    for (std::size_t i = from; i < to; ++i)
+      if (name[i] < '0' || name[i] > '9') return false;
+    return true;
+  };
+  return digits(0, 6) && digits(dash + 7, dot);
+}
+
 std::string ViewFileName(int keyframe, int learned_at) {
   char name[64];
   std::snprintf(name, sizeof(name), "-visit-%04d.yml", learned_at);
@@ -74,7 +87,8 @@ void SaveViews(const std::string& dir, Route* route) {
   const std::filesystem::path keyframes = std::filesystem::path(dir) / "keyframes";
   for (const auto& file : std::filesystem::directory_iterator(keyframes)) {
     const std::string name = "keyframes/" + file.path().filename().string();
-    if (name.find("-visit-") != std::string::npos && listed.count(name) == 0) {
+    if (IsViewFileName(file.path().filename().string(), ".yml") && file.is_regular_file() &&
+        !file.is_symlink() && listed.count(name) == 0) {
       std::error_code ignored;
       std::filesystem::remove(file.path(), ignored);
     }

@@ -1,6 +1,10 @@
 #include "mapless/run/learn.h"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <set>
 #include <thread>
@@ -12,6 +16,26 @@
 #include "mapless/route/route_store.h"
 
 namespace mapless::run {
+
+void CheckLearnable(const std::string& dir, bool complete, int visits,
+                    const std::string& views_folder, const std::string& command) {
+  namespace fs = std::filesystem;
+  MAPLESS_CHECK(complete, command << ": " << dir
+                                  << " is an interrupted teach; views are learned into complete "
+                                     "routes (teach it again)");
+  MAPLESS_CHECK(visits < route::kMaxRouteVisits,
+                command << ": " << dir << " has " << visits << " visits, the most a route counts");
+  // The manifest is replaced (a new file renamed over it: the directory must be writable), view
+  // files are written into the folder (created in the route when it is missing).
+  std::vector<std::string> written = {dir};
+  const fs::path folder = fs::path(dir) / views_folder;
+  std::error_code ec;
+  if (fs::exists(folder, ec)) written.push_back(folder.string());
+  for (const std::string& d : written)
+    MAPLESS_CHECK(::access(d.c_str(), W_OK | X_OK) == 0,
+                  command << ": " << d << ": cannot be written (" << std::strerror(errno)
+                          << "); the visit could not be saved");
+}
 
 std::string SaveVisit(const std::string& dir, const route::Route& route,
                       const std::vector<int>& used_views,
@@ -78,7 +102,7 @@ std::string MergeRouteViews(const std::string& dir, const std::string& other, in
   const io::DirectoryLock other_lock(other);  // not while a repeat learns into it
   route::Route route = route::LoadRoute(dir);
   const int merged = navigation::MergeViews(&route, route::LoadRoute(other), max_views);
-  route::SaveViews(dir, &route);
+  if (merged > 0) route::SaveViews(dir, &route);  // nothing new: nothing written (idempotent)
   std::size_t views = 0;
   for (const auto& kf : route.keyframes) views += kf.views.size();
   return dir + ": " + std::to_string(merged) + " learned view" + (merged == 1 ? "" : "s") +

@@ -33,6 +33,14 @@ std::string SaveAppearanceVisit(const std::string& dir, const route::StoredAppea
                                 std::vector<navigation::LearnedAppearanceView> learned,
                                 const navigation::AppearanceExperienceOptions& options);
 
+// Before a run that learns into the route at `dir` (repeat --learn, follow --learn): the route must
+// be complete (an interrupted teach is not learned into), below kMaxRouteVisits, and its directory
+// and the folder its view files go to (`views_folder`: "keyframes" or "views") writable, so that
+// the run does not drive the whole route and then fail to save. Throws InputError naming `command`
+// and what is wrong.
+void CheckLearnable(const std::string& dir, bool complete, int visits,
+                    const std::string& views_folder, const std::string& command);
+
 // `mapless route prune ROUTE --max-views N`: locks the route directory, keeps at most N views per
 // keyframe (navigation::PruneViews) and writes what changed (route::SaveViews: the manifest, then
 // the pruned files removed). Returns one line: "ROUTE: 3 learned views pruned, 12 left".
