@@ -78,12 +78,12 @@ CLI::Validator SeedCheck();
 template <typename T>
 CLI::Option* AddOldName(CLI::App* cmd, const std::string& old_name, const std::string& new_name,
                         T* value) {
-  CLI::Option* old = cmd->add_option(old_name, *value, "Old name of " + new_name)
-                         ->group("Old names")
-                         ->each([old_name, new_name](const std::string&) {
-                           spdlog::warn("{} is now {} here; the old name will go", old_name,
-                                        new_name);
-                         });
+  CLI::Option* old =
+      cmd->add_option(old_name, *value, "Old name of " + new_name)
+          ->group("Old names")
+          ->each([old_name, new_name](const std::string&) {
+            spdlog::warn("{} is now {} here; the old name will go", old_name, new_name);
+          });
   if (CLI::Option* renamed = cmd->get_option_no_throw(new_name)) old->excludes(renamed);
   return old;
 }

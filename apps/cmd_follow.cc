@@ -78,7 +78,8 @@ void FollowStored(const FollowArgs& a) {
   // --learn writes into the route: no other process may write it meanwhile.
   const auto lock = a.learn ? std::make_unique<io::DirectoryLock>(a.route) : nullptr;
   const route::StoredAppearanceRoute stored = route::LoadAppearanceRoute(a.route);
-  if (a.learn) run::CheckLearnable(a.route, stored.complete, stored.visits, "views", "follow --learn");
+  if (a.learn)
+    run::CheckLearnable(a.route, stored.complete, stored.visits, "views", "follow --learn");
   cv::Size size;
   const std::shared_ptr<const route::AppearanceRoute> route = RebuildRoute(a.route, stored, &size);
   robot::FollowMethod method([route] { return route; }, follower, size);

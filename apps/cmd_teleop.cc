@@ -1,6 +1,7 @@
 // `mapless teleop --robot ROBOT.yaml`: drive a robot from this terminal's keyboard (robot/teleop.h)
 #include <spdlog/spdlog.h>
 
+#include "mapless/core/interrupt.h"
 #include "mapless/robot/teleop.h"
 #include "mapless/run/keyboard.h"
 #include "robot_run.h"
@@ -26,11 +27,14 @@ void AddTeleopCommand(CLI::App* app) {
     const robot::RobotFile file = robot::LoadRobotFile(a->robot);
     a->keys.max_speed_mps = file.max_speed_mps;
     a->keys.max_turn_rate_radps = file.max_turn_rate_radps;
-    run::Keyboard keyboard;
+    // Whatever ends the keys ends the run at once, camera frames or not: every wait of the robot
+    // link hears the request within milliseconds, and the robot gets a zero Twist.
+    run::Keyboard keyboard(0, [] { RequestInterrupt(); });
     robot::TeleopMethod method(a->keys, [&keyboard] { return keyboard.Read(); });
     spdlog::info("teleop: {}", robot::TeleopKeysHelp());
     SourceRunArgs args;
     args.robot = true;
+    args.ended_by_user = [&keyboard] { return keyboard.ended(); };
     RunOnSource(method, a->robot, args);
   });
 }

@@ -5,9 +5,9 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <cerrno>
 #include <filesystem>
 #include <iostream>
 #include <opencv2/core.hpp>
@@ -173,7 +173,7 @@ int main(int argc, char** argv) {
     std::cerr << "mapless: error: " << OneLine(paths) << ": " << OneLine(e.code().message())
               << "\n";
     return code == ENOSPC || code == EIO || code == EDQUOT ? mapless::app::kExitRunFailed
-                                                          : mapless::app::kExitBadInput;
+                                                           : mapless::app::kExitBadInput;
   } catch (const cv::Exception& e) {
     // Inputs are checked before they reach OpenCV; one that still trips it is a mapless bug.
     std::cerr << "mapless: error: internal (OpenCV " << e.func << "): " << OneLine(e.err)

@@ -95,6 +95,10 @@ void RunOnRobot(robot::Method& method, const std::string& path, const SourceRunA
                outcome.loop.finished ? "finished" : "stopped", outcome.loop.frames,
                outcome.loop.reason);
   ThrowIfInterrupted();
+  if (!outcome.loop.finished && args.ended_by_user && args.ended_by_user()) {
+    spdlog::info("{}: finished: ended from the keyboard", method.name());
+    return;
+  }
   if (!outcome.loop.finished)
     throw RunFailed(std::string(method.name()) + " stopped: " + outcome.loop.reason);
 }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -34,6 +35,10 @@ struct SourceRunArgs {
   std::vector<Pose2> route;             // the taught route in its odometry frame, for the live view
   std::string size_needed_by;  // "the route R was taught at": a recording's frames must match
   bool robot = false;          // the source is a robot file (--robot), whatever its name
+  // The user ended the run at the method's own input, between frames too (teleop's keyboard:
+  // Ctrl-C or Ctrl-D, or its end). The loop then ends at once (mapless::RequestInterrupt) with
+  // the robot stopped, and the run counts as finished, not failed.
+  std::function<bool()> ended_by_user;
 };
 
 // Runs `method` on `source` (a robot file, a camera or a recording; run/link_kinds.h) through the

@@ -5,10 +5,12 @@
 //   int PID     SIGINT to the method (Ctrl-C)
 //   estop       true on /mapless/estop, held 1.2 s (commands meanwhile at most MAX_STOP_PER_S a
 //               second); then false, and the robot must be driven again within 2 s
+//   listen      (no action, NONZERO 0) the first command within LIMIT_S must be a zero Twist
+//               (teleop ending before any frame: tests/robot_link/teleop.sh)
 //   topics      (no action) the status topic carries one JSON object per frame naming the method,
 //               and the debug image topic bgr8 pictures at least 320 wide
 // Prints one JSON line; exit 0 when the zero came within the limit, 1 otherwise.
-//   safety_probe kill|int|estop|topics PID LIMIT_S [NONZERO_COMMANDS [MAX_STOP_PER_S]]
+//   safety_probe kill|int|estop|listen|topics PID LIMIT_S [NONZERO_COMMANDS [MAX_STOP_PER_S]]
 #include <signal.h>
 
 #include <chrono>
@@ -82,7 +84,8 @@ void OnDebug(dds_entity_t reader, void*) {
 
 int main(int argc, char** argv) {
   if (argc < 4) {
-    std::fprintf(stderr, "usage: safety_probe kill|int|estop|topics PID LIMIT_S [NONZERO]\n");
+    std::fprintf(stderr,
+                 "usage: safety_probe kill|int|estop|listen|topics PID LIMIT_S [NONZERO]\n");
     return 2;
   }
   const std::string mode = argv[1];
@@ -133,6 +136,8 @@ int main(int argc, char** argv) {
           kill(pid, SIGKILL);
         } else if (mode == "int") {
           kill(pid, SIGINT);
+        } else if (mode == "listen") {
+          // no action: the first command, whenever it comes within LIMIT_S, must be a zero
         } else {
           WriteBool(estop, true);
         }
@@ -147,7 +152,9 @@ int main(int argc, char** argv) {
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
-  const auto wait_until = Clock::now() + std::chrono::seconds(3);
+  const auto wait_until =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                         std::chrono::duration<double>(mode == "listen" ? limit : 3.0));
   while (Clock::now() < wait_until) {
     {
       std::lock_guard<std::mutex> lock(g_mutex);

@@ -3,8 +3,8 @@
 #include <algorithm>
 
 #include "mapless/core/check.h"
-#include "mapless/route/route.h"
 #include "mapless/navigation/appearance.h"
+#include "mapless/route/route.h"
 
 namespace mapless::navigation {
 namespace {

@@ -292,7 +292,8 @@ StoredAppearanceRoute ParseAppearanceManifest(const std::string& text, const std
            << kAppearanceRouteFormatVersion << " and " << kAppearanceRouteViewsFormatVersion
            << ")");
   StoredAppearanceRoute route;
-  if (version == kAppearanceRouteViewsFormatVersion) route.visits = integer("visits", 0, kMaxRouteVisits);
+  if (version == kAppearanceRouteViewsFormatVersion)
+    route.visits = integer("visits", 0, kMaxRouteVisits);
   route.image_width = integer("image_width", 16, io::kMaxImageSide);
   route.image_height = integer("image_height", 16, io::kMaxImageSide);
   MAPLESS_CHECK(std::int64_t{route.image_width} * route.image_height <= io::kMaxImagePixels,
