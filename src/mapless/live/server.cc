@@ -4,6 +4,7 @@
 #include <websocketpp/server.hpp>
 // (websocketpp before the rest: it defines what asio needs standalone)
 
+#include <algorithm>
 #include <chrono>
 #include <future>
 #include <map>
@@ -31,7 +32,7 @@ struct Client {
   std::optional<Clock::time_point> full_since;  // its queue over the limit since
   Clock::time_point window_start = Clock::now();
   int requests_in_window = 0;
-  std::set<std::string> told;  // the kinds of bad input already logged for it
+  std::set<std::string> told;  // the kinds of bad input already logged for it (at most 32)
   bool cut_off = false;        // its socket is closed; what it sent before is ignored
   bool heard = false;          // it has sent a message
 };
@@ -71,6 +72,12 @@ struct Server::Impl {
   std::string page;
   WsServer ws;
   std::map<Hdl, Client, std::owner_less<Hdl>> clients;  // the server's thread only
+  std::vector<Hdl> connections;  // every connection accepted and not yet gone (server's thread)
+  std::vector<Hdl> validated;    // handshakes accepted, not yet open (server's thread)
+  // Lines about clients in the current second, and those not shown since the last summary.
+  Clock::time_point log_window = Clock::now();
+  int log_lines_in_window = 0;
+  std::uint64_t log_suppressed = 0;
   std::atomic<std::size_t> client_count{0};
   int port = 0;
   std::unique_ptr<asio::steady_timer> timer;
@@ -88,17 +95,54 @@ struct Server::Impl {
   bool flush_posted = false;
   ServerStats stats;
 
-  void Log(const std::string& line) const {
-    if (options.log) options.log("live view: " + line);
+  // A line about clients, at most max_log_lines_per_s a second: 200 clients that come at once
+  // (or one that reconnects in a loop) get a few lines and a count, not a line each.
+  void Log(const std::string& line) {
+    if (!options.log) return;
+    SummarizeLog(false);
+    if (++log_lines_in_window > options.max_log_lines_per_s) {
+      ++log_suppressed;
+      std::lock_guard<std::mutex> lock(mu);
+      ++stats.log_lines_suppressed;
+      return;
+    }
+    options.log("live view: " + line);
   }
-  // Logs a kind of bad input once per client (a flood gets one line).
-  void Tell(Client& c, const std::string& kind, const std::string& line) const {
-    if (c.told.insert(kind).second) Log(c.name + ": " + line);
+  // At the end of each second: the count of the lines not shown in it, in one line.
+  void SummarizeLog(bool at_end) {
+    if (!at_end && SecondsSince(log_window) < 1.0) return;
+    if (log_suppressed > 0)
+      options.log("live view: " + std::to_string(log_suppressed) +
+                  " more lines about clients not shown (at most " +
+                  std::to_string(options.max_log_lines_per_s) + " a second)");
+    log_suppressed = 0;
+    log_window = Clock::now();
+    log_lines_in_window = 0;
+  }
+  // Logs a kind of bad input once per client (a flood gets one line), 32 kinds at most.
+  void Tell(Client& c, const std::string& kind, const std::string& line) {
+    if (c.told.size() < 32 && c.told.insert(kind).second) Log(c.name + ": " + line);
+  }
+  // Every message to a client goes through here: above twice max_buffered_bytes in its queue it
+  // is dropped (counted), so that a client that reads nothing cannot grow the process, whatever
+  // it asks for (replies to a flood, the route latched again on every subscribe). Images are
+  // dropped from max_buffered_bytes (Flush).
+  bool SendBounded(Hdl h, const std::string& payload, websocketpp::frame::opcode::value op) {
+    std::error_code ec;
+    WsServer::connection_ptr con = ws.get_con_from_hdl(h, ec);
+    if (ec) return false;
+    if (con->get_buffered_amount() > 2 * options.max_buffered_bytes) {
+      std::lock_guard<std::mutex> lock(mu);
+      ++stats.messages_dropped;
+      return false;
+    }
+    ws.send(h, payload, op, ec);
+    return !ec;
   }
   void SendText(Hdl h, const std::string& text) {
-    std::error_code ec;
-    ws.send(h, text, websocketpp::frame::opcode::text, ec);
+    SendBounded(h, text, websocketpp::frame::opcode::text);
   }
+  bool AdmitConnection(Hdl h);
   void CutOff(Hdl h, Client& c, const std::string& why) {
     if (c.cut_off) return;
     c.cut_off = true;
@@ -124,10 +168,35 @@ struct Server::Impl {
   void Start();
 };
 
+// Each accepted connection, before its handshake: refused (closed at once) when max_connections
+// are open already, handshakes under way included (a flood of connections that never finish
+// their handshake held buffers until each timed out).
+bool Server::Impl::AdmitConnection(Hdl h) {
+  connections.erase(std::remove_if(connections.begin(), connections.end(),
+                                   [](const Hdl& c) { return c.expired(); }),
+                    connections.end());
+  if (connections.size() < options.max_connections) {
+    connections.push_back(h);
+    return true;
+  }
+  {
+    std::lock_guard<std::mutex> lock(mu);
+    ++stats.connections_refused;
+  }
+  Log("a connection refused (" + std::to_string(options.max_connections) + " open already)");
+  return false;
+}
+
 bool Server::Impl::Validate(Hdl h) {
   WsServer::connection_ptr con = ws.get_con_from_hdl(h);
   const std::string who = con->get_remote_endpoint();
-  if (client_count.load() >= options.max_clients) {
+  // Handshakes accepted and not yet open count too (200 at once all passed the check before).
+  validated.erase(std::remove_if(validated.begin(), validated.end(),
+                                 [this](const Hdl& v) {
+                                   return v.expired() || clients.count(v) > 0;
+                                 }),
+                  validated.end());
+  if (client_count.load() + validated.size() >= options.max_clients) {
     Log(who + ": refused (" + std::to_string(options.max_clients) + " clients already)");
     return false;
   }
@@ -137,6 +206,7 @@ bool Server::Impl::Validate(Hdl h) {
     return false;
   }
   con->select_subprotocol(chosen);
+  validated.push_back(h);
   return true;
 }
 
@@ -236,11 +306,9 @@ void Server::Impl::Message(Hdl h, WsServer::message_ptr msg) {
     for (const auto& [sub, channel] : request.subscriptions) {
       if (channel != o.channel_id) continue;
       for (const std::uint32_t mine : c.subscriptions.For(channel))
-        if (mine == sub) {
-          std::error_code ec;
-          ws.send(h, MessageDataFrame(sub, static_cast<std::uint64_t>(last_t_ns), o.payload),
-                  websocketpp::frame::opcode::binary, ec);
-        }
+        if (mine == sub)
+          SendBounded(h, MessageDataFrame(sub, static_cast<std::uint64_t>(last_t_ns), o.payload),
+                      websocketpp::frame::opcode::binary);
     }
   }
 }
@@ -262,6 +330,10 @@ void Server::Impl::Flush() {
     std::error_code ec;
     WsServer::connection_ptr con = ws.get_con_from_hdl(h, ec);
     if (ec) continue;
+    if (con->get_buffered_amount() > 2 * options.max_buffered_bytes) {
+      ++dropped;  // nothing at all for a client this far behind, not even the time
+      continue;
+    }
     ws.send(h, time, websocketpp::frame::opcode::binary, ec);
     for (const Outgoing& o : messages) {
       for (const std::uint32_t sub : c.subscriptions.For(o.channel_id)) {
@@ -300,6 +372,7 @@ void Server::Impl::Tick() {
     if (ticks % 10 == 0) con->ping("", ec);
   }
   ++ticks;
+  if (options.log) SummarizeLog(false);
   for (Hdl h : stalled) {
     const auto it = clients.find(h);
     if (it != clients.end())
@@ -323,6 +396,14 @@ void Server::Impl::Start() {
   ws.set_open_handshake_timeout(handshake_ms);
   ws.set_close_handshake_timeout(1000);
   ws.set_pong_timeout(handshake_ms);
+  ws.set_tcp_pre_init_handler([this](Hdl h) {  // accepted, before the handshake is read
+    if (AdmitConnection(h)) return;
+    std::error_code ec;
+    WsServer::connection_ptr con = ws.get_con_from_hdl(h, ec);
+    if (ec) return;
+    con->get_raw_socket().shutdown(asio::ip::tcp::socket::shutdown_both, ec);
+    con->get_raw_socket().close(ec);
+  });
   ws.set_validate_handler([this](Hdl h) { return Validate(h); });
   ws.set_http_handler([this](Hdl h) { Http(h); });
   ws.set_open_handler([this](Hdl h) { Open(h); });
@@ -367,6 +448,7 @@ Server::~Server() {
     impl->timer->cancel();
     for (auto& [h, c] : impl->clients)
       impl->ws.close(h, websocketpp::close::status::going_away, "the run ended", ec);
+    if (impl->options.log) impl->SummarizeLog(true);
     done->set_value();
   });
   done->get_future().wait_for(std::chrono::seconds(2));

@@ -40,6 +40,12 @@ struct ServerOptions {
   std::size_t max_message_bytes = 64 * 1024;  // a larger frame from a client closes it (1009)
   int max_requests_per_s = 100;               // more text messages a second: cut off (a flood)
   double handshake_timeout_s = 5.0;           // half-open connections are closed after this
+  // Connections open at once, handshakes under way included (each holds websocketpp's buffers,
+  // about 40 KB, until its handshake times out): more are closed as they are accepted.
+  std::size_t max_connections = 64;
+  // Lines about clients (came, went, refused, cut off, sent bad input): at most this many a
+  // second; the rest are counted and said in one line ("... 190 more lines about clients").
+  int max_log_lines_per_s = 5;
   // One line per event worth telling (a client came or went, was refused or cut off, sent bad
   // input); called on the server's thread. Empty: silent.
   std::function<void(const std::string&)> log;
@@ -51,6 +57,9 @@ struct ServerStats {
   std::uint64_t messages_sent = 0;
   std::uint64_t images_dropped = 0;  // for slow clients
   std::uint64_t clients_cut_off = 0;
+  std::uint64_t messages_dropped = 0;      // replies and latched messages for a full queue
+  std::uint64_t connections_refused = 0;   // over max_connections
+  std::uint64_t log_lines_suppressed = 0;  // over max_log_lines_per_s
 };
 
 class Server {

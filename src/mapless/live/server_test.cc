@@ -255,6 +255,7 @@ TEST(LiveServer, BadInputIsAnsweredLoggedOnceAndChangesNothing) {
   std::vector<std::string> log;
   std::mutex log_mu;
   ServerOptions defaults;
+  defaults.max_log_lines_per_s = 100;  // every kind's line counted here, none held back
   auto server = AServer(defaults, &log, &log_mu);
   TestClient bad(server->port(), kSubprotocolSdk);
   TestClient good(server->port(), kSubprotocolSdk);
@@ -373,6 +374,64 @@ TEST(LiveServer, AStalledClientLosesImagesThenIsCutOffAndTheOthersGoOn) {
   const std::size_t before = reader.binaries().size();
   EXPECT_TRUE(OfferUntil(*server, [&] { return reader.binaries().size() > before + 10; }));
   EXPECT_FALSE(reader.Closed());
+}
+
+TEST(LiveServer, TwoHundredClientsGetAFewLinesWithACountAndConnectionsAreBounded) {
+  ServerOptions options;
+  options.max_connections = 40;
+  options.handshake_timeout_s = 1.0;
+  std::vector<std::string> log;
+  std::mutex log_mu;
+  auto server = AServer(options, &log, &log_mu);
+  // 200 connections at once: 20 send a whole handshake and then never read (8 become clients,
+  // the others are refused), 180 send half a request and wait (held until the handshake times
+  // out: past 40 open connections they are closed as they are accepted).
+  std::vector<std::unique_ptr<RawClient>> clients;
+  for (int i = 0; i < 200; ++i) {
+    clients.push_back(std::make_unique<RawClient>(server->port()));
+    std::error_code ignored;
+    asio::write(clients.back()->socket,
+                asio::buffer(i < 20 ? Upgrade(kSubprotocolV1) : "GET / HTTP/1.1\r\nHost: x\r\n"),
+                ignored);
+  }
+  std::this_thread::sleep_for(1500ms);
+  EXPECT_LE(server->clients(), options.max_clients);
+  EXPECT_GT(server->stats().connections_refused, 0u);
+  EXPECT_GT(server->stats().log_lines_suppressed, 0u);
+  std::lock_guard<std::mutex> lock(log_mu);
+  // A few lines a second (the test took about 2 s) and the count of the others.
+  EXPECT_LE(log.size(), 20u) << log.size() << " lines";
+  bool counted = false;
+  for (const std::string& line : log)
+    counted = counted || line.find("more lines about clients not shown") != std::string::npos;
+  EXPECT_TRUE(counted);
+}
+
+TEST(LiveServer, AClientThatResubscribesWithoutReadingCannotGrowItsQueue) {
+  ServerOptions options;
+  options.max_buffered_bytes = 64 * 1024;
+  options.stall_timeout_s = 60.0;  // not cut off: what it can queue is what is measured
+  auto server = AServer(options);
+  server->Offer(AFrame(0));  // a frame: the route is latched from now on
+  std::this_thread::sleep_for(100ms);
+  RawClient hostile(server->port());
+  hostile.socket.set_option(asio::socket_base::receive_buffer_size(4096));
+  hostile.Write(Upgrade(kSubprotocolV1));
+  std::this_thread::sleep_for(200ms);
+  // Subscribe and unsubscribe every channel, again and again (under the flood limit): each
+  // subscribe sends the latched route again, to a client that reads nothing.
+  for (int round = 0; round < 40; ++round) {
+    for (int id = 1; id <= 9; ++id)
+      hostile.Write(MaskedText(R"({"op":"subscribe","subscriptions":[{"id":)" +
+                               std::to_string(id) + R"(,"channelId":)" + std::to_string(id) +
+                               "}]}"));
+    hostile.Write(MaskedText(R"({"op":"unsubscribe","subscriptionIds":[1,2,3,4,5,6,7,8,9]})"));
+    server->Offer(AFrame(round + 1, 640, 480));  // and frames, whose images fill its queue
+    std::this_thread::sleep_for(120ms);
+  }
+  // Its queue went over the bound: what came then (the route again, the time) was dropped.
+  EXPECT_GT(server->stats().messages_dropped, 0u);
+  EXPECT_EQ(server->clients(), 1u);
 }
 
 TEST(LiveServer, AHalfOpenConnectionIsClosed) {
