@@ -482,7 +482,9 @@ const std::vector<NamedHarness>& Harnesses() {
                                                       {"mcap", McapFile},
                                                       {"rosbag", RosBag},
                                                       {"camera_info", CameraInfo},
-                                                      {"live_client", LiveClientMessage}};
+                                                      {"live_client", LiveClientMessage},
+                                                      {"live_http", LiveHttpRequest},
+                                                      {"live_ws_frames", LiveWebSocketFrames}};
   return harnesses;
 }
 

@@ -78,6 +78,13 @@ void RosBag(const std::string& input);
 // it, applied to a client's subscriptions of the run's channels, and answered (a status message
 // for what was refused): never an exception, the subscriptions within their bound.
 void LiveClientMessage(const std::string& input);
+// The bytes a live view client sends on its connection, as up to 16 reads: websocketpp's HTTP
+// request parser with the server's body limit, then the handshake's checks and the subprotocol
+// chosen (issue 67).
+void LiveHttpRequest(const std::string& input);
+// The same after the handshake: websocketpp's WebSocket frame parser (hybi13, server side, the
+// server's 64 KB message limit), each text message then parsed as the server does.
+void LiveWebSocketFrames(const std::string& input);
 
 const std::vector<NamedHarness>& Harnesses();
 

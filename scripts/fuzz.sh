@@ -12,7 +12,7 @@
 #     TARGET      route_manifest route_keyframe scenario config calibration flo tum image_folder
 #                 video_file scenario_world robot_file appearance_manifest camera_message
 #                 fleet_record fleet_follower fleet_view_offer ros2_message mcap rosbag camera_info
-#                 live_client
+#                 live_client live_http live_ws_frames
 #                 (default: all)
 #
 # Each target starts from fuzz/corpus/<target>/ (kept inputs) and grows a working corpus in
@@ -40,7 +40,7 @@ targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
   targets=(route_manifest route_keyframe scenario config calibration flo tum image_folder video_file
            scenario_world robot_file appearance_manifest camera_message fleet_record fleet_follower fleet_view_offer ros2_message mcap rosbag
-           camera_info live_client)
+           camera_info live_client live_http live_ws_frames)
 fi
 
 bash scripts/setup.sh
