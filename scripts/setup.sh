@@ -43,6 +43,9 @@ if [ "$WITH_ROS" = "1" ]; then
     libroscpp-dev          # ROS 1 client library (Noetic level in Debian 12)
     libsensor-msgs-dev libgeometry-msgs-dev libnav-msgs-dev libstd-msgs-dev
     ros-core-dev           # roscore / rosmaster, for `mapless sim serve` and the tests
+    # The message packages' Python side, for the ROS tools a robot owner looks with (`rostopic
+    # echo /cmd_vel` said "Cannot load message class" without them; ros-core-dev has rostopic).
+    python3-geometry-msgs python3-sensor-msgs python3-nav-msgs python3-std-msgs
     cyclonedds-dev cyclonedds-tools   # ROS 2 over DDS (Cyclone 0.10, as in Humble and Jazzy)
     libsodium-dev          # SHA-256 of the ROS 2 type descriptions (the RIHS01 type hash)
     librosbag-storage-dev libbz2-dev  # reading ROS 1 bags (recordings as sources; bz2 chunks checked)
