@@ -12,6 +12,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <fstream>
+#include <memory>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -150,6 +152,179 @@ void LoopPass(const Drive& d, live::LiveView& view, std::vector<double>* ms,
   }
 }
 
+// Hostile clients (issue 67), each on a thread of its own, until stopped: never reading and
+// subscribed to everything; subscribing and unsubscribing again and again without reading (each
+// subscribe sends the route again); flooding bad messages (cut off, then again); connecting and
+// going away in a loop; and 200 connections at once that never finish their handshake.
+class HostileClients {
+ public:
+  explicit HostileClients(int port) : port_(port) {
+    for (int i = 0; i < 3; ++i) stalled_.push_back(std::make_unique<StalledClient>(port));
+    threads_.emplace_back([this] { Resubscribe(); });
+    threads_.emplace_back([this] { Resubscribe(); });
+    threads_.emplace_back([this] { Flood(); });
+    threads_.emplace_back([this] { Reconnect(); });
+    threads_.emplace_back([this] { HalfOpen(); });
+  }
+  ~HostileClients() {
+    stop_ = true;
+    for (std::thread& t : threads_) t.join();
+  }
+
+ private:
+  static std::string Masked(const std::string& text) {
+    std::string frame = {'\x81'};
+    if (text.size() < 126) {
+      frame += static_cast<char>(0x80 | text.size());
+    } else {
+      frame += static_cast<char>(0x80 | 126);
+      frame += static_cast<char>(text.size() >> 8);
+      frame += static_cast<char>(text.size() & 0xff);
+    }
+    frame += std::string(4, '\0');  // a zero mask leaves the payload as it is
+    return frame + text;
+  }
+  // A handshake on a fresh socket (nothing read back); false when refused or closed.
+  bool Open(asio::ip::tcp::socket& socket) {
+    std::error_code ec;
+    socket.connect({asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port_)}, ec);
+    if (ec) return false;
+    socket.set_option(asio::socket_base::receive_buffer_size(4096), ec);
+    const std::string upgrade =
+        "GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+        "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n"
+        "Sec-WebSocket-Protocol: foxglove.websocket.v1\r\n\r\n";
+    asio::write(socket, asio::buffer(upgrade), ec);
+    return !ec;
+  }
+  void Sleep(int ms) { std::this_thread::sleep_for(std::chrono::milliseconds(ms)); }
+  void Resubscribe() {
+    asio::io_context io;
+    asio::ip::tcp::socket socket(io);
+    if (!Open(socket)) return;
+    Sleep(200);
+    while (!stop_) {  // 10 messages every 150 ms: under the flood limit of 100 a second
+      std::error_code ec;
+      for (int id = 1; id <= 9 && !ec; ++id)
+        asio::write(socket,
+                    asio::buffer(Masked(R"({"op":"subscribe","subscriptions":[{"id":)" +
+                                        std::to_string(id) + R"(,"channelId":)" +
+                                        std::to_string(id) + "}]}")),
+                    ec);
+      asio::write(socket,
+                  asio::buffer(Masked(R"({"op":"unsubscribe","subscriptionIds":[1,2,3,4,5,6,7,8,9]})")),
+                  ec);
+      if (ec) return;  // cut off
+      Sleep(150);
+    }
+  }
+  void Flood() {
+    while (!stop_) {
+      asio::io_context io;
+      asio::ip::tcp::socket socket(io);
+      if (Open(socket)) {
+        Sleep(100);
+        std::error_code ec;
+        for (int i = 0; i < 400 && !ec && !stop_; ++i)
+          asio::write(socket, asio::buffer(Masked("{\"op\": \"advertise\", \"junk\": " +
+                                                  std::to_string(i) + "}")),
+                      ec);
+      }
+      Sleep(500);
+    }
+  }
+  void Reconnect() {
+    while (!stop_) {
+      asio::io_context io;
+      asio::ip::tcp::socket socket(io);
+      Open(socket);
+      Sleep(50);
+    }
+  }
+  void HalfOpen() {
+    asio::io_context io;
+    std::vector<std::unique_ptr<asio::ip::tcp::socket>> sockets;
+    for (int i = 0; i < 200 && !stop_; ++i) {
+      auto s = std::make_unique<asio::ip::tcp::socket>(io);
+      std::error_code ec;
+      s->connect({asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port_)}, ec);
+      if (!ec) asio::write(*s, asio::buffer(std::string("GET / HTTP/1.1\r\nHost: x\r\n")), ec);
+      sockets.push_back(std::move(s));
+    }
+    while (!stop_) Sleep(20);
+  }
+
+  int port_;
+  std::atomic<bool> stop_{false};
+  std::vector<std::unique_ptr<StalledClient>> stalled_;
+  std::vector<std::thread> threads_;
+};
+
+double PeakRssMb() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line))
+    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+  return -1.0;
+}
+
+// The loop with no client and under the hostile clients, in alternating passes; the lines the
+// server logged meanwhile; the process's peak memory.
+void BenchHostile(const Drive& drive, nlohmann::json* j) {
+  live::LiveViewOptions options;
+  options.address = live::ParseAddress("127.0.0.1:0");
+  options.route = live::RoutePoses(*drive.route);
+  std::atomic<int> lines{0};
+  options.server.log = [&lines](const std::string&) { ++lines; };
+  live::LiveView view("repeat", options);
+  std::vector<double> none_ms, hostile_ms;
+  double hostile_s = 0.0;
+  for (int round = 0; round < 3; ++round) {
+    LoopPass(drive, view, &none_ms);
+    HostileClients hostile(view.port());
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    const auto start = Clock::now();
+    LoopPass(drive, view, &hostile_ms);
+    hostile_s += std::chrono::duration<double>(Clock::now() - start).count();
+  }
+  const live::ServerStats stats = view.server().stats();
+  (*j)["live_hostile_loop_0_clients_ms"] = Median(none_ms);
+  (*j)["live_hostile_loop_ms"] = Median(hostile_ms);
+  (*j)["live_hostile_over_0_clients"] = Median(hostile_ms) / Median(none_ms);
+  (*j)["live_hostile_log_lines"] = lines.load();
+  (*j)["live_hostile_seconds"] = hostile_s;
+  (*j)["live_hostile_clients_cut_off"] = stats.clients_cut_off;
+  (*j)["live_hostile_connections_refused"] = stats.connections_refused;
+  (*j)["live_hostile_messages_dropped"] = stats.messages_dropped + stats.images_dropped;
+  (*j)["live_hostile_log_lines_suppressed"] = stats.log_lines_suppressed;
+  (*j)["live_peak_rss_mb"] = PeakRssMb();
+}
+
+// --live-rate: frames 0.1 s apart in the run's time, offered as fast as they come, with a client
+// watching (and the hostile ones): the wall-clock time they take, against the time / rate.
+void BenchPace(const Drive& drive, double rate, nlohmann::json* j) {
+  live::LiveViewOptions options;
+  options.address = live::ParseAddress("127.0.0.1:0");
+  options.pace_rate = rate;
+  live::LiveView view("repeat", options);
+  ReadingClient watcher(view.port(), [](long long) {});
+  while (!watcher.subscribed()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  HostileClients hostile(view.port());
+  robot::Decision d;
+  d.state = robot::MethodState::kDriving;
+  const int n = 60;
+  const auto start = Clock::now();
+  for (int i = 0; i < n; ++i) {
+    robot::Observation o = drive.frames[static_cast<std::size_t>(i) % drive.frames.size()];
+    o.t_ns = static_cast<Timestamp>(i) * 100'000'000;
+    view.Frame(o, d, Twist2{}, std::nullopt);
+  }
+  const double wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+  // The first frame starts the clock: n - 1 periods of 0.1 s of the run's time.
+  (*j)["live_pace_rate"] = rate;
+  (*j)["live_pace_run_s_per_wall_s"] = (n - 1) * 0.1 / wall_s;
+}
+
 }  // namespace
 
 void BenchLive(nlohmann::json* j) {
@@ -203,6 +378,8 @@ void BenchLive(nlohmann::json* j) {
   const live::ServerStats stats = view.server().stats();
   (*j)["live_images_dropped"] = stats.images_dropped;
   (*j)["live_clients_cut_off"] = stats.clients_cut_off;
+  BenchHostile(drive, j);
+  BenchPace(drive, 2.0, j);
 }
 
 }  // namespace mapless::bench

@@ -89,9 +89,14 @@ class CanonicalReader {
   }
   bool Integer(long long lo, long long hi, long long* v) {
     double d = 0.0;
+    const std::size_t start = pos_;
     if (!Number(&d) || d != std::floor(d) || d < static_cast<double>(lo) ||
         d > static_cast<double>(hi))
       return false;
+    // Written as a whole number ("1", not "1.0" or "1e0"): else the general reader decides.
+    for (std::size_t i = start; i < pos_; ++i)
+      if (!std::isdigit(static_cast<unsigned char>(s_[i])) && !(i == start && s_[i] == '-'))
+        return false;
     *v = static_cast<long long>(d);
     return true;
   }
