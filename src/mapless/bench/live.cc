@@ -13,8 +13,8 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
-#include <memory>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
@@ -211,9 +211,10 @@ class HostileClients {
                                         std::to_string(id) + R"(,"channelId":)" +
                                         std::to_string(id) + "}]}")),
                     ec);
-      asio::write(socket,
-                  asio::buffer(Masked(R"({"op":"unsubscribe","subscriptionIds":[1,2,3,4,5,6,7,8,9]})")),
-                  ec);
+      asio::write(
+          socket,
+          asio::buffer(Masked(R"({"op":"unsubscribe","subscriptionIds":[1,2,3,4,5,6,7,8,9]})")),
+          ec);
       if (ec) return;  // cut off
       Sleep(150);
     }
@@ -226,9 +227,10 @@ class HostileClients {
         Sleep(100);
         std::error_code ec;
         for (int i = 0; i < 400 && !ec && !stop_; ++i)
-          asio::write(socket, asio::buffer(Masked("{\"op\": \"advertise\", \"junk\": " +
-                                                  std::to_string(i) + "}")),
-                      ec);
+          asio::write(
+              socket,
+              asio::buffer(Masked("{\"op\": \"advertise\", \"junk\": " + std::to_string(i) + "}")),
+              ec);
       }
       Sleep(500);
     }

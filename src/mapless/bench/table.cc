@@ -51,16 +51,16 @@ void PrintLinkRows(const nlohmann::json& j) {
                 j["live_latency_p99_ms"].get<double>(), j["live_latency_samples"].get<int>());
   }
   if (j.contains("live_hostile_over_0_clients")) {
-    std::printf("%-34s %10.3f  hostile clients: %.3f ms, %.3fx (issue 67: <= 1.05x)\n",
-                "live view: repeat loop, 0 clients", j["live_hostile_loop_0_clients_ms"].get<double>(),
-                j["live_hostile_loop_ms"].get<double>(),
-                j["live_hostile_over_0_clients"].get<double>());
-    std::printf("%-34s %10d  in %.1f s (%d not shown), %d cut off, %d refused, peak %.0f MB\n",
-                "live view: hostile, lines logged", j["live_hostile_log_lines"].get<int>(),
-                j["live_hostile_seconds"].get<double>(),
-                j["live_hostile_log_lines_suppressed"].get<int>(),
-                j["live_hostile_clients_cut_off"].get<int>(),
-                j["live_hostile_connections_refused"].get<int>(), j["live_peak_rss_mb"].get<double>());
+    std::printf(
+        "%-34s %10.3f  hostile clients: %.3f ms, %.3fx (issue 67: <= 1.05x)\n",
+        "live view: repeat loop, 0 clients", j["live_hostile_loop_0_clients_ms"].get<double>(),
+        j["live_hostile_loop_ms"].get<double>(), j["live_hostile_over_0_clients"].get<double>());
+    std::printf(
+        "%-34s %10d  in %.1f s (%d not shown), %d cut off, %d refused, peak %.0f MB\n",
+        "live view: hostile, lines logged", j["live_hostile_log_lines"].get<int>(),
+        j["live_hostile_seconds"].get<double>(), j["live_hostile_log_lines_suppressed"].get<int>(),
+        j["live_hostile_clients_cut_off"].get<int>(),
+        j["live_hostile_connections_refused"].get<int>(), j["live_peak_rss_mb"].get<double>());
     std::printf("%-34s %10.3f  run s per wall s at --live-rate %.1f\n", "live view: pacing",
                 j["live_pace_run_s_per_wall_s"].get<double>(), j["live_pace_rate"].get<double>());
   }

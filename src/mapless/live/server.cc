@@ -191,11 +191,10 @@ bool Server::Impl::Validate(Hdl h) {
   WsServer::connection_ptr con = ws.get_con_from_hdl(h);
   const std::string who = con->get_remote_endpoint();
   // Handshakes accepted and not yet open count too (200 at once all passed the check before).
-  validated.erase(std::remove_if(validated.begin(), validated.end(),
-                                 [this](const Hdl& v) {
-                                   return v.expired() || clients.count(v) > 0;
-                                 }),
-                  validated.end());
+  validated.erase(
+      std::remove_if(validated.begin(), validated.end(),
+                     [this](const Hdl& v) { return v.expired() || clients.count(v) > 0; }),
+      validated.end());
   if (client_count.load() + validated.size() >= options.max_clients) {
     Log(who + ": refused (" + std::to_string(options.max_clients) + " clients already)");
     return false;

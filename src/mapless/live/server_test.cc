@@ -422,9 +422,8 @@ TEST(LiveServer, AClientThatResubscribesWithoutReadingCannotGrowItsQueue) {
   // subscribe sends the latched route again, to a client that reads nothing.
   for (int round = 0; round < 40; ++round) {
     for (int id = 1; id <= 9; ++id)
-      hostile.Write(MaskedText(R"({"op":"subscribe","subscriptions":[{"id":)" +
-                               std::to_string(id) + R"(,"channelId":)" + std::to_string(id) +
-                               "}]}"));
+      hostile.Write(MaskedText(R"({"op":"subscribe","subscriptions":[{"id":)" + std::to_string(id) +
+                               R"(,"channelId":)" + std::to_string(id) + "}]}"));
     hostile.Write(MaskedText(R"({"op":"unsubscribe","subscriptionIds":[1,2,3,4,5,6,7,8,9]})"));
     server->Offer(AFrame(round + 1, 640, 480));  // and frames, whose images fill its queue
     std::this_thread::sleep_for(120ms);
