@@ -91,14 +91,12 @@ void RunOnRobot(robot::Method& method, const std::string& path, const SourceRunA
   const run::RunOutcome outcome = run::RunMethod(method, *link, options);
   link.reset();  // zero velocity published, then off the graph
   status.Clear();
+  const bool by_user = !outcome.loop.finished && args.ended_by_user && args.ended_by_user();
   spdlog::info("{}: {} after {} frames: {}", method.name(),
-               outcome.loop.finished ? "finished" : "stopped", outcome.loop.frames,
-               outcome.loop.reason);
+               outcome.loop.finished || by_user ? "finished" : "stopped", outcome.loop.frames,
+               by_user ? "ended from the keyboard" : outcome.loop.reason);
   ThrowIfInterrupted();
-  if (!outcome.loop.finished && args.ended_by_user && args.ended_by_user()) {
-    spdlog::info("{}: finished: ended from the keyboard", method.name());
-    return;
-  }
+  if (by_user) return;
   if (!outcome.loop.finished)
     throw RunFailed(std::string(method.name()) + " stopped: " + outcome.loop.reason);
 }

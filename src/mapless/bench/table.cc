@@ -52,7 +52,7 @@ void PrintLinkRows(const nlohmann::json& j) {
   }
   if (j.contains("live_hostile_over_0_clients")) {
     std::printf(
-        "%-34s %10.3f  hostile clients: %.3f ms, %.3fx (issue 67: <= 1.05x)\n",
+        "%-34s %10.3f  hostile clients: %.3f ms, %.3fx (target: <= 1.05x, docs/hardening.md)\n",
         "live view: repeat loop, 0 clients", j["live_hostile_loop_0_clients_ms"].get<double>(),
         j["live_hostile_loop_ms"].get<double>(), j["live_hostile_over_0_clients"].get<double>());
     std::printf(
