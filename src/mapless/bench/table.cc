@@ -18,10 +18,10 @@ void PrintLinkRows(const nlohmann::json& j) {
   for (const char* kind : {"eigenspace", "funnel"}) {
     const std::string k = std::string("fleet_latency_") + kind;
     if (!j.contains(k + "_median_ms")) continue;
-    std::printf("%-34s %10.3f  p99 %.3f  (issue 19: p99 <= 5)\n",
+    std::printf("%-34s %10.3f  p99 %.3f  (target: p99 <= 5)\n",
                 ("fleet record latency " + std::string(kind)).c_str(),
                 j[k + "_median_ms"].get<double>(), j[k + "_p99_ms"].get<double>());
-    std::printf("%-34s %10.3f  s (issue 19: <= 1 s; %d-byte records)\n",
+    std::printf("%-34s %10.3f  s (target: <= 1 s; %d-byte records)\n",
                 ("fleet catch-up 1000 " + std::string(kind)).c_str(),
                 j[std::string("fleet_catch_up_1000_") + kind + "_s"].get<double>(),
                 j[std::string("fleet_record_bytes_") + kind].get<int>());
@@ -30,7 +30,7 @@ void PrintLinkRows(const nlohmann::json& j) {
                   "fleet model rebuild 1000", j["fleet_model_rebuild_1000_s"].get<double>());
   }
   if (j.contains("fleet_follower_read_pieces_first100_ms")) {
-    std::printf("%-34s %10.3f  last 100: %.3f ms (issue 41: flat; whole snapshot %.3f -> %.3f)\n",
+    std::printf("%-34s %10.3f  last 100: %.3f ms (target: flat; whole snapshot %.3f -> %.3f)\n",
                 "fleet follower read/record, first 100",
                 j["fleet_follower_read_pieces_first100_ms"].get<double>(),
                 j["fleet_follower_read_pieces_last100_ms"].get<double>(),
@@ -42,11 +42,11 @@ void PrintLinkRows(const nlohmann::json& j) {
                 j["fleet_follower_apply_last100_ms"].get<double>());
   }
   if (j.contains("live_loop_3_over_0_clients")) {
-    std::printf("%-34s %10.3f  3 clients (1 stalled): %.3f ms, %.3fx (issue 43: <= 1.05x)\n",
+    std::printf("%-34s %10.3f  3 clients (1 stalled): %.3f ms, %.3fx (target: <= 1.05x)\n",
                 "live view: repeat loop, 0 clients", j["live_loop_0_clients_ms"].get<double>(),
                 j["live_loop_3_clients_ms"].get<double>(),
                 j["live_loop_3_over_0_clients"].get<double>());
-    std::printf("%-34s %10.3f  p99 %.3f ms, %d frames at 30 fps (issue 43: p99 <= 20)\n",
+    std::printf("%-34s %10.3f  p99 %.3f ms, %d frames at 30 fps (target: p99 <= 20)\n",
                 "live view: frame to client", j["live_latency_median_ms"].get<double>(),
                 j["live_latency_p99_ms"].get<double>(), j["live_latency_samples"].get<int>());
   }
@@ -130,33 +130,33 @@ void PrintStageTable(const nlohmann::json& j) {
     const double ms = j[key].get<double>();
     std::printf("%-40s %10.3f %9.0f\n", key, ms, ms > 0.0 ? 1000.0 / ms : 0.0);
   }
-  std::printf("%-34s %10.2f  (issue 44: <= 1.0; %s kernels)\n", "sim_render / dis_fast",
+  std::printf("%-34s %10.2f  (target: <= 1.0; %s kernels)\n", "sim_render / dis_fast",
               j["sim_render_over_dis_fast"].get<double>(),
               j["sim_render_kernels"].get<std::string>().c_str());
   std::printf("%-34s %10.2f  (the same images without AVX2)\n", "sim_render baseline / dis_fast",
               j["sim_render_baseline_kernels_over_dis_fast"].get<double>());
-  std::printf("%-34s %10.2f  (issue 3: <= 1.5)\n", "repeat_step / orb500",
+  std::printf("%-34s %10.2f  (target: <= 1.5)\n", "repeat_step / orb500",
               j["repeat_step_over_orb"].get<double>());
-  std::printf("%-34s %10.2f  (issue 3: <= 1.5; ORB-500 timed after each step)\n",
+  std::printf("%-34s %10.2f  (target: <= 1.5; ORB-500 timed after each step)\n",
               "repeat_step / orb500 interl.", j["repeat_step_over_orb_interleaved"].get<double>());
-  std::printf("%-34s %10.2f  (issue 21: <= 1.5)\n", "repeat_step_default / orb500",
+  std::printf("%-34s %10.2f  (target: <= 1.5)\n", "repeat_step_default / orb500",
               j["repeat_step_default_over_orb"].get<double>());
-  std::printf("%-34s %10.2f  (issue 21: <= 1.5; ORB-500 timed after each step)\n",
+  std::printf("%-34s %10.2f  (target: <= 1.5; ORB-500 timed after each step)\n",
               "repeat_step_default / orb500 interl.",
               j["repeat_step_default_over_orb_interleaved"].get<double>());
-  std::printf("%-34s %10.2f  (issue 44: <= 2.0; ORB-500 timed after each step)\n",
+  std::printf("%-34s %10.2f  (target: <= 2.0; ORB-500 timed after each step)\n",
               "teach_step / orb500 interl.", j["teach_step_over_orb_interleaved"].get<double>());
-  std::printf("%-34s %10.2f  (issue 44: <= 2.0; KLT in two halves on two threads)\n",
+  std::printf("%-34s %10.2f  (target: <= 2.0; KLT in two halves on two threads)\n",
               "teach_step 2 threads / orb500",
               j["teach_step_2_threads_over_orb_interleaved"].get<double>());
-  std::printf("%-34s %10.2f  (issue 44: <= 1.5; ORB-500 timed after each step)\n",
+  std::printf("%-34s %10.2f  (target: <= 1.5; ORB-500 timed after each step)\n",
               "repeat_step_with_watch / orb500 int.",
               j["repeat_step_default_with_watch_over_orb_interleaved"].get<double>());
-  std::printf("%-34s %10.2f  (issue 44: <= 1.5; the watch on a second thread)\n",
+  std::printf("%-34s %10.2f  (target: <= 1.5; the watch on a second thread)\n",
               "repeat_step_with_watch 2 thr / orb500",
               j["repeat_step_default_with_watch_2_threads_over_orb_interleaved"].get<double>());
   if (j.contains("repeat_step_5_views_over_1")) {
-    std::printf("%-34s %10.2f  (issue 45: <= 1.3; mean %.2f)\n", "repeat_step 5 views / 1 view",
+    std::printf("%-34s %10.2f  (target: <= 1.3; mean %.2f)\n", "repeat_step 5 views / 1 view",
                 j["repeat_step_5_views_over_1"].get<double>(),
                 j["repeat_step_5_views_over_1_mean"].get<double>());
   }
@@ -165,33 +165,33 @@ void PrintStageTable(const nlohmann::json& j) {
               j["orb_detector_over_opencv_same_settings"].get<double>());
   std::printf("%-34s %10.2f\n", "repeat_step_default_mean / orb500",
               j["repeat_step_default_mean_over_orb"].get<double>());
-  std::printf("%-34s %10.2f  (issue 21: <= 1.0)\n", "obstacle_watch / dis_fast",
+  std::printf("%-34s %10.2f  (target: <= 1.0)\n", "obstacle_watch / dis_fast",
               j["obstacle_watch_over_dis_fast"].get<double>());
   std::printf("%-34s %10.2f\n", "repeat_step_fresh / orb500",
               j["repeat_step_fresh_over_orb"].get<double>());
-  std::printf("%-34s %10.2f  (issue 3: <= 6.0)\n", "segment_start / orb500",
+  std::printf("%-34s %10.2f  (target: <= 6.0)\n", "segment_start / orb500",
               j["segment_start_over_orb"].get<double>());
-  std::printf("%-34s %10.2f  (issue 44: >= 100; %s kernels)\n", "pyrlk_every_pixel / dense_lk",
+  std::printf("%-34s %10.2f  (target: >= 100; %s kernels)\n", "pyrlk_every_pixel / dense_lk",
               j["pyrlk_every_pixel_over_dense_lk"].get<double>(),
               j["dense_lk_kernels"].get<std::string>().c_str());
   std::printf("%-34s %10.2f  (the same flow without AVX2)\n", "pyrlk_every_pixel / dense_lk base",
               j["pyrlk_every_pixel_over_dense_lk_baseline_kernels"].get<double>());
-  std::printf("%-34s %10.2f  (issue 4: <= 2.0)\n", "dominant_plane_step / dis_fast",
+  std::printf("%-34s %10.2f  (target: <= 2.0)\n", "dominant_plane_step / dis_fast",
               j["dominant_plane_step_over_dis_fast"].get<double>());
-  std::printf("%-34s %10.2f  (issue 44: <= 2.0; the navigator's default, DIS medium)\n",
+  std::printf("%-34s %10.2f  (target: <= 2.0; the navigator's default, DIS medium)\n",
               "navigator_default / dis_fast", j["navigator_default_over_dis_fast"].get<double>());
-  std::printf("%-34s %10.2f  (issue 44: <= 2.0; the flow on two threads, a robot file's default)\n",
+  std::printf("%-34s %10.2f  (target: <= 2.0; the flow on two threads, a robot file's default)\n",
               "navigator_default 2 thr / dis_fast",
               j["navigator_default_2_threads_over_dis_fast"].get<double>());
   for (const char* key : {"ipca_add_1000", "markov_update_10000", "subwindow_control"}) {
-    std::printf("%-34s %10.2f  (issue 5: <= 1.5)\n", (std::string(key) + " / dis_fast").c_str(),
+    std::printf("%-34s %10.2f  (target: <= 1.5)\n", (std::string(key) + " / dis_fast").c_str(),
                 j[std::string(key) + "_over_dis_fast"].get<double>());
   }
-  std::printf("%-34s %10.2f  (issue 66: <= 10; both images described)\n",
+  std::printf("%-34s %10.2f  (target: <= 10; both images described)\n",
               "shift_pair / orb500 512x192", j["shift_pair_over_orb500"].get<double>());
   std::printf("%-34s %10.2f  (the taught view described once, as a repeat does)\n",
               "shift_step / orb500 512x192", j["shift_step_over_orb500"].get<double>());
-  std::printf("%-34s %10.2f  (issue 66: <= 1.0)\n", "sequence_filter_1200 / dis_fast",
+  std::printf("%-34s %10.2f  (target: <= 1.0)\n", "sequence_filter_1200 / dis_fast",
               j["sequence_filter_step_over_dis_fast"].get<double>());
   PrintLinkRows(j);
 }
