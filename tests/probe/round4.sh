@@ -45,6 +45,10 @@ laughs "$FX/r4_robot.yaml" 10 'middleware: ros2\n'
 laughs "$FX/r4_world_inner.yaml" 10
 laughs "$FX/r4_key.yaml" 10
 sed 's/^world:/world: r4_world_inner.yaml/; /^  objects:/d; /^    - /d' "$FX/ok.yaml" >"$FX/r4_world.yaml"
+printf 'name: probe\nworld: &w\n  objects: [*w]\n' >"$FX/r4_cycle.yaml"
+probe "scenario with an alias inside its own node" 2 "an alias inside the node it names" -- "$MAPLESS" sim render --scenario "$FX/r4_cycle.yaml" --pose 0,0,0 --out "$NEW/r4.png"
+printf 'drive: &d {seed: 1, again: *d}\n' >"$FX/r4_cycle_config.yaml"
+probe "run config with an alias inside its own node" 2 "an alias inside the node it names" -- "$MAPLESS" sim drive --scenario "$FX/ok.yaml" --config "$FX/r4_cycle_config.yaml" --out "$NEW/r4d3"
 probe "run config of nested aliases" 2 "r4_config.yaml:" -- "$MAPLESS" sim drive --scenario "$FX/ok.yaml" --config "$FX/r4_config.yaml" --out "$NEW/r4d1"
 probe "calibration of nested aliases" 2 "r4_calibration.yaml:" -- "$MAPLESS" navigate --scenario obstacle_field --calibration "$FX/r4_calibration.yaml"
 probe "camera_info of nested aliases" 2 "r4_camera_info.yaml:" -- "$MAPLESS" repeat --route "$FX/route" --source sim:table1_almost_straight --record "$NEW/r4.mcap" --camera-info "$FX/r4_camera_info.yaml"

@@ -61,6 +61,15 @@ class ExpansionCounter : public YAML::EventHandler {
   void OnDocumentEnd() override {}
   void OnNull(const YAML::Mark& mark, YAML::anchor_t anchor) override { Leaf(mark, anchor); }
   void OnAlias(const YAML::Mark& mark, YAML::anchor_t anchor) override {
+    // An alias inside the very node it names makes the document a cycle: every walk of it (the
+    // duplicate-key check, a reader's loop) would go round for ever (found by fuzz_config).
+    for (const Open& o : open_)
+      if (o.anchor != YAML::NullAnchor && o.anchor == anchor) {
+        std::ostringstream out;
+        out << name_ << ":" << mark.line + 1 << ":" << mark.column + 1
+            << ": an alias inside the node it names (the document would be a cycle)";
+        throw InputError(out.str());
+      }
     const auto it = sizes_.find(anchor);
     Add(mark, it == sizes_.end() ? 1 : it->second);
   }
