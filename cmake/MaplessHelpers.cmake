@@ -5,6 +5,12 @@ function(mapless_target_warnings target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor
                                            -Wold-style-cast -Wcast-align -Wunused -Woverloaded-virtual
                                            -Wnull-dereference -Wformat=2 -Werror)
+  # GCC 12 for aarch64 reports a null dereference inside libstdc++'s std::string copy (a vector
+  # of objects with names copied, eval/suite.cc) that x86-64's GCC 12 does not: kept a warning
+  # there (docs/arm64.md).
+  if(CMAKE_CROSSCOMPILING AND CMAKE_SYSTEM_PROCESSOR STREQUAL "aarch64")
+    target_compile_options(${target} PRIVATE -Wno-error=null-dereference)
+  endif()
   if(MAPLESS_SANITIZE)
     target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer
                                              -fno-sanitize-recover=undefined)

@@ -12,14 +12,19 @@
 #                                    sanitizer build, with its runtimes), clang-format (the style
 #                                    check), dpkg-dev and file (the .deb's dependencies), and
 #                                    Node.js with npm where there is none (the interop tests)
+#        scripts/setup.sh --arm64    also the arm64 cross build's tools: Debian's cross GCC,
+#                                    mmdebstrap (scripts/sysroot_arm64.sh) and qemu user-mode
+#                                    emulation (docs/arm64.md); combines with the others
 set -euo pipefail
 WITH_ROS=0
 WITH_TEST=0
+WITH_ARM64=0
 for arg in "$@"; do
   case "$arg" in
     --ros) WITH_ROS=1 ;;
     --test) WITH_ROS=1; WITH_TEST=1 ;;
-    *) echo "setup: unknown option $arg (known: --ros, --test)" >&2; exit 2 ;;
+    --arm64) WITH_ARM64=1 ;;
+    *) echo "setup: unknown option $arg (known: --ros, --test, --arm64)" >&2; exit 2 ;;
   esac
 done
 
@@ -70,6 +75,10 @@ if [ "$WITH_TEST" = "1" ]; then
     # of ROS 2 Humble and Jazzy, and its type generator (Java).
     PACKAGES+=(libfastrtps-dev fastddsgen)
   fi
+fi
+if [ "$WITH_ARM64" = "1" ]; then
+  PACKAGES+=(crossbuild-essential-arm64 mmdebstrap qemu-user-static
+             cyclonedds-tools)  # idlc runs on the build machine for the arm64 ROS 2 link
 fi
 
 missing=()
