@@ -50,6 +50,14 @@ find "$DIR.new/usr" "$DIR.new/etc" -type l -lname '/*' | while read -r link; do
   target=$(readlink "$link")
   ln -sfn "$(realpath -m --relative-to="$(dirname "$link")" "$DIR.new$target")" "$link"
 done
+# BLAS and LAPACK (OpenCV links them) are reached through Debian's alternatives, which the
+# packages' scripts set up when installed; unpacked only, the reference builds are linked here.
+arch_lib="$DIR.new/usr/lib/aarch64-linux-gnu"
+for lib in blas lapack; do
+  if [ ! -e "$arch_lib/lib$lib.so.3" ] && [ -e "$arch_lib/$lib/lib$lib.so.3" ]; then
+    ln -sfn "$lib/lib$lib.so.3" "$arch_lib/lib$lib.so.3"
+  fi
+done
 mkdir -p "$DIR.new/mapless"
 index="$DIR.new/mapless/shlibs.tsv"
 : >"$index"
