@@ -32,6 +32,8 @@ install(FILES ${PROJECT_BINARY_DIR}/maplessConfig.cmake
 install(FILES ${PROJECT_SOURCE_DIR}/LICENSE ${PROJECT_SOURCE_DIR}/README.md
         DESTINATION ${CMAKE_INSTALL_DOCDIR})
 
+include(${CMAKE_CURRENT_LIST_DIR}/MaplessCrossDepends.cmake)
+
 # The Debian package: Depends from dpkg-shlibdeps (the runtime packages of every shared library
 # the command links), installed under /usr.
 set(CPACK_PACKAGE_NAME mapless)
@@ -66,6 +68,9 @@ endforeach()
 set(_mapless_lazy_packages)
 find_program(MAPLESS_DPKG_QUERY dpkg-query)
 foreach(_file IN LISTS _mapless_lazy_files)
+  if(CMAKE_CROSSCOMPILING)
+    break()
+  endif()
   get_filename_component(_real ${_file} REALPATH)
   if(MAPLESS_DPKG_QUERY)
     execute_process(COMMAND ${MAPLESS_DPKG_QUERY} -S ${_real} OUTPUT_VARIABLE _owner
@@ -76,6 +81,15 @@ foreach(_file IN LISTS _mapless_lazy_files)
     endif()
   endif()
 endforeach()
-list(JOIN _mapless_lazy_packages ", " CPACK_DEBIAN_PACKAGE_DEPENDS)
+if(CMAKE_CROSSCOMPILING)
+  # A cross build (the arm64 preset): the build machine's dpkg-shlibdeps and dpkg-query know only
+  # its own architecture's packages. The Depends come instead from the sysroot's index
+  # (scripts/sysroot_arm64.sh: soname, package, shlibs dependency), for every NEEDED entry of the
+  # packed command and the libraries opened on first use, when cpack runs
+  # (cmake/MaplessCrossDepends.cmake).
+  mapless_cross_package_depends("${_mapless_lazy_files}")
+else()
+  list(JOIN _mapless_lazy_packages ", " CPACK_DEBIAN_PACKAGE_DEPENDS)
+endif()
 set(CPACK_GENERATOR DEB)
 include(CPack)

@@ -4,7 +4,7 @@
 # theirs runs) by mmdebstrap from this machine's own apt sources, into build/sysroot-arm64.
 # It also writes the sysroot's shared-library index (mapless/shlibs.tsv inside it: soname, the
 # package that ships it and the dependency its shlibs file asks for), from which the arm64 .deb's
-# Depends are computed (cmake/MaplessDebArm64.cmake). Kept between runs: made again only when the
+# Depends are computed (cmake/MaplessCrossDepends.cmake). Kept between runs: made again only when the
 # package list below changes. Usage: scripts/sysroot_arm64.sh [DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
