@@ -1,6 +1,7 @@
 # Helpers shared by every target of the project.
 
-# Warnings as errors on the project's own targets only (never in global flags).
+# Warnings as errors and the arithmetic's flags on the project's own targets only (never in global
+# flags).
 function(mapless_target_warnings target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor
                                            -Wold-style-cast -Wcast-align -Wunused -Woverloaded-virtual
@@ -11,6 +12,13 @@ function(mapless_target_warnings target)
   if(CMAKE_CROSSCOMPILING AND CMAKE_SYSTEM_PROCESSOR STREQUAL "aarch64")
     target_compile_options(${target} PRIVATE -Wno-error=null-dereference)
   endif()
+  # No contraction of a*b+c into one fused multiply-add: every product and sum rounds on its own,
+  # on every CPU. GCC fuses by default in C++ where the target has FMA (always on aarch64, and on
+  # x86-64 with -march=native), which moves the last bit of a float and then, through a
+  # comparison, a decision: with this flag an arm64 build makes the decisions of x86-64's
+  # (tests/arm64/same_decisions.sh) and the SIMD kernels equal their portable loops
+  # (docs/arm64.md).
+  target_compile_options(${target} PRIVATE -ffp-contract=off)
   if(MAPLESS_SANITIZE)
     target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer
                                              -fno-sanitize-recover=undefined)

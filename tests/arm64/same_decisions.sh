@@ -31,8 +31,8 @@ run_both() {  # run_both NAME ARGS...: the command on both builds; logs in $TMP/
   [ $rc_a -eq 0 ] || tail -3 "$TMP/arm64/$name.log" | sed 's/^/     arm64 | /'
   [ $rc_x -eq 0 ] && [ $rc_a -eq 0 ]
 }
-# The log's lines without spdlog's time stamp.
-outcome() { sed -n "s/^\[[^]]*\] \[[a-z]*\] \($1.*\)/\1/p" "$2"; }
+# The log's lines without their level ("[info] teach: ...").
+outcome() { sed -n "s/^\[[a-z]*\] \($1.*\)/\1/p" "$2"; }
 same_files() {  # same_files GLOB: "EQUAL of TOTAL" over the files GLOB names under both routes
   local total=0 equal=0 f
   for f in $TMP/x86/$1; do

@@ -235,6 +235,30 @@ cv::Mat PlainDenseLucasKanade(const cv::Mat& first, const cv::Mat& second,
   return flow;
 }
 
+// The kept-images implementation against the plain composition of OpenCV calls: the same bytes
+// where OpenCV's build rounds as mapless's code does (x86-64). OpenCV's arm64 build does not: its
+// vector code uses NEON's fused multiply-add and GCC contracts its scalar code, while mapless's
+// kernels keep every product and sum rounded on its own (-ffp-contract=off), so that they give
+// x86-64's flow on arm64 too (docs/arm64.md). There the two agree within the bounds below.
+constexpr double kArm64MeanBoundPx = 1e-3;  // the mean difference over the pixels' components
+constexpr double kArm64MaxBoundPx = 0.25;   // the largest, at an ill-conditioned pixel
+::testing::AssertionResult SameFlowAsTheComposition(const cv::Mat& ours, const cv::Mat& plain) {
+#if defined(__aarch64__)
+  if (ours.size() != plain.size() || ours.type() != plain.type())
+    return ::testing::AssertionFailure() << "sizes or types differ";
+  const double max = cv::norm(ours, plain, cv::NORM_INF);
+  const double mean =
+      cv::norm(ours, plain, cv::NORM_L1) / (2.0 * static_cast<double>(ours.total()));
+  ::testing::AssertionResult r = mean <= kArm64MeanBoundPx && max <= kArm64MaxBoundPx
+                                     ? ::testing::AssertionSuccess()
+                                     : ::testing::AssertionFailure();
+  return r << "mean difference " << mean << " px, largest " << max << " px";
+#else
+  return SameBytes(ours, plain) ? ::testing::AssertionSuccess()
+                                : ::testing::AssertionFailure() << "the bytes differ";
+#endif
+}
+
 // Both builds of the vector loops (the AVX2 one where the CPU has it, and the baseline).
 class DenseLkKernelsTest : public ::testing::TestWithParam<bool> {
  protected:
@@ -253,11 +277,12 @@ TEST_P(DenseLkKernelsTest, IsThePlainCompositionBitForBit) {
     const cv::Mat b = Translate(a, dx, dy);
     std::vector<cv::Mat> plain_layers, layers;
     const cv::Mat plain = PlainDenseLucasKanade(a, b, DenseLkOptions{}, &plain_layers);
-    EXPECT_TRUE(SameBytes(DenseLucasKanade(a, b, DenseLkOptions{}, &layers), plain))
+    EXPECT_TRUE(SameFlowAsTheComposition(DenseLucasKanade(a, b, DenseLkOptions{}, &layers), plain))
         << w << "x" << h;
     ASSERT_EQ(layers.size(), plain_layers.size());
     for (std::size_t l = 0; l < layers.size(); ++l)
-      EXPECT_TRUE(SameBytes(layers[l], plain_layers[l])) << w << "x" << h << " layer " << l;
+      EXPECT_TRUE(SameFlowAsTheComposition(layers[l], plain_layers[l]))
+          << w << "x" << h << " layer " << l;
   }
   // Options other than the defaults: one iteration, no median, a 7x7 window, a flat threshold.
   DenseLkOptions other;
@@ -268,8 +293,8 @@ TEST_P(DenseLkKernelsTest, IsThePlainCompositionBitForBit) {
   const cv::Mat a = Texture(200, 150, 3);
   const cv::Mat b = Translate(a, 3.0, -2.0);
   std::vector<cv::Mat> plain_layers;
-  EXPECT_TRUE(
-      SameBytes(DenseLucasKanade(a, b, other), PlainDenseLucasKanade(a, b, other, &plain_layers)));
+  EXPECT_TRUE(SameFlowAsTheComposition(DenseLucasKanade(a, b, other),
+                                       PlainDenseLucasKanade(a, b, other, &plain_layers)));
 }
 
 TEST(DenseLucasKanade, Avx2KernelsGiveTheBaselineFlow) {
