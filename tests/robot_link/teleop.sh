@@ -24,27 +24,30 @@ printf 'middleware: %s\nname: teleop test\nnode_name: teleop\nsafety: {give_up_w
 run_case() {
   local name=$1 want=$2 how=$3
   rm -f "$OUT/before" "$OUT/after" "$OUT/pid" "$OUT/rc"
-  timeout 30 "$PROBE" listen 0 20 0 >"$OUT/probe_$how.json" 2>&1 &
+  rm -f "$OUT/ready" "$OUT/tpid" "$OUT/act" "$OUT/end"
+  SAFETY_PROBE_READY="$OUT/ready" timeout 30 "$PROBE" listen 0 20 0 >"$OUT/probe_$how.json" 2>&1 &
   local probe=$!; PIDS+=("$probe")
   sleep 1.5  # the probe's subscription in place (discovery)
-  rm -f "$OUT/tpid" "$OUT/act" "$OUT/end"
   local inner="stty -g >$OUT/before; $BIN teleop --robot $OUT/robot.yaml </dev/tty & t=\$!; echo \$t >$OUT/tpid; wait \$t; echo \$? >$OUT/rc; date +%s.%N >$OUT/end; stty -g >$OUT/after"
+  # The act waits for teleop's cmd_vel to be connected to the probe (its ready file), 15 s at
+  # most: a fixed delay was too short on a loaded machine (the zero went to no one).
+  ready() { for _ in $(seq 1 150); do [ -e "$OUT/ready" ] && return 0; sleep 0.1; done; return 1; }
   act() {  # the act, its time noted
     date +%s.%N >"$OUT/act"
     case "$how" in key_c) printf '\003' ;; key_d) printf '\004' ;; *) kill -"${how^^}" "$(cat "$OUT/tpid")" ;; esac
   }
   case "$how" in
     key_c | key_d | term | hup)
-      { sleep 2; act; sleep 3.5; } |
-        timeout 20 script -q -e -c "$inner" /dev/null >"$OUT/teleop_$how.log" 2>&1
+      { ready; sleep 0.3; act; sleep 3.5; } |
+        timeout 30 script -q -e -c "$inner" /dev/null >"$OUT/teleop_$how.log" 2>&1
       ;;
     eof)  # not a terminal: standard input a pipe that ends after 2 s
-      { sleep 2; date +%s.%N >"$OUT/act"; } |
-        (timeout 20 "$BIN" teleop --robot "$OUT/robot.yaml" >"$OUT/teleop_$how.log" 2>&1; echo $? >"$OUT/rc"; date +%s.%N >"$OUT/end")
+      { ready; sleep 0.3; date +%s.%N >"$OUT/act"; } |
+        (timeout 30 "$BIN" teleop --robot "$OUT/robot.yaml" >"$OUT/teleop_$how.log" 2>&1; echo $? >"$OUT/rc"; date +%s.%N >"$OUT/end")
       ;;
     close)  # the terminal goes away: `script` (the pseudo-terminal's master) killed
-      { sleep 30; } | timeout 20 script -q -e -c "$inner" /dev/null >"$OUT/teleop_$how.log" 2>&1 &
-      local s=$!; sleep 2
+      { sleep 30; } | timeout 30 script -q -e -c "$inner" /dev/null >"$OUT/teleop_$how.log" 2>&1 &
+      local s=$!; ready; sleep 0.3
       date +%s.%N >"$OUT/act"
       pkill -KILL -P "$s" -x script 2>/dev/null; kill -KILL "$s" 2>/dev/null
       local tpid; tpid=$(cat "$OUT/tpid" 2>/dev/null)
@@ -59,6 +62,8 @@ run_case() {
   [ -s "$OUT/act" ] && [ -s "$OUT/end" ] &&
     awk -v a="$(cat "$OUT/act")" -v e="$(cat "$OUT/end")" 'BEGIN { printf "  ended %.2f s after the act\n", e - a; exit !(e - a >= 0 && e - a < 3) }'
   check "$name: teleop ended within 3 s" $?
+  [ -e "$OUT/ready" ]
+  check "$name: teleop's cmd_vel reached the probe before the act" $?
   wait "$probe"; local probe_rc=$?
   echo "  probe: $(cat "$OUT/probe_$how.json")"
   if [ "$how" != close ]; then

@@ -6,7 +6,9 @@
 //   estop       true on /mapless/estop, held 1.2 s (commands meanwhile at most MAX_STOP_PER_S a
 //               second); then false, and the robot must be driven again within 2 s
 //   listen      (no action, NONZERO 0) the first command within LIMIT_S must be a zero Twist
-//               (teleop ending before any frame: tests/robot_link/teleop.sh)
+//               (teleop ending before any frame: tests/robot_link/teleop.sh); with
+//               SAFETY_PROBE_READY=FILE it writes FILE once a publisher of cmd_vel is matched
+//               (so the test acts on a connected robot link, not after a guessed delay)
 //   topics      (no action) the status topic carries one JSON object per frame naming the method,
 //               and the debug image topic bgr8 pictures at least 320 wide
 // Prints one JSON line; exit 0 when the zero came within the limit, 1 when it came late, was not
@@ -28,6 +30,15 @@
 #include <thread>
 
 namespace {
+
+// Writes the ready file (SAFETY_PROBE_READY) atomically; true when written.
+bool WriteReadyFile(const char* path) {
+  const std::string tmp = std::string(path) + ".tmp";
+  FILE* f = std::fopen(tmp.c_str(), "w");
+  if (f == nullptr) return false;
+  std::fputs("matched\n", f);
+  return std::fclose(f) == 0 && std::rename(tmp.c_str(), path) == 0;
+}
 
 using Clock = std::chrono::steady_clock;
 std::mutex g_mutex;
@@ -163,11 +174,15 @@ int main(int argc, char** argv) {
   const auto wait_until =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(
                          std::chrono::duration<double>(mode == "listen" ? limit : 3.0));
+  const char* ready_file = std::getenv("SAFETY_PROBE_READY");
+  bool ready = false;
   while (Clock::now() < wait_until) {
     {
       std::lock_guard<std::mutex> lock(g_mutex);
       if (g_after) break;
     }
+    if (ready_file != nullptr && !ready && sub.getNumPublishers() > 0)
+      ready = WriteReadyFile(ready_file);
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   bool resumed = true;

@@ -1,6 +1,7 @@
 #include "mapless/features/orb.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -8,6 +9,31 @@
 #include "mapless/core/check.h"
 
 namespace mapless::features {
+
+// OpenCV 4's scalar atan_f32, written out (orb.h).
+float FastAtan2Degrees(float y, float x) {
+  constexpr float kDegrees = static_cast<float>(180 / CV_PI);
+  constexpr float p1 = 0.9997878412794807f * kDegrees;
+  constexpr float p3 = -0.3258083974640975f * kDegrees;
+  constexpr float p5 = 0.1555786518463281f * kDegrees;
+  constexpr float p7 = -0.04432655554792128f * kDegrees;
+  const float ax = std::abs(x);
+  const float ay = std::abs(y);
+  float a;
+  if (ax >= ay) {
+    const float c = ay / (ax + static_cast<float>(DBL_EPSILON));
+    const float c2 = c * c;
+    a = (((p7 * c2 + p5) * c2 + p3) * c2 + p1) * c;
+  } else {
+    const float c = ax / (ay + static_cast<float>(DBL_EPSILON));
+    const float c2 = c * c;
+    a = 90.f - (((p7 * c2 + p5) * c2 + p3) * c2 + p1) * c;
+  }
+  if (x < 0) a = 180.f - a;
+  if (y < 0) a = 360.f - a;
+  return a;
+}
+
 namespace {
 
 constexpr int kEdge = 31;   // no keypoint closer than this to its level's edge (cv::ORB's default)
@@ -204,7 +230,7 @@ float HarrisResponse(const cv::Mat& level, const cv::KeyPoint& kp) {
          scale4;
 }
 
-// Orientation by the intensity centroid of the circular patch (degrees, cv::fastAtan2).
+// Orientation by the intensity centroid of the circular patch (degrees, as cv::fastAtan2).
 float CentroidAngle(const cv::Mat& level, const cv::KeyPoint& kp, const std::vector<int>& umax) {
   const int step = static_cast<int>(level.step);
   const uchar* centre = level.ptr<uchar>(cvRound(kp.pt.y)) + cvRound(kp.pt.x);
@@ -221,7 +247,7 @@ float CentroidAngle(const cv::Mat& level, const cv::KeyPoint& kp, const std::vec
     }
     m01 += v * v_sum;
   }
-  return cv::fastAtan2(static_cast<float>(m01), static_cast<float>(m10));
+  return FastAtan2Degrees(static_cast<float>(m01), static_cast<float>(m10));
 }
 
 void Describe(const cv::Mat& blurred, const cv::KeyPoint& kp, float level_scale,

@@ -31,6 +31,14 @@ struct OrbTestPair {
 // when they could not be read off this OpenCV (then OrbDetector falls back to cv::ORB).
 const std::vector<OrbTestPair>& OrbTestPairs();
 
+// cv::fastAtan2(y, x) (degrees in [0, 360): OpenCV 4's scalar 7th-order polynomial), computed
+// here for the keypoints' angles. OpenCV's arm64 build contracts the polynomial into fused
+// multiply-adds, and its angles differ from x86-64's in the last place; a descriptor's rotated
+// test points then cross a pixel now and then, and so do the matches and the robot's decisions.
+// This one rounds alike on both (mapless builds with -ffp-contract=off) and is bit for bit
+// cv::fastAtan2 on x86-64 (tested).
+float FastAtan2Degrees(float y, float x);
+
 class OrbDetector {
  public:
   // As cv::ORB::create(max_features, scale_factor, levels, 31, 0, 2, HARRIS_SCORE, 31,

@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <utility>
 
 #include "mapless/io/image_file.h"
 #include "mapless/sim/simulation.h"
@@ -52,8 +54,21 @@ bool SameResponse(float ours, float theirs) {
 #endif
 }
 
-// The same keypoints (every field; the response as SameResponse) and descriptors, in the same
-// order, as cv::ORB; returns how many.
+// The same angle as cv::ORB's (cv::fastAtan2). Bit for bit on x86-64; OpenCV's arm64 build fuses
+// the polynomial's multiply-adds (FastAtan2Degrees), so there within a few units in the last
+// place (2e-4 degrees, around the circle).
+bool SameAngle(float ours, float theirs) {
+#if defined(__aarch64__)
+  const float d = std::abs(ours - theirs);
+  return std::min(d, 360.f - d) <= 2e-4f;
+#else
+  return ours == theirs;
+#endif
+}
+
+// The same keypoints (every field; the response as SameResponse, the angle as SameAngle) and
+// descriptors, in the same order, as cv::ORB; returns how many. (On arm64 a descriptor is
+// compared where the two angles are equal: a different angle rotates the tests.)
 std::size_t ExpectSameAsOpenCv(const cv::Mat& grey, int max_features, int threshold,
                                const std::string& what) {
   EXPECT_EQ(OrbTestPairs().size(), 256u) << "without the test pairs OrbDetector is cv::ORB";
@@ -69,22 +84,47 @@ std::size_t ExpectSameAsOpenCv(const cv::Mat& grey, int max_features, int thresh
   for (std::size_t i = 0; i < ours.size(); ++i) {
     const cv::KeyPoint& a = ours[i];
     const cv::KeyPoint& b = theirs[i];
-    EXPECT_TRUE(a.pt == b.pt && a.size == b.size && a.angle == b.angle &&
+    EXPECT_TRUE(a.pt == b.pt && a.size == b.size && SameAngle(a.angle, b.angle) &&
                 SameResponse(a.response, b.response) && a.octave == b.octave &&
                 a.class_id == b.class_id)
         << what << ": keypoint " << i << " (" << a.pt << " " << a.angle << " " << a.response
         << " level " << a.octave << ") vs (" << b.pt << " " << b.angle << " " << b.response
         << " level " << b.octave << ")";
-    if (!(a.pt == b.pt && a.angle == b.angle)) return 0;
+    if (!(a.pt == b.pt && SameAngle(a.angle, b.angle))) return 0;
   }
   EXPECT_EQ(ours_d.size(), theirs_d.size()) << what;
   EXPECT_EQ(ours_d.type(), theirs_d.type()) << what;
   if (ours_d.size() != theirs_d.size() || ours_d.type() != theirs_d.type()) return 0;
   for (int r = 0; r < ours_d.rows; ++r) {
+    if (ours[static_cast<std::size_t>(r)].angle != theirs[static_cast<std::size_t>(r)].angle)
+      continue;  // (arm64 only: SameAngle)
     EXPECT_EQ(std::memcmp(ours_d.ptr(r), theirs_d.ptr(r), static_cast<std::size_t>(ours_d.cols)), 0)
         << what << ": descriptor " << r;
   }
   return ours.size();
+}
+
+// cv::fastAtan2 of the moments a patch can have (and the axes, the diagonals, zero), bit for bit
+// on x86-64; within SameAngle on arm64.
+TEST(FastAtan2Degrees, IsOpenCvsFastAtan2) {
+  std::vector<std::pair<float, float>> cases = {{0.f, 0.f}, {0.f, 1.f}, {1.f, 0.f}, {0.f, -1.f},
+                                                {-1.f, 0.f}, {1.f, 1.f}, {-1.f, -1.f}, {3.f, -3.f}};
+  cv::RNG rng(11);
+  for (int i = 0; i < 200000; ++i) {
+    const int range = i % 2 ? 4000 : 6000000;  // |m01|, |m10| up to 31 * 255 * 751
+    cases.emplace_back(static_cast<float>(rng.uniform(-range, range + 1)),
+                       static_cast<float>(rng.uniform(-range, range + 1)));
+  }
+  int different = 0;
+  for (const auto& [y, x] : cases) {
+    const float ours = FastAtan2Degrees(y, x);
+    const float theirs = cv::fastAtan2(y, x);
+    EXPECT_TRUE(SameAngle(ours, theirs)) << y << ", " << x << ": " << ours << " vs " << theirs;
+    EXPECT_TRUE(ours >= 0.f && ours <= 360.f) << y << ", " << x << ": " << ours;
+    different += ours != theirs;
+  }
+  std::printf("FastAtan2Degrees: %d of %zu angles differ from cv::fastAtan2's\n", different,
+              cases.size());
 }
 
 TEST(OrbTestPairs, AreReadOffOpenCv) {
