@@ -107,7 +107,7 @@ std::size_t ExpectSameAsOpenCv(const cv::Mat& grey, int max_features, int thresh
 // cv::fastAtan2 of the moments a patch can have (and the axes, the diagonals, zero), bit for bit
 // on x86-64; within SameAngle on arm64.
 TEST(FastAtan2Degrees, IsOpenCvsFastAtan2) {
-  std::vector<std::pair<float, float>> cases = {{0.f, 0.f}, {0.f, 1.f}, {1.f, 0.f}, {0.f, -1.f},
+  std::vector<std::pair<float, float>> cases = {{0.f, 0.f},  {0.f, 1.f}, {1.f, 0.f},   {0.f, -1.f},
                                                 {-1.f, 0.f}, {1.f, 1.f}, {-1.f, -1.f}, {3.f, -3.f}};
   cv::RNG rng(11);
   for (int i = 0; i < 200000; ++i) {

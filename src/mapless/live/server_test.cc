@@ -417,7 +417,7 @@ TEST(LiveServer, TwoHundredClientsGetAFewLinesWithACountAndConnectionsAreBounded
 TEST(LiveServer, AClientThatResubscribesWithoutReadingCannotGrowItsQueue) {
   ServerOptions options;
   options.max_buffered_bytes = 64 * 1024;
-  options.stall_timeout_s = 600.0;  // not cut off: what it can queue is what is measured
+  options.stall_timeout_s = 600.0;      // not cut off: what it can queue is what is measured
   options.handshake_timeout_s = 600.0;  // nor closed for its unanswered pings (every 5 s)
   auto server = AServer(options);
   server->Offer(AFrame(0));  // a frame: the route is latched from now on
