@@ -77,7 +77,7 @@ if [ "$WITH_TEST" = "1" ]; then
   fi
 fi
 if [ "$WITH_ARM64" = "1" ]; then
-  PACKAGES+=(crossbuild-essential-arm64 mmdebstrap qemu-user-static
+  PACKAGES+=(crossbuild-essential-arm64 mmdebstrap arch-test qemu-user-static
              cyclonedds-tools)  # idlc runs on the build machine for the arm64 ROS 2 link
 fi
 
